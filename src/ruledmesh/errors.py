@@ -1,0 +1,78 @@
+"""The exception hierarchy of ruledmesh.
+
+Every error the library raises on purpose derives from :class:`RuledMeshError`;
+the ones caused by a bad value also derive from :class:`ValueError`, so code
+that already catches ``ValueError`` keeps working.  The CLI turns any of them
+into a one-line message and exit code 2.
+"""
+
+from __future__ import annotations
+
+__all__ = [
+    "RuledMeshError",
+    "DesignError",
+    "ParameterError",
+    "GeometryError",
+    "ExportError",
+]
+
+
+class RuledMeshError(Exception):
+    """Base class of every error ruledmesh raises on purpose."""
+
+
+class _FieldError(RuledMeshError, ValueError):
+    """An error about one named field: ``source: field: detail``.
+
+    Parameters
+    ----------
+    message : str
+        What was expected and what was found.
+    path : str, optional
+        The parameter name or dotted field path, e.g. ``"rulings.count"``.
+    source : str, optional
+        The file name the field comes from.
+    """
+
+    def __init__(self, message: str, path: str | None = None, source: str | None = None):
+        self.field = path
+        self.source = source
+        self.detail = message
+        super().__init__(self._format())
+
+    def _format(self) -> str:
+        parts = []
+        if self.source:
+            parts.append(self.source)
+        if self.field:
+            parts.append(self.field)
+        parts.append(self.detail)
+        return ": ".join(parts)
+
+    def with_source(self, source: str) -> "_FieldError":
+        """Return the same error attributed to the file ``source``."""
+        return type(self)(self.detail, self.field, source)
+
+    def within(self, prefix: str) -> "_FieldError":
+        """Return the same error with ``prefix`` prepended to its field path."""
+        path = f"{prefix}.{self.field}" if self.field else prefix
+        return type(self)(self.detail, path, self.source)
+
+
+class ParameterError(_FieldError):
+    """A function argument has the wrong type, shape or value.
+
+    The message names the parameter and what was received.
+    """
+
+
+class DesignError(_FieldError):
+    """A design file is malformed; the message names the file and the field."""
+
+
+class GeometryError(RuledMeshError, ValueError):
+    """The geometry cannot be meshed as asked (degenerate, out of range, ...)."""
+
+
+class ExportError(RuledMeshError):
+    """A mesh cannot be written in the requested format."""
