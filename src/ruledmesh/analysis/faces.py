@@ -1,0 +1,235 @@
+"""Per-face measures: planarity, convexity, areas, angles, edge lengths.
+
+Every function is vectorised over faces.  Quads use the paper's own criterion
+(§2.1: a quad is planar iff its diagonals intersect), so a quad's planarity is
+the distance between its two diagonal lines divided by the mean diagonal
+length.  Other polygons use the largest distance from their best-fit plane
+divided by their diameter.  Triangles are planar by definition (0).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from ..mesh import Mesh
+
+__all__ = [
+    "quad_planarity",
+    "quad_diagonal_crossing",
+    "polygon_planarity",
+    "planarity",
+    "convexity",
+    "face_areas",
+    "face_normals",
+    "face_centroids",
+    "corner_angles",
+    "edge_lengths",
+]
+
+_TINY = 1e-300
+
+
+def quad_diagonal_crossing(corners: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Closest points of the two diagonals of quads.
+
+    Parameters
+    ----------
+    corners : (F, 4, 3) float64
+        Quad corners in boundary order; the diagonals are 0-2 and 1-3.
+
+    Returns
+    -------
+    s, t : (F,) float64
+        Parameters of the closest points on diagonal 0->2 and 1->3; a convex
+        quad has both strictly inside (0, 1).
+    gap : (F,) float64
+        Distance between the diagonal lines (0 for a planar quad).
+    """
+    p, q = corners[:, 0], corners[:, 1]
+    d1 = corners[:, 2] - p
+    d2 = corners[:, 3] - q
+    w = p - q
+    a = np.einsum("ij,ij->i", d1, d1)
+    b = np.einsum("ij,ij->i", d1, d2)
+    c = np.einsum("ij,ij->i", d2, d2)
+    d = np.einsum("ij,ij->i", d1, w)
+    e = np.einsum("ij,ij->i", d2, w)
+    den = a * c - b * b
+    parallel = den <= 1e-24 * np.maximum(a * c, _TINY)
+    safe = np.where(parallel, 1.0, den)
+    s = np.where(parallel, 0.0, (b * e - c * d) / safe)
+    t = np.where(parallel, e / np.maximum(c, _TINY), (a * e - b * d) / safe)
+    cross = np.cross(d1, d2)
+    ncross = np.linalg.norm(cross, axis=1)
+    gap_skew = np.abs(np.einsum("ij,ij->i", w, cross)) / np.maximum(ncross, _TINY)
+    # Parallel diagonals: distance from q to the line of d1.
+    gap_par = np.linalg.norm(np.cross(w, d1), axis=1) / np.sqrt(np.maximum(a, _TINY))
+    gap = np.where(parallel, gap_par, gap_skew)
+    return s, t, gap
+
+
+def quad_planarity(corners: np.ndarray) -> np.ndarray:
+    """Planarity of quads: distance between the diagonal lines / mean diagonal length.
+
+    Parameters
+    ----------
+    corners : (F, 4, 3) float64
+
+    Returns
+    -------
+    (F,) float64
+        0 for a planar quad; scale-free.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> square = np.array([[[0, 0, 0], [1, 0, 0], [1, 1, 0], [0, 1, 0]]], float)
+    >>> float(quad_planarity(square)[0])
+    0.0
+    >>> bent = square.copy(); bent[0, 2, 2] = 0.1
+    >>> round(float(quad_planarity(bent)[0]), 4)
+    0.0352
+    """
+    _, _, gap = quad_diagonal_crossing(corners)
+    l1 = np.linalg.norm(corners[:, 2] - corners[:, 0], axis=1)
+    l2 = np.linalg.norm(corners[:, 3] - corners[:, 1], axis=1)
+    return gap / np.maximum(0.5 * (l1 + l2), _TINY)
+
+
+def _padded_corners(mesh: Mesh, ids: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Corners of faces ``ids`` padded by repeating each face's first vertex."""
+    val = mesh.valences[ids]
+    k = int(val.max())
+    cols = np.arange(k)
+    start = mesh.face_offsets[ids][:, None]
+    mask = cols[None, :] < val[:, None]
+    idx = np.where(mask, start + cols, start)
+    return mesh.vertices[mesh.face_indices[idx]], mask
+
+
+def polygon_planarity(mesh: Mesh, ids: np.ndarray | None = None) -> np.ndarray:
+    """Largest distance of a face's vertices from its best-fit plane / its diameter.
+
+    Parameters
+    ----------
+    mesh : Mesh
+    ids : (k,) int, optional
+        Faces to measure (all by default).
+
+    Returns
+    -------
+    (k,) float64
+    """
+    ids = np.arange(mesh.n_faces) if ids is None else np.asarray(ids)
+    if ids.size == 0:
+        return np.zeros(0)
+    pts, mask = _padded_corners(mesh, ids)
+    w = mask.astype(float)
+    n = w.sum(axis=1)
+    centroid = (pts * w[..., None]).sum(axis=1) / n[:, None]
+    rel = (pts - centroid[:, None, :]) * w[..., None]
+    cov = np.einsum("fki,fkj->fij", rel, rel)
+    _, vecs = np.linalg.eigh(cov)
+    normal = vecs[:, :, 0]
+    dist = np.abs(np.einsum("fki,fi->fk", rel, normal)).max(axis=1)
+    diff = pts[:, :, None, :] - pts[:, None, :, :]
+    diam = np.sqrt(np.einsum("fabi,fabi->fab", diff, diff).max(axis=(1, 2)))
+    out = dist / np.maximum(diam, _TINY)
+    out[mesh.valences[ids] == 3] = 0.0
+    return out
+
+
+def planarity(mesh: Mesh) -> np.ndarray:
+    """(F,) float64: planarity of every face (quads by diagonals, others by plane fit)."""
+    out = np.zeros(mesh.n_faces)
+    qid, quads = mesh.faces_of_valence(4)
+    if qid.size:
+        out[qid] = quad_planarity(mesh.vertices[quads])
+    other = np.flatnonzero(mesh.valences > 4)
+    if other.size:
+        out[other] = polygon_planarity(mesh, other)
+    return out
+
+
+def face_normals(mesh: Mesh) -> tuple[np.ndarray, np.ndarray]:
+    """Newell vector area of every face.
+
+    Returns
+    -------
+    normals : (F, 3) float64
+        Unit normals (zero for a degenerate face).
+    areas : (F,) float64
+        Face areas (exact for planar faces).
+    """
+    v = mesh.vertices
+    idx = mesh.face_indices
+    nxt = np.arange(idx.size) + 1
+    nxt[mesh.face_offsets[1:] - 1] = mesh.face_offsets[:-1]
+    cr = np.cross(v[idx], v[idx[nxt]])
+    vec = 0.5 * np.add.reduceat(cr, mesh.face_offsets[:-1], axis=0) if idx.size else np.zeros((0, 3))
+    area = np.linalg.norm(vec, axis=1)
+    normals = vec / np.maximum(area, _TINY)[:, None]
+    return normals, area
+
+
+def face_areas(mesh: Mesh) -> np.ndarray:
+    """(F,) float64: area of every face."""
+    return face_normals(mesh)[1]
+
+
+def face_centroids(mesh: Mesh) -> np.ndarray:
+    """(F, 3) float64: mean of each face's vertices."""
+    sums = np.add.reduceat(mesh.vertices[mesh.face_indices], mesh.face_offsets[:-1], axis=0)
+    return sums / mesh.valences[:, None]
+
+
+def corner_angles(mesh: Mesh) -> np.ndarray:
+    """(N,) float64: interior angle in degrees at every face corner, in face_indices order."""
+    v = mesh.vertices
+    idx = mesh.face_indices
+    pos = np.arange(idx.size)
+    nxt = pos + 1
+    nxt[mesh.face_offsets[1:] - 1] = mesh.face_offsets[:-1]
+    prv = pos - 1
+    prv[mesh.face_offsets[:-1]] = mesh.face_offsets[1:] - 1
+    e1 = v[idx[prv]] - v[idx]
+    e2 = v[idx[nxt]] - v[idx]
+    cosang = np.einsum("ij,ij->i", e1, e2)
+    sinang = np.linalg.norm(np.cross(e1, e2), axis=1)
+    return np.degrees(np.arctan2(sinang, cosang))
+
+
+def convexity(mesh: Mesh, tol: float = 1e-9) -> np.ndarray:
+    """(F,) bool: every face convex (no bow-tie, no reflex corner).
+
+    A quad is convex when its diagonals cross strictly inside both (by
+    ``tol`` relative to the diagonal); a polygon when all its corners turn the
+    same way about its normal.
+    """
+    ok = np.ones(mesh.n_faces, dtype=bool)
+    qid, quads = mesh.faces_of_valence(4)
+    if qid.size:
+        s, t, _ = quad_diagonal_crossing(mesh.vertices[quads])
+        ok[qid] = (s > tol) & (s < 1 - tol) & (t > tol) & (t < 1 - tol)
+    other = np.flatnonzero(mesh.valences > 4)
+    if other.size:
+        normals, _ = face_normals(mesh)
+        pts, mask = _padded_corners(mesh, other)
+        val = mesh.valences[other]
+        k = pts.shape[1]
+        cols = np.arange(k)
+        nxt = np.where(cols[None, :] + 1 < val[:, None], cols[None, :] + 1, 0)
+        prv = np.where(cols[None, :] > 0, cols[None, :] - 1, val[:, None] - 1)
+        rows = np.arange(len(other))[:, None]
+        e1 = pts - pts[rows, prv]
+        e2 = pts[rows, nxt] - pts
+        turn = np.einsum("fki,fi->fk", np.cross(e1, e2), normals[other])
+        scale = (np.linalg.norm(e1, axis=2) * np.linalg.norm(e2, axis=2))
+        ok[other] = np.all((turn >= -tol * scale) | ~mask, axis=1)
+    return ok
+
+
+def edge_lengths(mesh: Mesh) -> np.ndarray:
+    """(E,) float64: length of every unique edge (see :meth:`Mesh.edges`)."""
+    e = mesh.edges()
+    return np.linalg.norm(mesh.vertices[e[:, 1]] - mesh.vertices[e[:, 0]], axis=1)

@@ -1,0 +1,142 @@
+"""The analysis report: one dictionary of figures, as a table or JSON.
+
+Figures (relative ones are divided by the bounding-box diagonal):
+
+* ``planarity``: per-face measure of :func:`.faces.planarity` (max, mean,
+  number of faces above the tolerance);
+* ``convexity``: number of non-convex faces;
+* ``area``, ``edge_length``, ``min_angle``;
+* ``closeness`` (with a reference surface): distance of face centroids and
+  vertices from the smooth patch, relative to the diagonal;
+* ``coverage`` (with a reference surface): mesh area / smooth patch area.
+"""
+
+from __future__ import annotations
+
+from typing import Any, Mapping
+
+import numpy as np
+
+from ..mesh import Mesh
+from ..tolerances import DEFAULT, Tolerances
+from . import faces as F
+
+__all__ = ["analyze", "format_table", "format_summary", "METRIC_HOOKS"]
+
+# Extra figures from other modules: name -> fn(mesh) -> dict or None (None: not applicable).
+METRIC_HOOKS: dict[str, Any] = {}
+
+
+def _stats(values: np.ndarray) -> dict[str, float]:
+    if values.size == 0:
+        return {"min": 0.0, "max": 0.0, "mean": 0.0}
+    return {"min": float(values.min()), "max": float(values.max()), "mean": float(values.mean())}
+
+
+def analyze(mesh: Mesh, reference=None, extras: Mapping[str, Any] | None = None,
+            tol: Tolerances = DEFAULT) -> dict[str, Any]:
+    """Measure ``mesh``.
+
+    Parameters
+    ----------
+    mesh : Mesh
+    reference : Reference, optional
+        The smooth design surface (``distance(points)``, ``area()``).
+    extras : mapping, optional
+        Construction-specific figures to include as they are.
+    tol : Tolerances
+
+    Returns
+    -------
+    dict
+        JSON-serialisable figures (see the module docstring).
+    """
+    diag = mesh.diagonal() or 1.0
+    plan = F.planarity(mesh)
+    convex = F.convexity(mesh, tol.convexity)
+    normals, areas = F.face_normals(mesh)
+    angles = F.corner_angles(mesh)
+    lengths = F.edge_lengths(mesh)
+    finite = bool(np.all(np.isfinite(mesh.vertices)))
+    report: dict[str, Any] = {
+        "vertices": mesh.n_vertices,
+        "faces": mesh.n_faces,
+        "members": int(len(mesh.members)),
+        "kinds": mesh.count_kinds(),
+        "valences": {str(int(k)): int(c) for k, c in zip(*np.unique(mesh.valences, return_counts=True))},
+        "finite": finite,
+        "diagonal": diag,
+        "planarity": {
+            **_stats(plan),
+            "tolerance": tol.planarity,
+            "above_tolerance": int(np.count_nonzero(plan > tol.planarity)),
+        },
+        "non_convex": int(np.count_nonzero(~convex)),
+        "area": {**_stats(areas), "total": float(areas.sum())},
+        "edge_length": _stats(lengths),
+        "min_angle_deg": float(angles.min()) if angles.size else 0.0,
+        "euler_characteristic": mesh.euler_characteristic(),
+    }
+    if reference is not None:
+        cent = F.face_centroids(mesh)
+        dc = reference.distance(cent) / diag
+        dv = reference.distance(mesh.vertices[np.unique(mesh.face_indices)]) / diag
+        report["closeness"] = {
+            "vertices_max": float(dv.max()) if dv.size else 0.0,
+            "centroids_max": float(dc.max()) if dc.size else 0.0,
+            "centroids_mean": float(dc.mean()) if dc.size else 0.0,
+            "relative_to": "bounding-box diagonal",
+        }
+        patch = reference.area()
+        if patch:
+            report["coverage"] = {
+                "mesh_area": float(areas.sum()),
+                "patch_area": float(patch),
+                "ratio": float(areas.sum() / patch),
+            }
+    for name, hook in METRIC_HOOKS.items():
+        value = hook(mesh)
+        if value is not None:
+            report[name] = value
+    if extras:
+        report.update(dict(extras))
+    warnings = list(mesh.info.get("warnings", []))
+    if not finite:
+        warnings.append("mesh has NaN or infinite coordinates")
+    if report["non_convex"]:
+        warnings.append(f"{report['non_convex']} faces are not convex")
+    if report["planarity"]["above_tolerance"]:
+        warnings.append(f"{report['planarity']['above_tolerance']} faces are not planar to "
+                        f"{tol.planarity:g}")
+    report["warnings"] = warnings
+    return report
+
+
+def format_summary(report: Mapping[str, Any]) -> str:
+    """One line: faces by kind and the worst planarity."""
+    kinds = ", ".join(f"{c} {k}" for k, c in report["kinds"].items())
+    text = (f"{report['faces']} faces ({kinds}), {report['vertices']} vertices, "
+            f"max planarity {report['planarity']['max']:.2e}")
+    if "coverage" in report:
+        text += f", coverage {report['coverage']['ratio']:.4f}"
+    return text
+
+
+def _fmt(value: Any) -> str:
+    if isinstance(value, float):
+        return f"{value:.6g}"
+    if isinstance(value, Mapping):
+        return ", ".join(f"{k} {_fmt(v)}" for k, v in value.items())
+    if isinstance(value, (list, tuple)):
+        return "; ".join(_fmt(v) for v in value) or "-"
+    return str(value)
+
+
+def format_table(report: Mapping[str, Any]) -> str:
+    """The report as an aligned two-column text table."""
+    rows = [(k, _fmt(v)) for k, v in report.items() if k != "warnings"]
+    width = max(len(k) for k, _ in rows)
+    lines = [f"{k.ljust(width)}  {v}" for k, v in rows]
+    for w in report.get("warnings", []):
+        lines.append(f"{'warning'.ljust(width)}  {w}")
+    return "\n".join(lines) + "\n"

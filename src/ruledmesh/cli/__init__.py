@@ -1,0 +1,97 @@
+"""The ``ruledmesh`` command line: one module per subcommand.
+
+Each subcommand module defines ``add_parser(subparsers)``, which registers its
+parser and sets ``run=function(args) -> int``.  :func:`main` turns every
+:class:`~ruledmesh.errors.RuledMeshError` (and unreadable files) into one line
+on stderr and exit code 2, never a traceback; ``--debug`` shows tracebacks.
+"""
+
+from __future__ import annotations
+
+import argparse
+import importlib
+import sys
+from typing import Sequence
+
+from ..errors import RuledMeshError
+
+__all__ = ["main", "COMMANDS"]
+
+# Subcommand modules (relative to ruledmesh.cli), in the order --help lists them.
+COMMANDS = ["build", "analyze", "export", "render", "fabricate", "compare", "design"]
+
+EPILOG = """examples:
+  ruledmesh build examples/skew.toml -o skew.obj     build a PQ mesh from a design file
+  ruledmesh analyze skew.obj                         planarity, convexity, areas (table)
+  ruledmesh analyze examples/skew.toml --json        full analysis incl. closeness, coverage
+  ruledmesh <command> --help                         options of one command
+"""
+
+
+def build_parser() -> argparse.ArgumentParser:
+    """The top-level parser with every available subcommand."""
+    from .. import __version__
+
+    parser = argparse.ArgumentParser(
+        prog="ruledmesh",
+        description="Planar quad meshes of ruled surfaces, by construction.",
+        epilog=EPILOG,
+        formatter_class=argparse.RawDescriptionHelpFormatter,
+    )
+    parser.add_argument("--version", action="version", version=f"ruledmesh {__version__}")
+    parser.add_argument("--debug", action="store_true", help="show tracebacks of errors")
+    sub = parser.add_subparsers(dest="command", metavar="COMMAND")
+    for name in COMMANDS:
+        try:
+            module = importlib.import_module(f"{__name__}.{name}")
+        except ModuleNotFoundError as exc:
+            if exc.name != f"{__name__}.{name}":
+                raise
+            continue
+        module.add_parser(sub)
+    return parser
+
+
+def main(argv: Sequence[str] | None = None) -> int:
+    """Run the command line; returns the exit code.
+
+    Exit codes: 0 success, 2 bad input (design file, parameters, files),
+    3 an internal error (a bug: please report it with ``--debug`` output),
+    130 interrupted.
+    """
+    parser = build_parser()
+    args = parser.parse_args(argv)
+    if not getattr(args, "run", None):
+        parser.print_help()
+        return 2
+    try:
+        return int(args.run(args) or 0)
+    except RuledMeshError as exc:
+        if args.debug:
+            raise
+        print(f"ruledmesh: error: {exc}", file=sys.stderr)
+        return 2
+    except OSError as exc:
+        if args.debug:
+            raise
+        where = f"{exc.filename}: " if exc.filename else ""
+        print(f"ruledmesh: error: {where}{exc.strerror or exc}", file=sys.stderr)
+        return 2
+    except KeyboardInterrupt:
+        print("ruledmesh: interrupted", file=sys.stderr)
+        return 130
+    except MemoryError:
+        if args.debug:
+            raise
+        print("ruledmesh: error: out of memory; reduce the counts in the design", file=sys.stderr)
+        return 2
+    except Exception as exc:  # a bug: one line, not a traceback, unless --debug
+        if args.debug:
+            raise
+        print(f"ruledmesh: internal error: {type(exc).__name__}: {exc} "
+              "(run with --debug and report it)", file=sys.stderr)
+        return 3
+
+
+if __name__ == "__main__":  # pragma: no cover
+    sys.exit(main())

@@ -1,0 +1,177 @@
+"""Design files: TOML in, a built mesh out.
+
+A design is either a ruled surface given by director curves or lines
+(``[curves.*]``, ``[rulings]``, ``[mesh]``) or a catalogue surface
+(``[surface]`` with a ``kind``, and ``[mesh]``), optionally followed by
+``[[transform]]`` tables applied in order.  Every error names the file, the
+dotted field path and what was expected (see ``docs/design-reference.md``).
+"""
+
+from __future__ import annotations
+
+import os
+import tomllib
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any, Mapping
+
+from ._validation import check_keys, describe
+from .errors import DesignError, RuledMeshError
+from .registry import (MESH_METHODS, SURFACE_KINDS, TRANSFORMS, BuildContext, Built,
+                       load_plugins)
+
+__all__ = ["Design", "load_design", "parse_design", "build_design", "build_file"]
+
+TOP_LEVEL = ("curves", "rulings", "mesh", "surface", "transform", "name", "description")
+
+
+@dataclass(frozen=True)
+class Design:
+    """A parsed design file.
+
+    Attributes
+    ----------
+    data : mapping
+        The TOML tables.
+    source : str
+        File name (for messages).
+    base_dir : Path
+        Folder that relative paths resolve against.
+    """
+
+    data: Mapping[str, Any]
+    source: str = "<design>"
+    base_dir: Path = Path(".")
+
+    @property
+    def context(self) -> BuildContext:
+        """The :class:`BuildContext` handed to builders."""
+        return BuildContext(self.source, self.base_dir, self.data)
+
+
+def parse_design(text: str, source: str = "<design>", base_dir: str | os.PathLike = ".") -> Design:
+    """Parse design TOML text.
+
+    Raises
+    ------
+    DesignError
+        For TOML syntax errors (with line and column) and unknown top-level tables.
+    """
+    try:
+        data = tomllib.loads(text)
+    except tomllib.TOMLDecodeError as exc:
+        raise DesignError(f"invalid TOML: {exc}", None, source) from None
+    try:
+        check_keys(data, TOP_LEVEL, "", err=DesignError)
+    except DesignError as exc:
+        raise exc.with_source(source) from None
+    return Design(data, source, Path(base_dir))
+
+
+def load_design(path: str | os.PathLike) -> Design:
+    """Read and parse the design file at ``path``."""
+    path = Path(path)
+    try:
+        text = path.read_text(encoding="utf-8")
+    except FileNotFoundError:
+        raise DesignError("file not found", None, str(path)) from None
+    except (OSError, UnicodeDecodeError) as exc:
+        raise DesignError(f"cannot read: {exc}", None, str(path)) from None
+    return parse_design(text, path.name, path.parent)
+
+
+def _table(data: Mapping, key: str, required: bool = False) -> Mapping:
+    value = data.get(key, {})
+    if key in data and not isinstance(value, Mapping):
+        raise DesignError(f"expected a table, got {describe(value)}", key)
+    if required and key not in data:
+        raise DesignError("missing table", key)
+    return value
+
+
+def _build(design: Design) -> Built:
+    data = design.data
+    ctx = design.context
+    load_plugins()
+    mesh_table = _table(data, "mesh")
+    if "surface" in data:
+        if "rulings" in data:
+            raise DesignError("give either [surface] or [rulings], not both", "rulings")
+        surface = _table(data, "surface")
+        kind = surface.get("kind")
+        if kind not in SURFACE_KINDS:
+            raise _unknown("surface.kind", kind, SURFACE_KINDS)
+        built = SURFACE_KINDS[kind](surface, mesh_table, ctx)
+    else:
+        if "rulings" not in data:
+            raise DesignError("expected a [rulings] table (with [curves.*]) or a [surface] table", "rulings")
+        from .curves import curve_from_spec
+        from .rulings import rulings_from_spec
+
+        curves_table = _table(data, "curves")
+        curves = {}
+        for name, spec in curves_table.items():
+            if not isinstance(spec, Mapping):
+                raise DesignError(f"expected a table, got {describe(spec)}", f"curves.{name}")
+            curves[name] = curve_from_spec(spec, f"curves.{name}")
+        rulings = rulings_from_spec(_table(data, "rulings"), curves, path="rulings",
+                                    base_dir=design.base_dir)
+        method = mesh_table.get("method", "pq")
+        if method not in MESH_METHODS:
+            raise _unknown("mesh.method", method, MESH_METHODS)
+        built = MESH_METHODS[method](rulings, mesh_table, ctx)
+    transforms = data.get("transform", [])
+    if not isinstance(transforms, list):
+        raise DesignError("expected [[transform]] tables (an array of tables)", "transform")
+    for k, table in enumerate(transforms):
+        path = f"transform[{k}]"
+        if not isinstance(table, Mapping):
+            raise DesignError(f"expected a table, got {describe(table)}", path)
+        kind = table.get("type")
+        if kind not in TRANSFORMS:
+            raise _unknown(f"{path}.type", kind, TRANSFORMS)
+        built = TRANSFORMS[kind](built, table, path)
+    return built
+
+
+def _unknown(path: str, value: Any, table: Mapping) -> DesignError:
+    import difflib
+
+    names = sorted(table)
+    listed = " | ".join(f'"{n}"' for n in names)
+    hint = ""
+    if isinstance(value, str):
+        near = difflib.get_close_matches(value, names, n=1)
+        if near:
+            hint = f' (did you mean "{near[0]}"?)'
+    got = "nothing" if value is None else describe(value)
+    return DesignError(f"expected one of {listed}, got {got}{hint}", path)
+
+
+def build_design(design: Design) -> Built:
+    """Build the mesh a design describes.
+
+    Returns
+    -------
+    Built
+        The mesh, its smooth reference surface and the rulings.
+
+    Raises
+    ------
+    DesignError
+        Naming the file and field for any malformed value.
+    GeometryError
+        When the geometry cannot be meshed as asked.
+    """
+    try:
+        built = _build(design)
+    except DesignError as exc:
+        raise (exc if exc.source else exc.with_source(design.source)) from None
+    except RuledMeshError as exc:
+        raise type(exc)(f"{design.source}: {exc}") from None
+    return built
+
+
+def build_file(path: str | os.PathLike) -> Built:
+    """:func:`build_design` of :func:`load_design` (``path``)."""
+    return build_design(load_design(path))

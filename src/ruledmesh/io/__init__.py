@@ -1,0 +1,124 @@
+"""Mesh files: one module per format behind one registry.
+
+Each format module provides pure serialisers, ``dumpb(mesh, **options) ->
+bytes`` (and ``loadb(data) -> Mesh`` where ruledmesh reads the format back).
+:func:`save` picks the format by file extension, refuses a mesh with NaN or
+infinite coordinates, and writes atomically: the bytes go to a temporary file
+in the target folder which is renamed over the target only when complete, so
+an interrupted export never leaves a truncated file.
+"""
+
+from __future__ import annotations
+
+import importlib
+import os
+import tempfile
+from pathlib import Path
+
+import numpy as np
+
+from ..errors import ExportError, ParameterError
+from ..mesh import Mesh
+
+__all__ = ["save", "load", "write_atomic", "WRITERS", "READERS", "formats"]
+
+# extension -> module (relative to ruledmesh.io) providing dumpb / loadb.
+WRITERS: dict[str, str] = {
+    ".obj": "obj",
+    ".ply": "ply",
+}
+READERS: dict[str, str] = {
+    ".obj": "obj",
+    ".ply": "ply",
+}
+
+
+def formats() -> list[str]:
+    """Extensions :func:`save` can write."""
+    return sorted(WRITERS)
+
+
+def _module(ext: str, table: dict[str, str], what: str):
+    try:
+        name = table[ext]
+    except KeyError:
+        known = ", ".join(sorted(table))
+        raise ParameterError(f"cannot {what} \"{ext or '(no extension)'}\" files; known: {known}",
+                             "path") from None
+    return importlib.import_module(f"{__name__}.{name}")
+
+
+def write_atomic(path: str | os.PathLike, data: bytes) -> Path:
+    """Write ``data`` to ``path`` through a temporary file and a rename.
+
+    Parameters
+    ----------
+    path : path-like
+    data : bytes
+
+    Returns
+    -------
+    Path
+        The written path.
+    """
+    path = Path(path)
+    folder = path.parent if str(path.parent) else Path(".")
+    if not folder.is_dir():
+        raise ExportError(f"{path}: folder {folder} does not exist")
+    fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".part", dir=folder)
+    try:
+        with os.fdopen(fd, "wb") as fh:
+            fh.write(data)
+            fh.flush()
+            os.fsync(fh.fileno())
+        os.replace(tmp, path)
+    except BaseException:
+        try:
+            os.unlink(tmp)
+        except FileNotFoundError:
+            pass
+        raise
+    return path
+
+
+def check_finite(mesh: Mesh) -> None:
+    """Refuse to export a mesh with NaN or infinite coordinates."""
+    if not np.all(np.isfinite(mesh.vertices)):
+        bad = int(np.count_nonzero(~np.all(np.isfinite(mesh.vertices), axis=1)))
+        raise ExportError(f"mesh has {bad} vertices with NaN or infinite coordinates; nothing written")
+
+
+def save(path: str | os.PathLike, mesh: Mesh, **options) -> Path:
+    """Write ``mesh`` to ``path``; the format follows the extension.
+
+    Parameters
+    ----------
+    path : path-like
+        Target file; its extension picks the format (see :func:`formats`).
+    mesh : Mesh
+    **options
+        Passed to the format's ``dumpb``.
+
+    Returns
+    -------
+    Path
+    """
+    path = Path(path)
+    module = _module(path.suffix.lower(), WRITERS, "write")
+    check_finite(mesh)
+    data = module.dumpb(mesh, **options)
+    return write_atomic(path, data)
+
+
+def load(path: str | os.PathLike) -> Mesh:
+    """Read a mesh file written by ruledmesh (or any plain OBJ/PLY polygon mesh)."""
+    path = Path(path)
+    module = _module(path.suffix.lower(), READERS, "read")
+    try:
+        data = path.read_bytes()
+    except OSError as exc:
+        raise ParameterError(f"cannot read {path}: {exc.strerror}", "path") from None
+    try:
+        return module.loadb(data)
+    except ParameterError as exc:
+        raise ParameterError(f"{path}: {exc.detail}", exc.field) from None
