@@ -24,7 +24,20 @@ from . import faces as F
 __all__ = ["analyze", "format_table", "format_summary", "METRIC_HOOKS"]
 
 # Extra figures from other modules: name -> fn(mesh) -> dict or None (None: not applicable).
+# Modules in _HOOK_MODULES register themselves here when imported.
 METRIC_HOOKS: dict[str, Any] = {}
+_HOOK_MODULES = ["ruledmesh.analysis.circularity", "ruledmesh.analysis.triangles"]
+
+
+def _load_hooks() -> None:
+    import importlib
+
+    for name in _HOOK_MODULES:
+        try:
+            importlib.import_module(name)
+        except ModuleNotFoundError as exc:
+            if exc.name != name:
+                raise
 
 
 def _stats(values: np.ndarray) -> dict[str, float]:
@@ -94,6 +107,7 @@ def analyze(mesh: Mesh, reference=None, extras: Mapping[str, Any] | None = None,
                 "patch_area": float(patch),
                 "ratio": float(areas.sum() / patch),
             }
+    _load_hooks()
     for name, hook in METRIC_HOOKS.items():
         value = hook(mesh)
         if value is not None:
