@@ -1,0 +1,230 @@
+"""Renders: a mesh's faces coloured by a measure, its generators drawn on top.
+
+Every figure in the docs comes from :func:`render`.  Faces are coloured by
+planarity (log scale, the measure of :func:`ruledmesh.analysis.planarity`),
+by closeness of their centroids to the smooth design surface (relative to the
+bounding-box diagonal), or by :class:`~ruledmesh.mesh.FaceKind`; a colour bar
+says which.  matplotlib is an optional dependency (extra ``plot``) and runs
+headless (the Agg canvas, no pyplot, so no global figure state and no display).
+"""
+
+from __future__ import annotations
+
+import io
+import os
+from enum import Enum
+from pathlib import Path
+
+import numpy as np
+
+from ._validation import check_choice, check_float, check_int
+from .analysis import faces as F
+from .errors import ExportError, ParameterError
+from .mesh import FaceKind, Mesh
+from .tolerances import DEFAULT
+
+__all__ = ["ColorBy", "face_values", "render", "save_render", "FORMATS"]
+
+# File types the Agg-based figure can write, by extension.
+FORMATS = {".png": "png", ".svg": "svg", ".pdf": "pdf"}
+
+# Planarity below this is rounding noise in float64; clamping keeps the log scale finite.
+_PLANARITY_FLOOR = 1e-17
+
+# One fixed colour per FaceKind so figures agree with each other.
+_KIND_COLORS = {
+    FaceKind.QUAD: "#4c78a8",
+    FaceKind.BORDER: "#f58518",
+    FaceKind.FILL: "#e45756",
+    FaceKind.SPLIT: "#b279a2",
+    FaceKind.TRIANGLE: "#54a24b",
+    FaceKind.POLYGON: "#9d755d",
+}
+
+
+class ColorBy(str, Enum):
+    """What the face colours show."""
+
+    PLANARITY = "planarity"
+    CLOSENESS = "closeness"
+    KIND = "kind"
+
+
+def face_values(mesh: Mesh, color: ColorBy | str = ColorBy.PLANARITY, reference=None) -> np.ndarray:
+    """The per-face value a render colours by.
+
+    Parameters
+    ----------
+    mesh : Mesh
+    color : ColorBy or str
+        ``"planarity"``, ``"closeness"`` or ``"kind"``.
+    reference : object with ``distance(points)``, optional
+        The smooth design surface; required for ``"closeness"``.
+
+    Returns
+    -------
+    values : (F,) float64
+        Planarity (scale-free), centroid distance / bounding-box diagonal, or
+        the FaceKind value.
+    """
+    color = check_choice(color, ColorBy, "color")
+    if color is ColorBy.PLANARITY:
+        return F.planarity(mesh)
+    if color is ColorBy.KIND:
+        return mesh.face_kind.astype(np.float64)
+    if reference is None:
+        raise ParameterError("colouring by closeness needs the design surface; "
+                             "give the design file the mesh was built from", "reference")
+    diag = mesh.diagonal() or 1.0
+    return reference.distance(F.face_centroids(mesh)) / diag
+
+
+def _pair(value, name: str, check) -> tuple:
+    """Two checked numbers from a pair (a tuple, list or array)."""
+    if isinstance(value, str) or np.ndim(value) != 1 or len(value) != 2:
+        raise ParameterError(f"expected two numbers, got {value!r}", name)
+    return check(value[0], name), check(value[1], name)
+
+
+def _face_polygons(mesh: Mesh) -> np.ndarray:
+    """(F, K, 3): faces padded to the largest valence by repeating their last vertex.
+
+    A repeated vertex draws nothing, so one array serves faces of mixed valence.
+    """
+    padded = mesh.padded_faces(fill=-1)
+    last = mesh.face_indices[mesh.face_offsets[1:] - 1]
+    padded = np.where(padded < 0, last[:, None], padded)
+    return mesh.vertices[padded]
+
+
+def _colouring(values: np.ndarray, color: ColorBy):
+    """Colormap, norm, colour-bar label and ticks for ``values``."""
+    from matplotlib import colors
+
+    if color is ColorBy.KIND:
+        kinds = list(FaceKind)
+        cmap = colors.ListedColormap([_KIND_COLORS[k] for k in kinds])
+        norm = colors.BoundaryNorm(np.arange(len(kinds) + 1) - 0.5, len(kinds))
+        return cmap, norm, "face kind", (np.arange(len(kinds)), [k.label for k in kinds])
+    if color is ColorBy.PLANARITY:
+        v = np.maximum(values, _PLANARITY_FLOOR)
+        lo = float(v.min()) if v.size else _PLANARITY_FLOOR
+        # The bar reaches at least the planarity tolerance, so an exact mesh shows as
+        # uniformly low instead of stretching rounding noise over the whole colour map.
+        hi = max(float(v.max()) if v.size else lo, DEFAULT.planarity, lo * 10.0)
+        return ("viridis", colors.LogNorm(lo, hi),
+                "planarity (diagonal gap / diagonal length)", None)
+    hi = float(values.max()) if values.size else 0.0
+    return "magma_r", colors.Normalize(0.0, hi if hi > 0 else 1.0), \
+        "closeness (centroid distance / bounding-box diagonal)", None
+
+
+def render(mesh: Mesh, *, color: ColorBy | str = ColorBy.PLANARITY, reference=None,
+           view: tuple[float, float] = (25.0, -60.0), size: tuple[int, int] = (1000, 800),
+           dpi: int = 100, generators: bool = True, edges: bool = True,
+           title: str | None = None, fmt: str = "png") -> bytes:
+    """The picture of ``mesh`` as image bytes.
+
+    Parameters
+    ----------
+    mesh : Mesh
+    color : ColorBy or str
+        ``"planarity"`` (log colour scale), ``"closeness"`` (needs
+        ``reference``) or ``"kind"``.
+    reference : object with ``distance(points)``, optional
+        The smooth design surface, for ``"closeness"``.
+    view : (elevation, azimuth) in degrees
+        The camera direction (matplotlib's ``view_init``).
+    size : (width, height) in pixels
+        The image size (exact for raster formats).
+    dpi : int
+    generators : bool
+        Draw the members (generator segments) as dark lines.
+    edges : bool
+        Outline the faces.
+    title : str, optional
+    fmt : {"png", "svg", "pdf"}
+
+    Returns
+    -------
+    bytes
+        The encoded image.
+    """
+    if not isinstance(mesh, Mesh):
+        raise ParameterError(f"expected a Mesh, got {type(mesh).__name__}", "mesh")
+    color = check_choice(color, ColorBy, "color")
+    if fmt not in FORMATS.values():
+        raise ParameterError(f"expected one of {', '.join(FORMATS.values())}, got \"{fmt}\"", "fmt")
+    elev, azim = _pair(view, "view", check_float)
+    width, height = _pair(size, "size", lambda x, n: check_int(x, n, lo=16, hi=20000))
+    dpi = check_int(dpi, "dpi", lo=10, hi=1200)
+    if mesh.n_faces == 0:
+        raise ParameterError("the mesh has no faces to render", "mesh")
+    if not np.all(np.isfinite(mesh.vertices)):
+        raise ParameterError("the mesh has NaN or infinite coordinates", "mesh")
+    try:
+        from matplotlib.backends.backend_agg import FigureCanvasAgg
+        from matplotlib.figure import Figure
+        from mpl_toolkits.mplot3d.art3d import Line3DCollection, Poly3DCollection
+    except ImportError:
+        raise ExportError("rendering needs matplotlib: pip install 'ruledmesh[plot]'") from None
+
+    values = face_values(mesh, color, reference)
+    cmap, norm, label, ticks = _colouring(values, color)
+
+    fig = Figure(figsize=(width / dpi, height / dpi), dpi=dpi)
+    FigureCanvasAgg(fig)
+    # The 3-D axes reserve wide empty margins; most of the canvas goes to the mesh.
+    ax = fig.add_axes((-0.02, -0.05, 0.88, 1.1), projection="3d", computed_zorder=False)
+    polys = Poly3DCollection(_face_polygons(mesh), cmap=cmap, norm=norm,
+                             edgecolors="#20202080" if edges else "none",
+                             linewidths=0.3 if edges else 0.0)
+    polys.set_array(values if color is not ColorBy.PLANARITY
+                    else np.maximum(values, _PLANARITY_FLOOR))
+    ax.add_collection3d(polys)
+    if generators and len(mesh.members):
+        segs = mesh.vertices[mesh.members]
+        ax.add_collection3d(Line3DCollection(segs, colors="#111111", linewidths=0.8, zorder=3))
+
+    lo, hi = mesh.bounding_box()
+    span = np.maximum(hi - lo, 1e-9 * max(float(np.max(hi - lo)), 1.0))
+    ax.set_xlim(lo[0], lo[0] + span[0])
+    ax.set_ylim(lo[1], lo[1] + span[1])
+    ax.set_zlim(lo[2], lo[2] + span[2])
+    # Equal scale on the three axes: a flat-looking panel must look flat.
+    ax.set_box_aspect(tuple(np.maximum(span / span.max(), 0.02)), zoom=0.9)
+    ax.view_init(elev=elev, azim=azim)
+    ax.set_axis_off()
+    bar = fig.colorbar(polys, cax=fig.add_axes((0.88, 0.2, 0.025, 0.6)))
+    bar.set_label(label)
+    if ticks is not None:
+        bar.set_ticks(ticks[0], labels=ticks[1])
+    if title:
+        ax.set_title(title)
+    buf = io.BytesIO()
+    fig.savefig(buf, format=fmt, dpi=dpi)
+    return buf.getvalue()
+
+
+def save_render(path: str | os.PathLike, mesh: Mesh, **options) -> Path:
+    """Render ``mesh`` to ``path`` (format by extension: .png, .svg, .pdf), atomically.
+
+    Parameters
+    ----------
+    path : path-like
+    mesh : Mesh
+    **options
+        As in :func:`render`.
+
+    Returns
+    -------
+    Path
+    """
+    from .io import write_atomic
+
+    path = Path(path)
+    fmt = FORMATS.get(path.suffix.lower())
+    if fmt is None:
+        raise ParameterError(f"cannot render to \"{path.suffix or '(no extension)'}\" files; "
+                             f"known: {', '.join(FORMATS)}", "path")
+    return write_atomic(path, render(mesh, fmt=fmt, **options))

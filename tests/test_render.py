@@ -1,0 +1,112 @@
+"""Renders: real PNGs read back by matplotlib's reader, faces coloured as asked."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+pytest.importorskip("matplotlib")
+from matplotlib import image as mpimg  # noqa: E402
+from matplotlib import colors  # noqa: E402
+
+from ruledmesh.cli import main  # noqa: E402
+from ruledmesh.errors import ParameterError  # noqa: E402
+from ruledmesh.io import save  # noqa: E402
+from ruledmesh.mesh import FaceKind, Mesh  # noqa: E402
+from ruledmesh.render import face_values, render, save_render  # noqa: E402
+
+
+def translational_mesh(n=7, m=5):
+    """X[i, j] = p_i + q_j: every quad is a parallelogram, hence planar."""
+    s = np.linspace(0.0, 3.0, n)
+    t = np.linspace(0.0, 2.0, m)
+    p = np.c_[s, np.zeros(n), 0.3 * np.sin(s)]
+    q = np.c_[np.zeros(m), t, 0.2 * t ** 2]
+    x = (p[:, None, :] + q[None, :, :]).reshape(-1, 3)
+    i, j = np.meshgrid(np.arange(n - 1), np.arange(m - 1), indexing="ij")
+    a = (i * m + j).ravel()
+    faces = np.stack([a, a + m, a + m + 1, a + 1], axis=1)
+    start = (np.arange(n)[:, None] * m + np.arange(m - 1)).ravel()
+    members = np.stack([start, start + 1], axis=1)
+    return Mesh.from_faces(x, faces, members=members, member_id=np.repeat(np.arange(n), m - 1))
+
+
+def _has_colour(img, hex_colour, tol=0.02):
+    rgb = np.asarray(colors.to_rgb(hex_colour))
+    return np.any(np.all(np.abs(img[..., :3] - rgb) < tol, axis=-1))
+
+
+def test_png_has_size_and_content(tmp_path):
+    path = save_render(tmp_path / "m.png", translational_mesh(), size=(640, 480))
+    img = mpimg.imread(path)
+    assert img.shape[:2] == (480, 640)
+    nonwhite = np.any(img[..., :3] < 0.95, axis=-1).mean()
+    assert 0.05 < nonwhite < 0.95
+
+
+def test_kind_colours_drawn(tmp_path):
+    mesh = translational_mesh()
+    kind = mesh.face_kind.copy()
+    kind[:3] = FaceKind.FILL
+    mesh = Mesh.from_arrays(mesh.vertices, mesh.face_offsets, mesh.face_indices, kind,
+                            members=mesh.members, member_id=mesh.member_id)
+    img = mpimg.imread(save_render(tmp_path / "k.png", mesh, color="kind", edges=False))
+    assert _has_colour(img, "#4c78a8")   # quads
+    assert _has_colour(img, "#e45756")   # fills
+
+
+def test_planarity_shows_bent_face(tmp_path):
+    """A bent quad gets the top of the colour map; a planar mesh does not reach it."""
+    mesh = translational_mesh()
+    top = colors.to_hex(__import__("matplotlib").colormaps["viridis"](1.0))
+    flat = mpimg.imread(save_render(tmp_path / "f.png", mesh, edges=False, generators=False))
+    # outside the colour bar (right-most 14 %), no face is at the top colour
+    assert not _has_colour(flat[:, : int(0.86 * flat.shape[1])], top, tol=0.05)
+    v = mesh.vertices.copy()
+    v[mesh.face(10)[2], 2] += 0.5
+    bent = mpimg.imread(save_render(tmp_path / "b.png", mesh.with_vertices(v),
+                                    edges=False, generators=False))
+    assert _has_colour(bent[:, : int(0.86 * bent.shape[1])], top, tol=0.05)
+
+
+class _Plane:
+    """The plane z = height (a real reference surface: exact distances)."""
+
+    def __init__(self, height):
+        self.height = height
+
+    def distance(self, points):
+        return np.abs(points[:, 2] - self.height)
+
+
+def test_closeness_values_exact():
+    s = np.linspace(0, 1, 4)
+    x = np.stack(np.meshgrid(s, s, indexing="ij"), -1).reshape(-1, 2)
+    x = np.c_[x, np.zeros(len(x))]
+    a = np.array([0, 1, 2, 4, 5, 6, 8, 9, 10])
+    mesh = Mesh.from_faces(x, np.stack([a, a + 4, a + 5, a + 1], 1))
+    vals = face_values(mesh, "closeness", _Plane(0.25))
+    np.testing.assert_allclose(vals, 0.25 / np.sqrt(2.0), rtol=1e-15)
+    with pytest.raises(ParameterError, match="closeness"):
+        face_values(mesh, "closeness")
+    assert render(mesh, color="closeness", reference=_Plane(0.1), fmt="svg").lstrip().startswith(b"<?xml")
+
+
+@pytest.mark.parametrize("bad, match", [({"color": "planar"}, "did you mean"),
+                                        ({"view": (1, 2, 3)}, "view"),
+                                        ({"size": (5, 5)}, "size")])
+def test_bad_options(bad, match):
+    with pytest.raises(ParameterError, match=match):
+        render(translational_mesh(), **bad)
+
+
+def test_cli_render(tmp_path, capsys):
+    save(tmp_path / "m.obj", translational_mesh())
+    out = tmp_path / "m.png"
+    assert main(["render", str(tmp_path / "m.obj"), "-o", str(out), "--color", "kind",
+                 "--view", "40,-30", "--size", "320x200", "-q"]) == 0
+    assert mpimg.imread(out).shape[:2] == (200, 320)
+    assert main(["render", str(tmp_path / "m.obj"), "-o", str(tmp_path / "c.png"),
+                 "--color", "closeness"]) == 2
+    assert "design" in capsys.readouterr().err
+    assert not (tmp_path / "c.png").exists()
