@@ -26,10 +26,14 @@ __all__ = ["save", "load", "write_atomic", "WRITERS", "READERS", "formats"]
 WRITERS: dict[str, str] = {
     ".obj": "obj",
     ".ply": "ply",
+    ".stl": "stl",
+    ".glb": "gltf",
+    ".json": "json_mesh",
 }
 READERS: dict[str, str] = {
     ".obj": "obj",
     ".ply": "ply",
+    ".json": "json_mesh",
 }
 
 
