@@ -29,6 +29,9 @@ WRITERS: dict[str, str] = {
     ".stl": "stl",
     ".glb": "gltf",
     ".json": "json_mesh",
+    ".dxf": "dxf",
+    ".3dm": "rhino",
+    ".ifc": "ifc",
 }
 READERS: dict[str, str] = {
     ".obj": "obj",
