@@ -1,0 +1,988 @@
+"""Generators (rulings) from director curves, lines or files (paper §5).
+
+A :class:`Rulings` set holds ``m`` generators ``g_i`` from ``a_i`` (t = 0, on
+director curve c1) to ``b_i`` (t = 1, on c2), their surface parameters ``u_i``
+and the smooth :class:`RuledSurface` they sample,
+``S(u, t) = (1 - t) A(u) + t B(u)``.
+
+Constructors, one per way the paper gives a ruled surface:
+
+* :func:`between` two director curves with a *distribution* (§5.2):
+  (a) equal arc length, (b) equal curve parameter, (c) a director plane (the
+  pencil of parallel planes ``n . x = s`` cuts both curves), (d) a linear
+  directrix ``d`` (the planes through ``d`` cut both curves);
+* :func:`three_directrices`: the lines meeting three curves (§5, general case);
+* :func:`conoid`: one curve, a line directrix and a director plane (§5.1);
+* :func:`from_lines` / :func:`from_csv`: explicit generators;
+* :func:`rulings_from_spec`: the ``[rulings]`` table of a design file.
+
+The smooth reference surface.  For curve-based rulings ``A(u) = c1(sigma1(u))``
+lies exactly on c1: ``sigma`` is the identity (parameter distribution), the
+exact arc-length inverse (arc length), or a PCHIP interpolant (monotone, C1)
+of a dense sampling of the correspondence, at least 1025 samples that include
+the generators (director plane, linear directrix, three directrices).  For
+explicit lines, ``A`` and ``B`` are C2 cubic splines (``scipy`` ``CubicSpline``,
+not-a-knot) through the endpoints, with ``u`` the cumulative mean chord length
+of the endpoints, ``(|a_{i+1} - a_i| + |b_{i+1} - b_i|) / 2``, normalised:
+uneven spacing of the given lines is then followed rather than smoothed over.
+"""
+
+from __future__ import annotations
+
+import math
+import os
+from collections.abc import Mapping
+from dataclasses import dataclass, field
+from enum import Enum
+from typing import Any
+
+import numpy as np
+from scipy.interpolate import CubicSpline, PchipInterpolator
+
+from ._validation import (
+    check_choice,
+    check_int,
+    check_keys,
+    check_points,
+    check_vector,
+    describe,
+)
+from .curves import Curve, _Level, _LiesInLevel, _perpendicular
+from .errors import DesignError, GeometryError, ParameterError
+from .tolerances import DEFAULT, Tolerances
+
+__all__ = [
+    "Distribution",
+    "Rulings",
+    "RuledSurface",
+    "between",
+    "three_directrices",
+    "conoid",
+    "from_lines",
+    "from_csv",
+    "rulings_from_spec",
+]
+
+# dense samples of a numerically found correspondence (PCHIP nodes)
+_DENSE = 1024
+
+
+class Distribution(Enum):
+    """How generators are distributed between two director curves (paper §5.2)."""
+
+    PARAMETER = "parameter"
+    ARC_LENGTH = "arc-length"
+    DIRECTOR_PLANE = "director-plane"
+    LINEAR_DIRECTRIX = "linear-directrix"
+
+
+# --------------------------------------------------------------------------
+# the smooth reference surface
+# --------------------------------------------------------------------------
+
+class _Identity:
+    def value(self, u):
+        return u
+
+    def deriv(self, u):
+        return np.ones_like(u)
+
+
+@dataclass(frozen=True, eq=False)
+class _ArcLength:
+    """sigma(u) = the curve parameter at arc length u L (exact inverse)."""
+
+    curve: Curve
+
+    def value(self, u):
+        return self.curve._param_at_length(u * self.curve.length())
+
+    def deriv(self, u):
+        return self.curve.length() / self.curve._speed(self.value(u))
+
+
+@dataclass(frozen=True, eq=False)
+class _Pchip:
+    """sigma(u): monotone C1 interpolant of dense samples of a correspondence."""
+
+    interp: PchipInterpolator
+
+    @classmethod
+    def of(cls, u: np.ndarray, sigma: np.ndarray) -> "_Pchip":
+        return cls(PchipInterpolator(u, sigma))
+
+    def value(self, u):
+        return np.clip(self.interp(u), 0.0, 1.0)
+
+    def deriv(self, u):
+        return self.interp(u, 1)
+
+
+@dataclass(frozen=True, eq=False)
+class _CurveTrack:
+    """A(u) = curve(sigma(u)): exactly on the curve."""
+
+    curve: Curve
+    sigma: Any
+
+    def value(self, u):
+        return self.curve._eval(self.sigma.value(u))
+
+    def deriv(self, u):
+        return self.curve._deriv(self.sigma.value(u), 1) * self.sigma.deriv(u)[..., None]
+
+
+@dataclass(frozen=True, eq=False)
+class _SplineTrack:
+    """A(u) = a C2 cubic spline through given points."""
+
+    spline: CubicSpline
+
+    def value(self, u):
+        return self.spline(u)
+
+    def deriv(self, u):
+        return self.spline(u, 1)
+
+
+@dataclass(frozen=True, eq=False)
+class _ConoidTrack:
+    """B(u) on the line d0 + s e, in the plane through A(u) with normal n."""
+
+    base: Any
+    d0: np.ndarray
+    e: np.ndarray
+    n: np.ndarray
+
+    def value(self, u):
+        s = (self.base.value(u) - self.d0) @ self.n / (self.e @ self.n)
+        return self.d0 + s[..., None] * self.e
+
+    def deriv(self, u):
+        s = self.base.deriv(u) @ self.n / (self.e @ self.n)
+        return s[..., None] * self.e
+
+
+@dataclass(frozen=True, eq=False)
+class RuledSurface:
+    """The smooth ruled surface ``S(u, t) = (1 - t) A(u) + t B(u)``, u, t in [0, 1].
+
+    Parameters
+    ----------
+    rail_a, rail_b : track
+        Objects with vectorised ``value(u)`` and ``deriv(u)`` -> (..., 3): the
+        correspondence ``A(u)``, ``B(u)`` of the distribution.
+    breaks : (k,) float64
+        Parameters where ``A`` or ``B`` may be less smooth (the generators'
+        ``u``, kinks): panel ends of the area quadrature.
+    """
+
+    rail_a: Any
+    rail_b: Any
+    breaks: np.ndarray = field(default_factory=lambda: np.array([0.0, 1.0]))
+
+    def a(self, u: Any) -> np.ndarray:
+        """A(u): (..., 3), the rail at t = 0 (on c1)."""
+        return self.rail_a.value(np.asarray(u, dtype=np.float64))
+
+    def b(self, u: Any) -> np.ndarray:
+        """B(u): (..., 3), the rail at t = 1 (on c2)."""
+        return self.rail_b.value(np.asarray(u, dtype=np.float64))
+
+    def point(self, u: Any, t: Any) -> np.ndarray:
+        """Points ``S(u, t)``; ``u`` and ``t`` broadcast: (..., 3)."""
+        u, t = np.broadcast_arrays(np.asarray(u, dtype=np.float64), np.asarray(t, dtype=np.float64))
+        a, b = self.rail_a.value(u), self.rail_b.value(u)
+        return a + t[..., None] * (b - a)
+
+    def partials(self, u: Any, t: Any) -> tuple[np.ndarray, np.ndarray]:
+        """``(S_u, S_t)``, each (..., 3); ``u`` and ``t`` broadcast."""
+        u, t = np.broadcast_arrays(np.asarray(u, dtype=np.float64), np.asarray(t, dtype=np.float64))
+        da, db = self.rail_a.deriv(u), self.rail_b.deriv(u)
+        su = da + t[..., None] * (db - da)
+        st = self.rail_b.value(u) - self.rail_a.value(u)
+        return su, st
+
+    def area(self, n: int = 16) -> float:
+        """Area of the patch: composite Gauss-Legendre of ``|S_u x S_t|``.
+
+        Parameters
+        ----------
+        n : int
+            Nodes per panel in ``u`` (panels between :attr:`breaks`) and in ``t``.
+        """
+        n = check_int(n, "n", lo=1)
+        x, w = np.polynomial.legendre.leggauss(n)
+        x, w = 0.5 * (x + 1.0), 0.5 * w
+        br = np.unique(np.concatenate([[0.0, 1.0], self.breaks]))
+        lo, hi = br[:-1], br[1:]
+        uu = (lo[:, None] + (hi - lo)[:, None] * x[None, :]).ravel()
+        wu = ((hi - lo)[:, None] * w[None, :]).ravel()
+        su, st = self.partials(uu[:, None], x[None, :])
+        dens = np.linalg.norm(np.cross(su, st), axis=-1)
+        return float(wu @ dens @ w)
+
+
+# --------------------------------------------------------------------------
+# the rulings set
+# --------------------------------------------------------------------------
+
+@dataclass(frozen=True, eq=False)
+class Rulings:
+    """A discrete set of generators and the smooth surface they sample.
+
+    Parameters
+    ----------
+    a : (m, 3) float64
+        Generator points at t = 0 (on c1).
+    b : (m, 3) float64
+        Generator points at t = 1 (on c2).
+    u : (m,) float64
+        Surface parameter of each generator, strictly increasing in [0, 1].
+    surface : RuledSurface or None
+        The smooth ruled surface; ``surface.point(u[i], t)`` is on ``g_i``.
+    info : dict
+        ``distribution``, ``warnings`` (list of str) and per-constructor
+        details (curve parameters of the endpoints, ...).
+    """
+
+    a: np.ndarray
+    b: np.ndarray
+    u: np.ndarray
+    surface: RuledSurface | None = None
+    info: dict = field(default_factory=dict)
+
+    def __post_init__(self) -> None:
+        a = check_points(self.a, "a", min_count=2)
+        b = check_points(self.b, "b", min_count=2)
+        if a.shape != b.shape:
+            raise ParameterError(f"expected as many points as a ({len(a)}), got {len(b)}", "b")
+        u = np.asarray(self.u, dtype=np.float64)
+        if u.shape != (len(a),) or not np.all(np.isfinite(u)):
+            raise ParameterError(f"expected {len(a)} finite numbers, got {describe(self.u)}", "u")
+        if np.any(np.diff(u) <= 0) or u[0] < 0 or u[-1] > 1:
+            raise ParameterError("expected strictly increasing values in [0, 1]", "u")
+        for name, arr in (("a", a), ("b", b), ("u", u)):
+            arr = np.array(arr)
+            arr.setflags(write=False)
+            object.__setattr__(self, name, arr)
+        info = dict(self.info)
+        info.setdefault("warnings", [])
+        object.__setattr__(self, "info", info)
+
+    @property
+    def directions(self) -> np.ndarray:
+        """(m, 3) float64: ``b - a``."""
+        return self.b - self.a
+
+    def __len__(self) -> int:
+        return len(self.a)
+
+
+def _check_generators(a: np.ndarray, b: np.ndarray, what: str, tol: Tolerances) -> None:
+    pts = np.concatenate([a, b])
+    size = max(float(np.linalg.norm(pts.max(axis=0) - pts.min(axis=0))), 1e-300)
+    short = np.nonzero(np.linalg.norm(b - a, axis=1) <= tol.degenerate * size)[0]
+    if len(short):
+        i = int(short[0])
+        raise GeometryError(
+            f"{what}: generator {i} has zero length: its ends coincide at "
+            f"{np.array2string(a[i], precision=6, separator=', ')}")
+
+
+def _dense_grid(count: int) -> tuple[np.ndarray, int]:
+    """A dense u grid holding the ``count`` generator parameters at every k-th node."""
+    k = max(1, math.ceil(_DENSE / (count - 1)))
+    return np.linspace(0.0, 1.0, k * (count - 1) + 1), k
+
+
+def _check_curve(c: Any, name: str) -> Curve:
+    if not isinstance(c, Curve):
+        raise ParameterError(f"expected a curve (ruledmesh.curves.Curve), got {describe(c)}", name)
+    return c
+
+
+def _curve_rulings(c1: Curve, s1: Any, c2: Curve, s2: Any, count: int, info: dict,
+                   tol: Tolerances, sig1: np.ndarray | None = None,
+                   sig2: np.ndarray | None = None) -> Rulings:
+    u = np.linspace(0.0, 1.0, count)
+    sig1 = s1.value(u) if sig1 is None else sig1
+    sig2 = s2.value(u) if sig2 is None else sig2
+    a, b = c1._eval(sig1), c2._eval(sig2)
+    _check_generators(a, b, info["distribution"], tol)
+    info = {**info, "c1_params": sig1, "c2_params": sig2}
+    surface = RuledSurface(_CurveTrack(c1, s1), _CurveTrack(c2, s2), u)
+    return Rulings(a, b, u, surface, info)
+
+
+# --------------------------------------------------------------------------
+# two director curves
+# --------------------------------------------------------------------------
+
+def between(c1: Curve, c2: Curve, count: int, distribution: Distribution | str = "arc-length", *,
+            director_plane: Any = None, directrix: Any = None,
+            tol: Tolerances = DEFAULT) -> Rulings:
+    """Generators between two director curves (paper §5.2).
+
+    Parameters
+    ----------
+    c1, c2 : Curve
+        Director curves; generator ``i`` runs from ``a_i`` on c1 to ``b_i`` on c2.
+    count : int >= 2
+        Number of generators.
+    distribution : Distribution or str
+        ``"arc-length"`` (a): equal arc length on both curves;
+        ``"parameter"`` (b): equal curve parameter;
+        ``"director-plane"`` (c): the planes ``n . x = s``, ``count`` values of
+        ``s`` evenly over the range where both curves meet them, each curve's
+        intersection followed along one continuous branch (from the end of c1
+        nearest ``u = 0``); ``"linear-directrix"`` (d): ``a_i`` at equal arc
+        length on c1, ``b_i`` where the plane through ``a_i`` and the line
+        ``d`` meets c2 (branch followed from the root nearest ``c2(0)``).
+    director_plane : (3,) array_like
+        The normal ``n``, for ``"director-plane"`` only.
+    directrix : (2, 3) array_like
+        Two points of the line ``d``, for ``"linear-directrix"`` only.
+    tol : Tolerances
+
+    Returns
+    -------
+    Rulings
+        ``info`` holds ``c1_params``/``c2_params`` (curve parameters of the
+        generators' ends) and, for (c), ``levels`` (the values of ``s``).
+
+    Raises
+    ------
+    GeometryError
+        A curve parallel to the director plane or lying in a plane through
+        ``d``, curves without a common range of planes, ``d`` through a point
+        of c1 or meeting c2, a branch that turns back or runs off a curve
+        before the last generator (the message says which generator).
+    """
+    c1 = _check_curve(c1, "c1")
+    c2 = _check_curve(c2, "c2")
+    count = check_int(count, "count", lo=2)
+    dist = check_choice(distribution, Distribution, "distribution")
+    if director_plane is not None and dist is not Distribution.DIRECTOR_PLANE:
+        raise ParameterError('only used with distribution "director-plane"', "director_plane")
+    if directrix is not None and dist is not Distribution.LINEAR_DIRECTRIX:
+        raise ParameterError('only used with distribution "linear-directrix"', "directrix")
+    info = {"distribution": dist.value, "warnings": []}
+    if dist is Distribution.PARAMETER:
+        return _curve_rulings(c1, _Identity(), c2, _Identity(), count, info, tol)
+    if dist is Distribution.ARC_LENGTH:
+        return _curve_rulings(c1, _ArcLength(c1), c2, _ArcLength(c2), count, info, tol)
+    if dist is Distribution.DIRECTOR_PLANE:
+        if director_plane is None:
+            raise ParameterError('required with distribution "director-plane"', "director_plane")
+        return _director_plane(c1, c2, count, check_vector(director_plane, "director_plane",
+                                                           nonzero=True), info, tol)
+    if directrix is None:
+        raise ParameterError('required with distribution "linear-directrix"', "directrix")
+    d = _check_line(directrix, "directrix")
+    return _linear_directrix(c1, c2, count, d, info, tol)
+
+
+def _check_line(value: Any, name: str, err: type = ParameterError) -> np.ndarray:
+    d = check_points(value, name, min_count=2, err=err)
+    if len(d) != 2:
+        raise err(f"expected 2 points of the line, got {len(d)}", name)
+    if np.linalg.norm(d[1] - d[0]) <= DEFAULT.degenerate * max(np.abs(d).max(), 1e-300):
+        raise err("the two points coincide; a line needs two distinct points", name)
+    return d
+
+
+def _ended(what: str, curve_name: str, end: tuple, k: int, count: int, extra: str = "") -> GeometryError:
+    j, reason, u_end = end
+    gen = j / k
+    where = (f"between generators {int(gen)} and {int(gen) + 1}" if gen != int(gen)
+             else f"at generator {int(gen)}")
+    at = f" at u = {u_end:.6g}" if u_end is not None else ""
+    return GeometryError(f"{what}: the branch on {curve_name} {reason}{at} {where} of {count}"
+                         f"{extra}")
+
+
+def _director_plane(c1: Curve, c2: Curve, count: int, normal: np.ndarray, info: dict,
+                    tol: Tolerances) -> Rulings:
+    n = normal / np.linalg.norm(normal)
+    levels = [c._plane_level(n, tol) for c in (c1, c2)]
+    for name, lev in zip(("c1", "c2"), levels):
+        lo, hi = lev.range
+        if hi - lo <= lev.tol:
+            raise GeometryError(
+                f"director-plane: {name} lies in a plane parallel to the director plane "
+                f"(n . x = {lo:g} with n = {np.array2string(n, precision=6, separator=', ')}): "
+                "each plane of the pencil meets it everywhere or nowhere")
+    (lo1, hi1), (lo2, hi2) = levels[0].range, levels[1].range
+    lo, hi = max(lo1, lo2), min(hi1, hi2)
+    if hi - lo <= max(levels[0].tol, levels[1].tol):
+        raise GeometryError(
+            f"director-plane: no plane n . x = s meets both curves: s spans "
+            f"[{lo1:g}, {hi1:g}] on c1 and [{lo2:g}, {hi2:g}] on c2")
+    # sweep in the direction that runs along c1 from its start
+    forward = levels[0].values[-1] >= levels[0].values[0]
+    grid, k = _dense_grid(count)
+    s = lo + grid * (hi - lo) if forward else hi - grid * (hi - lo)
+    sig = []
+    for name, c, lev in zip(("c1", "c2"), (c1, c2), levels):
+        roots = lev.roots(float(s[0]))
+        if len(roots) == 0:  # only by rounding at a range end
+            raise GeometryError(f"director-plane: the first plane n . x = {s[0]:g} misses {name}")
+        u, ok, end = lev.follow(s, float(roots[0]))
+        if end is not None:
+            raise _ended("director-plane", name, end, k, count,
+                         ": the planes n . x = s meet it more than once (or not at all) over "
+                         f"s in [{lo:g}, {hi:g}]; choose another director plane")
+        sig.append(u)
+    s1, s2 = _Pchip.of(grid, sig[0]), _Pchip.of(grid, sig[1])
+    info = {**info, "levels": s[::k].copy(), "director_plane": n}
+    return _curve_rulings(c1, s1, c2, s2, count, info, tol, sig[0][::k].copy(), sig[1][::k].copy())
+
+
+class _PencilAngle:
+    """The angle of the plane through line d and a point, continuous along a curve.
+
+    ``theta(x) = atan2(q . (x - d0), p . (x - d0))`` with ``p, q`` an
+    orthonormal frame perpendicular to d.  Points on one plane through d have
+    the same ``theta`` modulo pi.  Along a curve ``theta`` is unwrapped
+    against a piecewise-linear reference through a fine sampling, so it is a
+    continuous level function.
+    """
+
+    def __init__(self, d: np.ndarray):
+        self.d0 = d[0]
+        self.e = (d[1] - d[0]) / np.linalg.norm(d[1] - d[0])
+        self.p = _perpendicular(self.e)
+        self.q = np.cross(self.e, self.p)
+
+    def xy(self, pts: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        rel = pts - self.d0
+        return rel @ self.p, rel @ self.q
+
+    def raw(self, pts: np.ndarray) -> np.ndarray:
+        x, y = self.xy(pts)
+        return np.arctan2(y, x)
+
+    def radius(self, pts: np.ndarray) -> np.ndarray:
+        x, y = self.xy(pts)
+        return np.hypot(x, y)
+
+    def level(self, curve: Curve, name: str, tol: Tolerances) -> _Level:
+        grid = np.unique(np.concatenate([curve._level_grid(), curve._breaks()]))
+        for _ in range(6):
+            pts = curve._eval(grid)
+            r = self.radius(pts)
+            near = np.argmin(r)
+            if r[near] <= tol.degenerate * curve._size:
+                raise GeometryError(
+                    f"linear-directrix: {name} meets the directrix d at u = {grid[near]:.6g}: "
+                    "every plane through d contains that point")
+            ref = np.unwrap(self.raw(pts))
+            if np.max(np.abs(np.diff(ref))) < 0.5:
+                break
+            grid = np.unique(np.concatenate([grid, 0.5 * (grid[:-1] + grid[1:])]))
+        else:
+            raise GeometryError(
+                f"linear-directrix: {name} winds around the directrix d too closely to follow")
+
+        def g(u):
+            u = np.asarray(u, dtype=np.float64)
+            lin = np.interp(u, grid, ref)
+            return lin + (np.mod(self.raw(curve._eval(u)) - lin + np.pi, 2 * np.pi) - np.pi)
+
+        def dg(u):
+            u = np.asarray(u, dtype=np.float64)
+            x, y = self.xy(curve._eval(u))
+            dx, dy = self.xy(curve._deriv(u, 1) + self.d0)
+            return (x * dy - y * dx) / (x * x + y * y)
+
+        return _Level(g, dg, grid, tol.degenerate)
+
+
+def _linear_directrix(c1: Curve, c2: Curve, count: int, d: np.ndarray, info: dict,
+                      tol: Tolerances) -> Rulings:
+    pencil = _PencilAngle(d)
+    grid, k = _dense_grid(count)
+    arc1 = _ArcLength(c1)
+    sig1 = arc1.value(grid)
+    pts1 = c1._eval(sig1)
+    r1 = pencil.radius(pts1)
+    near = int(np.argmin(r1))
+    if r1[near] <= tol.degenerate * c1._size:
+        gen = near / k
+        where = f"a_{int(gen)} (generator {int(gen)})" if gen == int(gen) else (
+            f"c1 between generators {int(gen)} and {int(gen) + 1}")
+        raise GeometryError(
+            f"linear-directrix: the directrix d passes through {where} at "
+            f"{np.array2string(pts1[near], precision=6, separator=', ')}: the plane through "
+            "it and d is undefined")
+    theta1 = np.unwrap(pencil.raw(pts1))
+    if np.max(np.abs(np.diff(theta1))) > 0.5:
+        raise GeometryError("linear-directrix: c1 winds around the directrix d too closely")
+    lev2 = pencil.level(c2, "c2", tol)
+    lo, hi = lev2.range
+    if hi - lo <= lev2.tol:
+        raise GeometryError(
+            "linear-directrix: c2 lies in a plane through the directrix d: the planes through d "
+            "and the points of c1 meet it everywhere or nowhere")
+    # the plane through d and a_0 has angle theta1[0] modulo pi
+    starts = []
+    for j in range(math.ceil((lo - theta1[0]) / np.pi - 1e-12),
+                   math.floor((hi - theta1[0]) / np.pi + 1e-12) + 1):
+        for r in lev2.roots(float(theta1[0] + j * np.pi)):
+            starts.append((float(r), j))
+    if not starts:
+        raise GeometryError(
+            "linear-directrix: the plane through the directrix d and a_0 (generator 0) does not "
+            "meet c2")
+    v0, j0 = min(starts)
+    sig2, ok, end = lev2.follow(theta1 + j0 * np.pi, v0)
+    if end is not None:
+        raise _ended("linear-directrix", "c2", end, k, count,
+                     ": the planes through d and the points of c1 stop meeting c2 along one "
+                     "branch; move d or shorten c1")
+    info = {**info, "directrix": d}
+    return _curve_rulings(c1, arc1, c2, _Pchip.of(grid, sig2), count, info, tol,
+                          sig1[::k].copy(), sig2[::k].copy())
+
+
+# --------------------------------------------------------------------------
+# three directrices (§5 general case)
+# --------------------------------------------------------------------------
+
+def _newton_3(c2: Curve, c3: Curve, p: np.ndarray, x: np.ndarray, size: float,
+              iterations: int = 40) -> tuple[np.ndarray, bool]:
+    """Solve c3(w) - p = lam (c2(v) - p) for x = (v, w, lam) by Newton."""
+    x = x.copy()
+    for _ in range(iterations):
+        v, w, lam = x
+        q = c2._eval(np.array(v))
+        r = c3._eval(np.array(w))
+        f = r - p - lam * (q - p)
+        jac = np.column_stack([-lam * c2._deriv(np.array(v), 1), c3._deriv(np.array(w), 1), p - q])
+        try:
+            dx = np.linalg.solve(jac, -f)
+        except np.linalg.LinAlgError:
+            return x, False
+        if not np.all(np.isfinite(dx)):
+            return x, False
+        x = x + dx
+        if abs(x[0] - 0.5) > 1.5 or abs(x[1] - 0.5) > 1.5:
+            return x, False
+        if np.linalg.norm(dx[:2]) <= 1e-15 and np.linalg.norm(f) <= 1e-12 * size:
+            return x, True
+    v, w, lam = x
+    f = c3._eval(np.array(w)) - p - lam * (c2._eval(np.array(v)) - p)
+    return x, bool(np.linalg.norm(f) <= 1e-12 * size)
+
+
+def _first_transversal(c2: Curve, c3: Curve, p: np.ndarray, size: float,
+                       samples: int = 160) -> list[np.ndarray]:
+    """All lines through p meeting c2 and c3: grid search of the central projections."""
+    from scipy.ndimage import minimum_filter
+
+    v = np.linspace(0.0, 1.0, samples)
+    q = c2._eval(v) - p
+    r = c3._eval(v) - p
+    qn = q / np.maximum(np.linalg.norm(q, axis=1), 1e-300)[:, None]
+    rn = r / np.maximum(np.linalg.norm(r, axis=1), 1e-300)[:, None]
+    sine = np.linalg.norm(np.cross(qn[:, None, :], rn[None, :, :]), axis=-1)
+    minima = (sine == minimum_filter(sine, size=3, mode="nearest")) & (sine < 0.3)
+    order = np.argsort(sine[minima])
+    iv, iw = np.nonzero(minima)
+    found: list[np.ndarray] = []
+    for idx in order[:200]:
+        i, j = iv[idx], iw[idx]
+        lam = float(r[j] @ q[i] / max(q[i] @ q[i], 1e-300))
+        x, ok = _newton_3(c2, c3, p, np.array([v[i], v[j], lam]), size)
+        if ok and -1e-12 <= x[0] <= 1 + 1e-12 and -1e-12 <= x[1] <= 1 + 1e-12:
+            x[:2] = np.clip(x[:2], 0.0, 1.0)
+            if not any(np.linalg.norm(x[:2] - y[:2]) < 1e-8 for y in found):
+                found.append(x)
+    return sorted(found, key=lambda y: (y[0], y[1]))
+
+
+def three_directrices(c1: Curve, c2: Curve, c3: Curve, count: int, *,
+                      start: Any = None, tol: Tolerances = DEFAULT) -> Rulings:
+    """The lines meeting three director curves (paper §5, general case).
+
+    For ``u_i`` at equal arc length on c1, find ``v`` on c2 and ``w`` on c3
+    with ``c1(u_i)``, ``c2(v)``, ``c3(w)`` collinear: Newton on
+    ``c3(w) - a = lam (c2(v) - a)`` (three equations, unknowns ``v, w, lam``),
+    continued from the previous solution with step halving, the first from a
+    grid search over the central projections of c2 and c3 from ``c1(0)``.
+
+    Parameters
+    ----------
+    c1, c2, c3 : Curve
+        Generator ``i`` runs from ``a_i`` on c1 to ``b_i`` on c2 and meets c3
+        at ``t = info["c3_t"][i]``.
+    count : int >= 2
+    start : (2,) array_like, optional
+        ``(v, w)`` near the wanted first line, when ``c1(0)`` has several; by
+        default the one with the smallest ``v`` (then ``w``).
+
+    Raises
+    ------
+    GeometryError
+        No line through ``c1(0)`` meets c2 and c3, or the family ends (the
+        line runs off c2 or c3, or the solution turns back) before ``c1(1)``:
+        the message gives the generator and the parameter on c1.
+    """
+    c1 = _check_curve(c1, "c1")
+    c2 = _check_curve(c2, "c2")
+    c3 = _check_curve(c3, "c3")
+    count = check_int(count, "count", lo=2)
+    size = max(c1._size, c2._size, c3._size)
+    grid, k = _dense_grid(count)
+    arc1 = _ArcLength(c1)
+    sig1 = arc1.value(grid)
+    pts1 = c1._eval(sig1)
+    candidates = _first_transversal(c2, c3, pts1[0], size)
+    if not candidates:
+        raise GeometryError("three directrices: no line through c1(0) meets both c2 and c3")
+    if start is not None:
+        st = check_vector(start, "start", dim=2)
+        x = min(candidates, key=lambda y: float(np.linalg.norm(y[:2] - st)))
+    else:
+        x = candidates[0]
+    sol = np.empty((len(grid), 3))
+    sol[0] = x
+    a_param = lambda g: float(arc1.value(np.array(g)))  # noqa: E731
+    for i in range(1, len(grid)):
+        # continue from grid[i-1] to grid[i] with step halving; a secant predictor
+        g0, g1 = grid[i - 1], grid[i]
+        cur, prev_step = sol[i - 1].copy(), (sol[i - 1] - sol[i - 2]) if i > 1 else np.zeros(3)
+        h_prev = g1 - g0
+        g = g0
+        h = g1 - g0
+        while g < g1:
+            h = min(h, g1 - g)
+            gn = g1 if g + h >= g1 - 1e-15 else g + h
+            p = c1._eval(np.array(a_param(gn)))
+            pred = cur + prev_step * ((gn - g) / h_prev)
+            x, ok = _newton_3(c2, c3, p, pred, size)
+            jump = np.linalg.norm(x[:2] - cur[:2]) if ok else np.inf
+            if ok and jump <= 0.05 + 4 * np.linalg.norm(prev_step[:2]) * (gn - g) / h_prev:
+                if not (-1e-9 <= x[0] <= 1 + 1e-9 and -1e-9 <= x[1] <= 1 + 1e-9):
+                    which = "c2" if not -1e-9 <= x[0] <= 1 + 1e-9 else "c3"
+                    raise _family_end(f"the line runs off the end of {which}", gn, sig1, grid,
+                                      k, count)
+                prev_step, h_prev = x - cur, gn - g
+                cur, g = x, gn
+                h = 2 * h
+            else:
+                h = h / 2
+                if h < 1e-9:
+                    raise _family_end("the solution turns back (the line becomes tangent to "
+                                      "the surface's director curves)", g, sig1, grid, k, count)
+        cur[:2] = np.clip(cur[:2], 0.0, 1.0)
+        sol[i] = cur
+    s2, s3 = _Pchip.of(grid, sol[:, 0]), _Pchip.of(grid, sol[:, 1])
+    info = {"distribution": "three-directrices", "warnings": [],
+            "c3_params": sol[::k, 1].copy(), "c3_t": sol[::k, 2].copy()}
+    return _curve_rulings(c1, arc1, c2, s2, count, info, tol, sig1[::k].copy(),
+                          sol[::k, 0].copy())
+
+
+def _family_end(reason: str, g: float, sig1: np.ndarray, grid: np.ndarray, k: int,
+                count: int) -> GeometryError:
+    gen = g * (count - 1)
+    u1 = float(np.interp(g, grid, sig1))
+    return GeometryError(
+        f"three directrices: the family of lines ends near u = {u1:.6g} on c1 (arc-length "
+        f"fraction {g:.6g}, near generator {gen:.3g} of {count}): {reason}")
+
+
+# --------------------------------------------------------------------------
+# conoid (§5.1)
+# --------------------------------------------------------------------------
+
+def conoid(curve: Curve, directrix: Any, director_plane: Any, count: int, *,
+           tol: Tolerances = DEFAULT) -> Rulings:
+    """A conoid: one curve, a line directrix d and a director plane (paper §5.1).
+
+    The curve is divided at equal arc length; the plane through each division
+    point parallel to the director plane meets d in the generator's other end.
+
+    Parameters
+    ----------
+    curve : Curve
+        The director curve (``a_i``, t = 0).
+    directrix : (2, 3) array_like
+        Two points of the line d (``b_i``, t = 1, anywhere on the line).
+    director_plane : (3,) array_like
+        Its normal ``n``: every generator satisfies ``n . (b_i - a_i) = 0``.
+    count : int >= 2
+
+    Raises
+    ------
+    GeometryError
+        d is parallel to the director plane, or the curve meets d.
+    """
+    curve = _check_curve(curve, "curve")
+    d = _check_line(directrix, "directrix")
+    n = check_vector(director_plane, "director_plane", nonzero=True)
+    count = check_int(count, "count", lo=2)
+    n = n / np.linalg.norm(n)
+    e = d[1] - d[0]
+    if abs(n @ e) <= tol.degenerate * np.linalg.norm(e):
+        raise GeometryError(
+            "conoid: the directrix d is parallel to the director plane: the planes parallel to "
+            "the director plane never meet it (or contain it)")
+    arc = _ArcLength(curve)
+    u = np.linspace(0.0, 1.0, count)
+    sig = arc.value(u)
+    rail_a = _CurveTrack(curve, arc)
+    rail_b = _ConoidTrack(rail_a, d[0], e, n)
+    a = curve._eval(sig)
+    b = rail_b.value(u)
+    _check_generators(a, b, "conoid", tol)
+    info = {"distribution": "conoid", "warnings": [], "c1_params": sig,
+            "directrix_params": (a - d[0]) @ n / (e @ n), "director_plane": n, "directrix": d}
+    return Rulings(a, b, u, RuledSurface(rail_a, rail_b, u), info)
+
+
+# --------------------------------------------------------------------------
+# explicit lines
+# --------------------------------------------------------------------------
+
+def from_lines(lines: Any, *, tol: Tolerances = DEFAULT) -> Rulings:
+    """Rulings from explicit generators.
+
+    Parameters
+    ----------
+    lines : (m, 2, 3) array_like, m >= 2
+        ``lines[i] = [a_i, b_i]``.
+
+    Returns
+    -------
+    Rulings
+        ``u`` is the normalised cumulative mean chord length of the endpoints;
+        the reference surface interpolates the endpoints with C2 cubic splines
+        (not-a-knot) in that ``u``.
+
+    Raises
+    ------
+    GeometryError
+        A generator of zero length, or two consecutive equal generators.
+    """
+    try:
+        arr = np.asarray(lines, dtype=np.float64)
+    except (TypeError, ValueError):
+        raise ParameterError(f"expected numbers, got {describe(lines)}", "lines") from None
+    if arr.ndim != 3 or arr.shape[1:] != (2, 3):
+        raise ParameterError(
+            f"expected a list of lines [[x, y, z], [x, y, z]], got {describe(lines)}", "lines")
+    if len(arr) < 2:
+        raise ParameterError(f"expected at least 2 lines, got {len(arr)}", "lines")
+    if not np.all(np.isfinite(arr)):
+        raise ParameterError("expected finite coordinates, got NaN or infinity", "lines")
+    a, b = arr[:, 0].copy(), arr[:, 1].copy()
+    _check_generators(a, b, "lines", tol)
+    step = 0.5 * (np.linalg.norm(np.diff(a, axis=0), axis=1)
+                  + np.linalg.norm(np.diff(b, axis=0), axis=1))
+    pts = np.concatenate([a, b])
+    size = float(np.linalg.norm(pts.max(axis=0) - pts.min(axis=0)))
+    dup = np.nonzero(step <= tol.degenerate * size)[0]
+    if len(dup):
+        i = int(dup[0])
+        raise GeometryError(f"lines: generators {i} and {i + 1} are the same line")
+    u = np.concatenate([[0.0], np.cumsum(step)]) / step.sum()
+    u[-1] = 1.0
+    surface = RuledSurface(_SplineTrack(CubicSpline(u, a, axis=0)),
+                           _SplineTrack(CubicSpline(u, b, axis=0)), u)
+    return Rulings(a, b, u, surface, {"distribution": "lines", "warnings": []})
+
+
+def from_csv(path: str | os.PathLike, *, tol: Tolerances = DEFAULT) -> Rulings:
+    """Rulings from a CSV file with rows ``x0,y0,z0,x1,y1,z1``.
+
+    A first line that is not numeric is a header; blank lines and lines
+    starting with ``#`` are skipped.
+
+    Raises
+    ------
+    DesignError
+        The file cannot be read or a row is malformed; the message names the
+        file and the line number, e.g. ``lines.csv: line 4: expected 6 numbers, got 5``.
+    """
+    name = os.fspath(path)
+    try:
+        with open(name, encoding="utf-8") as fh:
+            text = fh.read()
+    except (OSError, UnicodeDecodeError) as exc:
+        raise DesignError(f"cannot read the file: {exc.strerror or exc}", None, name) from None
+    rows = []
+    first = True
+    for number, line in enumerate(text.splitlines(), start=1):
+        stripped = line.strip()
+        if not stripped or stripped.startswith("#"):
+            continue
+        cells = [c.strip() for c in stripped.split(",")]
+        try:
+            values = [float(c) for c in cells]
+        except ValueError:
+            if first:
+                first = False
+                continue  # header
+            raise DesignError(f"expected 6 numbers separated by commas, got {stripped!r}",
+                              f"line {number}", name) from None
+        first = False
+        if len(values) != 6:
+            raise DesignError(f"expected 6 numbers (x0,y0,z0,x1,y1,z1), got {len(values)}",
+                              f"line {number}", name)
+        if not all(math.isfinite(v) for v in values):
+            raise DesignError("expected finite numbers, got NaN or infinity", f"line {number}",
+                              name)
+        rows.append(values)
+    if len(rows) < 2:
+        raise DesignError(f"expected at least 2 lines (rows), got {len(rows)}", None, name)
+    try:
+        return from_lines(np.asarray(rows).reshape(-1, 2, 3), tol=tol)
+    except GeometryError as exc:
+        raise GeometryError(f"{name}: {exc}") from None
+
+
+# --------------------------------------------------------------------------
+# design files
+# --------------------------------------------------------------------------
+
+_SOURCES = ("between", "lines", "file", "conoid")
+_RULINGS_KEYS = ("between", "distribution", "director_plane", "directrix", "count", "lines",
+                 "file", "conoid")
+
+
+def rulings_from_spec(spec: Mapping, curves: Mapping[str, Curve], *, path: str = "rulings",
+                      base_dir: str | os.PathLike = ".") -> Rulings:
+    """Build rulings from the ``[rulings]`` table of a design file.
+
+    Parameters
+    ----------
+    spec : Mapping
+        Exactly one of ``between`` (two or three curve names), ``lines``
+        (list of ``[[x, y, z], [x, y, z]]``), ``file`` (CSV, relative to
+        ``base_dir``) or ``conoid`` (table ``curve``, ``directrix``,
+        ``director_plane``); with ``between`` of two curves ``distribution``
+        (default ``"arc-length"``) and its ``director_plane`` or
+        ``directrix``; ``count`` (>= 3) with ``between`` and ``conoid``.
+    curves : Mapping[str, Curve]
+        The design's ``[curves.*]``, by name.
+    path : str
+        Dotted path of the table for error messages.
+    base_dir : path
+        Directory that ``file`` is relative to.
+
+    Raises
+    ------
+    DesignError
+        With the dotted field path, e.g. ``rulings.count: expected an integer
+        >= 3, got "forty"`` or ``rulings.between: no curve named "c3"
+        (defined: c1, c2)``.
+    GeometryError
+        The table is well formed but the generators cannot be built.
+    """
+    E = DesignError
+    if not isinstance(spec, Mapping):
+        raise E(f"expected a table, got {describe(spec)}", path)
+    check_keys(spec, _RULINGS_KEYS, path, err=E)
+    given = [k for k in _SOURCES if k in spec]
+    if not given:
+        raise E("expected one of between, lines, file or conoid", path)
+    if len(given) > 1:
+        raise E(f"give only one of between, lines, file or conoid; also got {given[0]}",
+                f"{path}.{given[1]}")
+    source = given[0]
+
+    def refuse(*keys: str, why: str) -> None:
+        for key in keys:
+            if key in spec:
+                raise E(f"not used {why}", f"{path}.{key}")
+
+    def curve(name: Any, where: str) -> Curve:
+        if not isinstance(name, str):
+            raise E(f"expected the name of a [curves.*] table, got {describe(name)}", where)
+        if name not in curves:
+            defined = ", ".join(curves) if curves else "none"
+            raise E(f'no curve named "{name}" (defined: {defined})', where)
+        return curves[name]
+
+    def count() -> int:
+        if "count" not in spec:
+            raise E("missing; expected an integer >= 3 (the number of generators)",
+                    f"{path}.count")
+        return check_int(spec["count"], f"{path}.count", lo=3, err=E)
+
+    try:
+        if source in ("lines", "file"):
+            refuse("count", "distribution", "director_plane", "directrix",
+                   why=f"with {source} (the generators are given)")
+            if source == "lines":
+                raw = spec["lines"]
+                try:
+                    arr = np.asarray(raw, dtype=np.float64)
+                except (TypeError, ValueError):
+                    arr = None
+                if arr is None or arr.ndim != 3 or arr.shape[1:] != (2, 3) or len(arr) < 2:
+                    raise E("expected at least 2 lines [[x, y, z], [x, y, z]], got "
+                            f"{describe(raw)}", f"{path}.lines")
+                if not np.all(np.isfinite(arr)):
+                    raise E("expected finite coordinates, got NaN or infinity", f"{path}.lines")
+                return from_lines(arr)
+            fname = spec["file"]
+            if not isinstance(fname, str) or not fname:
+                raise E(f"expected a file name, got {describe(fname)}", f"{path}.file")
+            full = os.path.join(os.fspath(base_dir), fname)
+            if not os.path.isfile(full):
+                raise E(f'no such file "{fname}" (looked in {os.fspath(base_dir)})',
+                        f"{path}.file")
+            return from_csv(full)
+
+        if source == "conoid":
+            refuse("distribution", "director_plane", "directrix",
+                   why="with conoid (give directrix and director_plane inside the conoid table)")
+            table = spec["conoid"]
+            cpath = f"{path}.conoid"
+            if not isinstance(table, Mapping):
+                raise E(f"expected a table {{ curve, directrix, director_plane }}, got "
+                        f"{describe(table)}", cpath)
+            check_keys(table, ("curve", "directrix", "director_plane"), cpath, err=E)
+            for key in ("curve", "directrix", "director_plane"):
+                if key not in table:
+                    raise E("missing", f"{cpath}.{key}")
+            c = curve(table["curve"], f"{cpath}.curve")
+            d = _check_line(table["directrix"], f"{cpath}.directrix", err=E)
+            n = check_vector(table["director_plane"], f"{cpath}.director_plane", nonzero=True,
+                             err=E)
+            return conoid(c, d, n, count())
+
+        names = spec["between"]
+        bpath = f"{path}.between"
+        if isinstance(names, str) or not isinstance(names, (list, tuple)) or len(names) not in (2, 3):
+            raise E(f"expected two or three curve names, got {describe(names)}", bpath)
+        cs = [curve(nm, bpath) for nm in names]
+        if len(cs) == 3:
+            refuse("distribution", "director_plane", "directrix",
+                   why="with three directrices (the lines meeting all three are the generators)")
+            return three_directrices(cs[0], cs[1], cs[2], count())
+        dist = check_choice(spec.get("distribution", "arc-length"), Distribution,
+                            f"{path}.distribution", err=E)
+        plane = directrix = None
+        if dist is Distribution.DIRECTOR_PLANE:
+            refuse("directrix", why='with distribution "director-plane"')
+            if "director_plane" not in spec:
+                raise E('missing; expected the normal [x, y, z] of the director plane for '
+                        'distribution "director-plane"', f"{path}.director_plane")
+            plane = check_vector(spec["director_plane"], f"{path}.director_plane", nonzero=True,
+                                 err=E)
+        elif dist is Distribution.LINEAR_DIRECTRIX:
+            refuse("director_plane", why='with distribution "linear-directrix"')
+            if "directrix" not in spec:
+                raise E('missing; expected two points [[x, y, z], [x, y, z]] of the line d for '
+                        'distribution "linear-directrix"', f"{path}.directrix")
+            directrix = _check_line(spec["directrix"], f"{path}.directrix", err=E)
+        else:
+            refuse("director_plane", "directrix", why=f'with distribution "{dist.value}"')
+        return between(cs[0], cs[1], count(), dist, director_plane=plane, directrix=directrix)
+    except ParameterError as exc:  # pragma: no cover - inputs are checked above
+        raise E(exc.detail, f"{path}.{exc.field}" if exc.field else path) from None
