@@ -1,0 +1,80 @@
+"""``ruledmesh fabricate MESH -o DIR``: sheets, schedules, statistics, hot-wire paths."""
+
+from __future__ import annotations
+
+import sys
+from pathlib import Path
+
+
+def _size(text: str) -> tuple[float, float]:
+    import argparse
+
+    try:
+        w, h = (float(p) for p in text.lower().split("x"))
+    except ValueError:
+        raise argparse.ArgumentTypeError(f'expected WIDTHxHEIGHT, e.g. 2500x1250, got "{text}"')
+    return w, h
+
+
+def add_parser(sub) -> None:
+    p = sub.add_parser(
+        "fabricate",
+        help="write cutting sheets, schedules and hot-wire paths for a mesh",
+        description="Unroll every panel (exactly: they are planar), lay the panels out on sheets "
+                    "(SVG, and DXF when ezdxf is installed), and write node/edge/member schedules, "
+                    "panel statistics with congruence classes, and 4-axis hot-wire paths (CSV and "
+                    "XYUV G-code) along the generators. See docs/fabrication.md.",
+        epilog="examples:\n  ruledmesh fabricate skew.obj -o skew-fab\n"
+               "  ruledmesh fabricate skew.obj -o fab --scale 1000 --unit mm --sheet 2500x1250",
+    )
+    p.add_argument("mesh", help="mesh file (.obj, .ply, ...) or design file (.toml)")
+    p.add_argument("-o", "--output", required=True, help="folder to write into (created if missing)")
+    p.add_argument("--scale", type=float, default=1.0, help="multiply coordinates first (e.g. 1000: m -> mm)")
+    p.add_argument("--unit", default="", choices=["", "mm", "cm", "m", "in", "ft"],
+                   help="name of the (scaled) mesh unit in the files")
+    p.add_argument("--sheet", type=_size, metavar="WxH", help="sheet size (default: one square sheet)")
+    p.add_argument("--gap", type=float, help="clearance between panels (default: 2%% of the largest)")
+    p.add_argument("--decimals", type=int, default=3, help="decimals of edge-length labels (default 3)")
+    p.add_argument("--length-tol", type=float, help="congruence tolerance on edge lengths "
+                   "(default 1e-9 x diagonal)")
+    p.add_argument("--angle-tol", type=float, default=1e-4,
+                   help="congruence tolerance on angles, degrees (default 1e-4)")
+    p.add_argument("--no-dxf", action="store_true", help="do not write DXF sheets")
+    p.add_argument("--span", default="auto", choices=["auto", "x", "y", "z"],
+                   help="hot wire: mesh axis across the towers (default: auto)")
+    p.add_argument("--up", choices=["x", "y", "z"], help="hot wire: mesh axis of Y/V (default z)")
+    p.add_argument("--kerf", type=float, default=0.0, help="hot wire: slot width (default 0)")
+    p.add_argument("--kerf-side", default="left", choices=["left", "right"],
+                   help="hot wire: offset side, relative to travel (default left)")
+    p.add_argument("--feed", type=float, default=300.0, help="hot wire: feed per minute (default 300)")
+    p.add_argument("--allow-bent", action="store_true",
+                   help="project non-planar faces instead of refusing them")
+    p.add_argument("-q", "--quiet", action="store_true", help="print nothing on success")
+    p.set_defaults(run=run)
+
+
+def run(args) -> int:
+    from ..design import build_file
+    from ..fabricate.output import fabricate
+    from ..io import load
+
+    path = Path(args.mesh)
+    mesh = build_file(path).mesh if path.suffix.lower() == ".toml" else load(path)
+    if args.scale != 1.0:
+        mesh = mesh.with_vertices(mesh.vertices * args.scale)
+    summary = fabricate(
+        mesh, args.output, sheet=args.sheet, gap=args.gap, unit=args.unit,
+        decimals=args.decimals, length_tol=args.length_tol, angle_tol=args.angle_tol,
+        dxf=False if args.no_dxf else None,
+        hotwire=True if args.span != "auto" else None, span=args.span, up=args.up,
+        kerf=args.kerf, kerf_side=args.kerf_side, feed=args.feed,
+        require_planar=not args.allow_bent)
+    for note in summary["notes"]:
+        print(f"warning: {note}", file=sys.stderr)
+    if not args.quiet:
+        st = summary["panels"]
+        print(f"wrote {len(summary['files'])} files to {args.output}: {st['count']} panels "
+              f"({st['distinct_panels']} distinct) on {summary['sheets']['count']} sheets"
+              + ("" if summary["hotwire"] is None else
+                 f", hot-wire path of {summary['hotwire']['steps']} generators"))
+    return 0
