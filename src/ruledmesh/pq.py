@@ -1,0 +1,577 @@
+"""PQ meshes of skew surfaces from a discrete set of generators (paper §4.3).
+
+Divide a primary generator ``g_p``; from each division point hop across the
+next generator to the next-but-one (chain *a*, generators of the primary's
+parity), and from the first crossing hop likewise (chain *b*, the other
+parity).  The grid point ``X[i, j]`` is the vertex of row ``j`` on ``g_i``.
+The two options of the paper are the two colours of a checkerboard on that
+grid: a face is centred on every grid point of the other colour,
+
+    [X[i-1, j], X[i, j-1], X[i+1, j], X[i, j+1]],
+
+with one diagonal on the generator ``g_i`` and the other on a hop line that
+crosses ``g_i``: two intersecting lines, so every face is planar by
+construction, up to rounding that does not accumulate.
+
+The rows are computed through Moebius maps of the parameter (see
+:mod:`ruledmesh.hop`): ``t[i, j] = M_i(tau_j)``, one broadcast for the whole
+grid.  The maps also tell which division of the primary generator reaches the
+patch ``0 <= t <= 1`` on every generator (automatic extension), and where a
+row passes through infinity (the sign of the homogeneous denominator flips).
+Torsal pairs of consecutive generators (coplanar, so no hop exists across
+them) split the generators into runs meshed independently; the strips
+between runs are filled with triangles (paper §4.3, last paragraph).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from typing import Any, Mapping
+
+import numpy as np
+
+from ._validation import check_bool, check_float, check_int, check_keys, check_points, describe
+from .errors import DesignError, GeometryError, ParameterError
+from .hop import coplanarity, landing_maps, crossing_maps
+from .mesh import FaceKind, Mesh
+from .registry import BuildContext, Built, mesh_method
+from .tolerances import DEFAULT, Tolerances
+
+__all__ = ["pq_mesh", "row_maps", "PQOptions", "MAX_GRID_POINTS"]
+
+# Grid points (generators x rows) above which a build is refused up front, with
+# the memory it would need, instead of running out of memory half-way.
+MAX_GRID_POINTS = 60_000_000
+_BYTES_PER_GRID_POINT = 96
+
+
+@dataclass(frozen=True)
+class PQOptions:
+    """Options of the §4.3 mesher (see :func:`pq_mesh`)."""
+
+    rows: int = 20
+    primary: int | str = "middle"
+    option: int = 0
+    extend: float | str = "auto"
+    trim: bool = True
+    max_extend: float = 20.0
+
+
+def _normalise(M: np.ndarray) -> np.ndarray:
+    return M / np.abs(M).max()
+
+
+def row_maps(a: np.ndarray, d: np.ndarray, primary: int) -> np.ndarray:
+    """Moebius maps from the primary generator's parameter to every generator's.
+
+    Chain *a* lives on the generators of the primary's parity and starts at
+    the identity; chain *b* starts where chain *a*'s first hop crosses the
+    neighbouring generator (towards the longer side) and hops both ways.
+
+    Parameters
+    ----------
+    a, d : (m, 3) float64
+        Generator points and directions, ``m >= 3``, no torsal pair.
+    primary : int
+        Index of the primary generator.
+
+    Returns
+    -------
+    M : (m, 2, 2) float64
+        ``t_i = (M[i,0,0] tau + M[i,0,1]) / (M[i,1,0] tau + M[i,1,1])``;
+        each matrix scaled to unit max-norm.
+    """
+    m = len(a)
+    M = np.zeros((m, 2, 2))
+    M[primary] = np.eye(2)
+    # Landing maps g_k -> g_{k+2} (forward) and g_k -> g_{k-2} (backward), all at once.
+    fwd = landing_maps(a[:-2], d[:-2], a[1:-1], d[1:-1], a[2:], d[2:])
+    bwd = landing_maps(a[2:], d[2:], a[1:-1], d[1:-1], a[:-2], d[:-2])
+    if primary + 2 < m:
+        root = primary + 1
+        M[root] = _normalise(crossing_maps(a[primary:primary + 1], d[primary:primary + 1],
+                                           a[root:root + 1], d[root:root + 1],
+                                           a[root + 1:root + 2], d[root + 1:root + 2])[0])
+    else:
+        root = primary - 1
+        M[root] = _normalise(crossing_maps(a[primary:primary + 1], d[primary:primary + 1],
+                                           a[root:root + 1], d[root:root + 1],
+                                           a[root - 1:root], d[root - 1:root])[0])
+    # Sequential only along the generators (m small 2x2 products), never per vertex.
+    fwd_l = fwd.tolist()
+    bwd_l = bwd.tolist()
+    out = M.tolist()
+    for start in (primary, root):
+        for i in range(start + 2, m, 2):
+            (h00, h01), (h10, h11) = fwd_l[i - 2]
+            (m00, m01), (m10, m11) = out[i - 2]
+            r = [[h00 * m00 + h01 * m10, h00 * m01 + h01 * m11],
+                 [h10 * m00 + h11 * m10, h10 * m01 + h11 * m11]]
+            s = max(abs(r[0][0]), abs(r[0][1]), abs(r[1][0]), abs(r[1][1])) or 1.0
+            out[i] = [[r[0][0] / s, r[0][1] / s], [r[1][0] / s, r[1][1] / s]]
+        for i in range(start - 2, -1, -2):
+            (h00, h01), (h10, h11) = bwd_l[i]
+            (m00, m01), (m10, m11) = out[i + 2]
+            r = [[h00 * m00 + h01 * m10, h00 * m01 + h01 * m11],
+                 [h10 * m00 + h11 * m10, h10 * m01 + h11 * m11]]
+            s = max(abs(r[0][0]), abs(r[0][1]), abs(r[1][0]), abs(r[1][1])) or 1.0
+            out[i] = [[r[0][0] / s, r[0][1] / s], [r[1][0] / s, r[1][1] / s]]
+    return np.array(out)
+
+
+def _patch_preimage(M: np.ndarray, tol: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """For each map, the tau interval that lands on 0 <= t <= 1.
+
+    Returns
+    -------
+    lo, hi : (m,) float64
+        Interval ends (finite where ``bounded``).
+    bounded : (m,) bool
+        False where the interval passes through tau = infinity (or the map is
+        degenerate), so no finite division of the primary covers that generator.
+    """
+    m00, m01, m10, m11 = M[:, 0, 0], M[:, 0, 1], M[:, 1, 0], M[:, 1, 1]
+    # tau(t) = (m11 t - m01) / (m00 - m10 t), the inverse map, at t = 0 and t = 1.
+    den0 = m00
+    den1 = m00 - m10
+    small = tol * np.abs(M).max(axis=(1, 2))
+    finite = (np.abs(den0) > small) & (np.abs(den1) > small)
+    tau0 = np.where(finite, -m01 / np.where(finite, den0, 1.0), 0.0)
+    tau1 = np.where(finite, (m11 - m01) / np.where(finite, den1, 1.0), 0.0)
+    lo, hi = np.minimum(tau0, tau1), np.maximum(tau0, tau1)
+    # The map's pole (t = inf) inside [lo, hi] means the preimage of [0, 1] is the outside.
+    pole_den = np.abs(m10) > small
+    pole = np.where(pole_den, -m11 / np.where(pole_den, m10, 1.0), np.inf)
+    wraps = pole_den & (pole > lo) & (pole < hi)
+    return lo, hi, finite & ~wraps
+
+
+def _row_range(M: np.ndarray, rows: int, extend, max_extend: float, tol: Tolerances,
+               warnings: list[str]) -> tuple[int, int]:
+    """Integer row range [j0, j1] (tau = j / rows) covering the patch."""
+    if extend == "auto":
+        lo, hi, bounded = _patch_preimage(M, tol.degenerate)
+        if not np.all(bounded):
+            warnings.append(f"{int((~bounded).sum())} generators cannot be covered by a finite "
+                            f"division of the primary generator; extension capped at "
+                            f"{max_extend:g} generator lengths")
+        lo = lo[bounded].min() if bounded.any() else 0.0
+        hi = hi[bounded].max() if bounded.any() else 1.0
+        lo = max(min(lo, 0.0), -max_extend)
+        hi = min(max(hi, 1.0), 1.0 + max_extend)
+        # One row of margin on each side: a face spans two row steps.
+        j0 = math.floor(lo * rows) - 2
+        j1 = math.ceil(hi * rows) + 2
+    else:
+        e = float(extend)
+        j0 = -math.ceil(e * rows)
+        j1 = rows + math.ceil(e * rows)
+    if (j1 - j0 + 1) % 2:
+        j1 += 1
+    return j0, j1
+
+
+@dataclass
+class _Run:
+    """The checkerboard grid of one run of generators (before trimming).
+
+    Half-faces are triangles of the zigzag strips between consecutive
+    generators: the face centred at (i, j) is the union of its left half
+    [X[i-1,j], X[i,j-1], X[i,j+1]] and right half [X[i,j-1], X[i+1,j], X[i,j+1]],
+    coplanar because the face is planar.  The halves of centres on the first and
+    last generator are the notch triangles of paper §4.3.
+    """
+
+    vertices: np.ndarray      # (V, 3)
+    t: np.ndarray             # (V,) parameter on its generator
+    gen: np.ndarray           # (V,) generator index (global)
+    far: np.ndarray           # (V,) beyond the 'far' bound: never emitted
+    left: np.ndarray          # (F, 3) left halves (-1 row where absent)
+    right: np.ndarray         # (F, 3) right halves
+    pole: np.ndarray          # (F,) a row passes through infinity inside the face
+    centre_gen: np.ndarray    # (F,) generator index of each centre (global)
+
+
+def _mesh_run(a: np.ndarray, d: np.ndarray, first: int, primary: int, rows: int, option: int,
+              extend, max_extend: float, tol: Tolerances, scale: float,
+              warnings: list[str]) -> _Run:
+    """Checkerboard PQ grid on generators a, d (a run), before trimming."""
+    m = len(a)
+    M = row_maps(a, d, primary)
+    j0, j1 = _row_range(M, rows, extend, max_extend, tol, warnings)
+    J = j1 - j0 + 1
+    if m * J > MAX_GRID_POINTS:
+        need = m * J * _BYTES_PER_GRID_POINT / 2**30
+        raise GeometryError(f"the grid would have {m} x {J} points (about {need:.1f} GiB); "
+                            f"reduce the generator count, the rows or the extension")
+    H = J // 2
+    # Vertex (i, j) exists where (i + j) % 2 == option; on generator i its rows are
+    # j = j0 + s_i + 2h, h = 0..H-1, with s_i the row parity of that generator.
+    i_idx = np.arange(m)
+    s = (option - i_idx - j0) % 2
+    tau = (j0 + s[:, None] + 2 * np.arange(H)[None, :]) / rows          # (m, H)
+    num = M[:, 0, 0, None] * tau + M[:, 0, 1, None]
+    den = M[:, 1, 0, None] * tau + M[:, 1, 1, None]
+    # Far limit in t: tol.far patch diagonals along each generator.
+    glen = np.linalg.norm(d, axis=1)
+    tmax = tol.far * scale / np.maximum(glen, 1e-300)
+    far = ~(np.abs(num) < tmax[:, None] * np.abs(den))
+    t = np.where(far, 0.0, num / np.where(far, 1.0, den))
+    X = a[:, None, :] + t[..., None] * d[:, None, :]
+    vid = np.arange(m * H).reshape(m, H)
+    # Centres (i, j) of the other colour on every generator: on g_i the vertex rows
+    # around centre c are h = c - 1 + (1 - s_i) ... written as h_lo = c + s_i - 1 + ... below.
+    cc = np.arange(H)
+    jc = j0 + (1 - s)[:, None] + 2 * cc[None, :]                       # (m, H) centre rows
+    h_lo = (jc - 1 - j0 - s[:, None]) // 2                              # vertex row j-1 on g_i
+    ok = (h_lo >= 0) & (h_lo + 1 < H)
+    ic = np.broadcast_to(i_idx[:, None], jc.shape)[ok]
+    hl = h_lo[ok]
+    hc = np.broadcast_to(cc[None, :], jc.shape)[ok]   # row j on g_{i-1} and g_{i+1}
+    lo_v, hi_v = vid[ic, hl], vid[ic, hl + 1]
+    has_l, has_r = ic > 0, ic < m - 1
+    left = np.where(has_l[:, None],
+                    np.stack([vid[np.maximum(ic - 1, 0), hc], lo_v, hi_v], axis=1), -1)
+    right = np.where(has_r[:, None],
+                     np.stack([lo_v, vid[np.minimum(ic + 1, m - 1), hc], hi_v], axis=1), -1)
+    # A row passes through infinity inside a face when the homogeneous denominator
+    # changes sign between the face's two rows on its generator g_i.  (Signs on
+    # different generators are not comparable: M and -M are the same map.)
+    sg = np.sign(den)
+    pole = sg[ic, hl] != sg[ic, hl + 1]
+    gen = np.repeat(np.arange(first, first + m), H)
+    return _Run(X.reshape(-1, 3), t.reshape(-1), gen, far.reshape(-1), left, right, pole,
+                ic + first)
+
+
+def _strip_triangles(ta: np.ndarray, tb: np.ndarray) -> np.ndarray:
+    """Triangulate the strip between two sorted chains by merging their parameters.
+
+    Parameters
+    ----------
+    ta, tb : (p,), (q,) float64
+        Increasing parameters of the chain vertices on the left and right generator.
+
+    Returns
+    -------
+    (p + q - 2, 3) int64
+        Triangles indexing the concatenation [chain a, chain b] (b offset by p),
+        oriented like the PQ faces (left chain, right chain, left chain).
+    """
+    p, q = len(ta), len(tb)
+    # Walk both chains in order of parameter: each step advances one chain and
+    # closes one triangle (the classical zipper).
+    keys = np.concatenate([ta[1:], tb[1:]])
+    which = np.concatenate([np.zeros(p - 1, bool), np.ones(q - 1, bool)])
+    order = np.argsort(keys, kind="stable")
+    step_b = which[order]
+    ia = np.concatenate([[0], np.cumsum(~step_b)])
+    ib = np.concatenate([[0], np.cumsum(step_b)])
+    tri = np.where(step_b[:, None],
+                   np.stack([ia[:-1], p + ib[:-1], p + ib[:-1] + 1], axis=1),
+                   np.stack([ia[:-1], p + ib[:-1], ia[:-1] + 1], axis=1))
+    return tri
+
+
+def pq_mesh(a, b, rows: int = 20, primary: int | str = "middle", option: int = 0,
+            extend: float | str = "auto", trim: bool = True, *, max_extend: float = 20.0,
+            tol: Tolerances = DEFAULT) -> Mesh:
+    """The §4.3 PQ mesh of the ruled surface through generators ``a_i b_i``.
+
+    Parameters
+    ----------
+    a, b : (m, 3) array_like
+        Generator end points; ``t = 0`` at ``a`` (director curve c1), ``t = 1``
+        at ``b`` (c2).  ``m >= 3``.
+    rows : int
+        Divisions of the primary generator between ``t = 0`` and ``t = 1``.
+    primary : int or "middle"
+        Index of the primary generator (negative indices count from the end).
+    option : {0, 1}
+        Which colour of the checkerboard carries the vertices (the paper's two options).
+    extend : "auto" or float
+        How far the division of the primary generator continues beyond
+        ``[0, 1]`` (in primary-generator lengths); ``"auto"`` takes just what
+        covers the patch on every generator, found from the row maps.
+    trim : bool
+        Clip the faces to the patch ``0 <= t <= 1`` (clipped faces stay planar).
+    max_extend : float
+        Cap of the automatic extension.
+    tol : Tolerances
+
+    Returns
+    -------
+    Mesh
+        Faces of kind QUAD (interior), BORDER (clipped), FILL (notch and torsal
+        triangles) and SPLIT (quads that were not convex, split along their
+        generator diagonal); members are the generator segments between
+        consecutive vertices; ``vertex_data`` holds ``t`` and ``generator``;
+        ``info["warnings"]`` says what was replaced or could not be covered.
+
+    Raises
+    ------
+    ParameterError
+        For bad arguments.
+    GeometryError
+        For zero-length generators or a grid too large to build.
+
+    Examples
+    --------
+    Generators of one regulus of the hyperboloid x^2 + y^2 - z^2 = 1:
+
+    >>> import numpy as np
+    >>> phi = np.linspace(0, np.pi, 12)
+    >>> a = np.stack([np.cos(phi) - np.sin(phi), np.sin(phi) + np.cos(phi), -np.ones(12)], 1)
+    >>> b = np.stack([np.cos(phi) + np.sin(phi), np.sin(phi) - np.cos(phi), np.ones(12)], 1)
+    >>> mesh = pq_mesh(a, b, rows=10)
+    >>> v = mesh.vertices
+    >>> bool(np.abs(v[:, 0]**2 + v[:, 1]**2 - v[:, 2]**2 - 1).max() < 1e-12)
+    True
+    """
+    a = check_points(a, "a", min_count=3)
+    b = check_points(b, "b", min_count=3)
+    if a.shape != b.shape:
+        raise ParameterError(f"expected the shape of a {a.shape}, got {b.shape}", "b")
+    m = len(a)
+    rows = check_int(rows, "rows", lo=1)
+    option = check_int(option, "option", lo=0, hi=1)
+    trim = check_bool(trim, "trim")
+    if isinstance(primary, str):
+        if primary != "middle":
+            raise ParameterError(f'expected "middle" or an index, got {describe(primary)}', "primary")
+        p = m // 2
+    else:
+        p = check_int(primary, "primary", lo=-m, hi=m - 1) % m
+    if not (isinstance(extend, str) and extend == "auto"):
+        if isinstance(extend, str):
+            raise ParameterError(f'expected "auto" or a number >= 0, got {describe(extend)}', "extend")
+        extend = check_float(extend, "extend", lo=0.0, hi=1e3)
+    max_extend = check_float(max_extend, "max_extend", lo=0.0, hi=1e3)
+    d = b - a
+    lo, hi = np.minimum(a.min(0), b.min(0)), np.maximum(a.max(0), b.max(0))
+    scale = float(np.linalg.norm(hi - lo))
+    if scale == 0.0:
+        raise GeometryError("all generator end points coincide")
+    glen = np.linalg.norm(d, axis=1)
+    short = np.flatnonzero(glen <= tol.degenerate * scale)
+    if short.size:
+        raise GeometryError(f"generator {int(short[0])} has zero length (its end points coincide)"
+                            + (f", and {short.size - 1} more" if short.size > 1 else ""))
+    warnings: list[str] = []
+    # Torsal pairs: consecutive generators (nearly) coplanar cut the generators into runs.
+    cop = coplanarity(a, d, scale)
+    cut = np.flatnonzero(cop <= tol.degenerate)
+    bounds = np.concatenate([[0], cut + 1, [m]])
+    if cut.size:
+        warnings.append(f"{cut.size} torsal pairs of generators (at {', '.join(map(str, cut[:8].tolist()))}"
+                        f"{' ...' if cut.size > 8 else ''}): strips filled with triangles")
+    parts = []          # (vertices, t, gen, faces_list, kinds)
+    offset = 0
+    run_of = np.full(m, -1)
+    for r0, r1 in zip(bounds[:-1], bounds[1:]):
+        if r1 - r0 < 3:
+            continue
+        pr = p - r0 if r0 <= p < r1 else (r1 - r0) // 2
+        run = _mesh_run(a[r0:r1], d[r0:r1], r0, pr, rows, option, extend, max_extend, tol,
+                        scale, warnings)
+        run_of[r0:r1] = len(parts)
+        parts.append(run)
+    return _assemble(parts, a, d, rows, trim, tol, warnings, bounds, run_of)
+
+
+def _assemble(parts, a, d, rows, trim, tol, warnings, bounds, run_of) -> Mesh:
+    """Join the runs; keep convex quads, halves, fill bands; add members."""
+    from .analysis.faces import quad_diagonal_crossing
+
+    m = len(a)
+    V = np.concatenate([r.vertices for r in parts]) if parts else np.zeros((0, 3))
+    T = np.concatenate([r.t for r in parts]) if parts else np.zeros(0)
+    G = np.concatenate([r.gen for r in parts]) if parts else np.zeros(0, np.int64)
+    FAR = np.concatenate([r.far for r in parts]) if parts else np.zeros(0, bool)
+    offs = np.cumsum([0] + [len(r.vertices) for r in parts])
+    shift = lambda f, o: np.where(f >= 0, f + o, -1)  # noqa: E731
+    L = np.concatenate([shift(r.left, o) for r, o in zip(parts, offs)]) if parts else np.zeros((0, 3), np.int64)
+    R = np.concatenate([shift(r.right, o) for r, o in zip(parts, offs)]) if parts else np.zeros((0, 3), np.int64)
+    POLE = np.concatenate([r.pole for r in parts]) if parts else np.zeros(0, bool)
+    CG = np.concatenate([r.centre_gen for r in parts]) if parts else np.zeros(0, np.int64)
+    lo_t, hi_t = (0.0, 1.0) if trim else (-np.inf, np.inf)
+    good_v = ~FAR & (T >= lo_t) & (T <= hi_t)
+    has_l, has_r = L[:, 0] >= 0, R[:, 0] >= 0
+    ok_l = has_l & ~POLE & good_v[np.maximum(L, 0)].all(axis=1)
+    ok_r = has_r & ~POLE & good_v[np.maximum(R, 0)].all(axis=1)
+    both = ok_l & ok_r
+    quads = np.stack([L[both, 0], L[both, 1], R[both, 1], L[both, 2]], axis=1)
+    # Bow-ties: the diagonals must cross inside both; else keep the two halves.
+    sq, tq, _ = quad_diagonal_crossing(V[quads])
+    eps = tol.convexity
+    convex = (sq > eps) & (sq < 1 - eps) & (tq > eps) & (tq < 1 - eps)
+    whole = np.zeros(len(L), bool)
+    whole[np.flatnonzero(both)[convex]] = True
+    nsplit = int(np.count_nonzero(~convex))
+    interior = has_l & has_r
+    kind_half = np.where(interior, np.where(both, FaceKind.SPLIT, FaceKind.BORDER),
+                         FaceKind.FILL).astype(np.uint8)
+    half_l = ok_l & ~whole
+    half_r = ok_r & ~whole
+    faces = [quads[convex]]
+    kinds = [np.full(int(convex.sum()), FaceKind.QUAD, np.uint8)]
+    tri = np.concatenate([L[half_l], R[half_r]])
+    faces.append(tri)
+    kinds.append(np.concatenate([kind_half[half_l], kind_half[half_r]]))
+    if trim:
+        # Strip k lies between g_k and g_k+1; its kept triangles (whole quads count
+        # with both halves) reach between [lo, hi] on each side; fill the bands
+        # from the director curves (t = 0 and t = 1) to them with zipper triangles.
+        strip_l = CG[ok_l] - 1          # left half of a centre on g_i lies in strip i-1
+        strip_r = CG[ok_r]
+        V, T, G, band_faces = _fill_bands(V, T, G, good_v, a, d, rows, m,
+                                          np.concatenate([L[ok_l], R[ok_r]]),
+                                          np.concatenate([strip_l, strip_r]), run_of)
+        faces.append(band_faces)
+        kinds.append(np.full(len(band_faces), FaceKind.FILL, np.uint8))
+    if nsplit:
+        warnings.append(f"{nsplit} quads were not convex (the two chains of §4.3 drifted apart) "
+                        "and were kept as two triangles split along their generator diagonal; "
+                        "sample the generators more finely there")
+    return _to_mesh(V, T, G, faces, kinds, warnings)
+
+
+def _fill_bands(V, T, G, good_v, a, d, rows, m, tris, strip, run_of):
+    """Zipper triangles between the director curves and the kept triangles of each strip."""
+    # Per strip and side (left generator, right generator): t range used by kept triangles.
+    nstrip = m - 1
+    lo = np.full((nstrip, 2), np.inf)
+    hi = np.full((nstrip, 2), -np.inf)
+    if len(tris):
+        gl = G[tris]                                  # generators of the 3 corners
+        side = (gl == (strip + 1)[:, None]).astype(np.int64)
+        tt = T[tris]
+        sidx = np.broadcast_to(strip[:, None], tt.shape)
+        np.minimum.at(lo, (sidx.ravel(), side.ravel()), tt.ravel())
+        np.maximum.at(hi, (sidx.ravel(), side.ravel()), tt.ravel())
+    # Points at t = 0 and t = 1 on every generator: the discrete director curves.
+    base = len(V)
+    V = np.concatenate([V, a, a + d])
+    T = np.concatenate([T, np.zeros(m), np.ones(m)])
+    G = np.concatenate([G, np.arange(m), np.arange(m)])
+    inside = np.flatnonzero(good_v)
+    order = inside[np.lexsort((T[inside], G[inside]))]
+    gen_sorted = G[order]
+    starts = np.searchsorted(gen_sorted, np.arange(m + 1))
+    out = []
+    for k in range(nstrip):
+        chains = []
+        for sd, g in ((0, k), (1, k + 1)):
+            ids = order[starts[g]:starts[g + 1]]
+            chains.append(ids)
+        ca, cb = chains
+        ta, tb = T[ca], T[cb]
+        if np.isfinite(lo[k]).all():
+            # Lower band: from the director curve c1 up to the lowest kept vertices.
+            for pa, pb in (((base + k, ca[ta <= lo[k, 0]]), (base + k + 1, cb[tb <= lo[k, 1]])),
+                           ((base + m + k, ca[ta >= hi[k, 0]][::-1]),
+                            (base + m + k + 1, cb[tb >= hi[k, 1]][::-1]))):
+                out.append(_band(V, T, pa, pb, upper=pa[0] >= base + m))
+        else:
+            ids_a = _with_ends(T, ca, base + k, base + m + k)
+            ids_b = _with_ends(T, cb, base + k + 1, base + m + k + 1)
+            tri = _strip_triangles(T[ids_a], T[ids_b])
+            out.append(np.concatenate([ids_a, ids_b])[tri])
+    faces = np.concatenate(out) if out else np.zeros((0, 3), np.int64)
+    # A zipper step between two points of equal t on one generator gives a sliver of
+    # zero area: drop it (its two edges coincide, so the mesh stays conforming).
+    pts = V[faces]
+    e1, e2 = pts[:, 1] - pts[:, 0], pts[:, 2] - pts[:, 0]
+    area2 = np.einsum("ij,ij->i", *(np.cross(e1, e2),) * 2)
+    longest = np.max(np.stack([np.einsum("ij,ij->i", e, e) for e in (e1, e2, pts[:, 2] - pts[:, 1])]), axis=0)
+    faces = faces[area2 > 1e-18 * longest ** 2]
+    return V, T, G, faces
+
+
+def _with_ends(T, chain, start, end, eps: float = 1e-12):
+    """A generator's chain with its director points, unless a vertex already sits there."""
+    parts = []
+    if not (len(chain) and T[chain[0]] <= eps):
+        parts.append([start])
+    parts.append(chain)
+    if not (len(chain) and T[chain[-1]] >= 1 - eps):
+        parts.append([end])
+    return np.concatenate(parts).astype(np.int64)
+
+
+def _band(V, T, pa, pb, upper: bool) -> np.ndarray:
+    """Zipper triangles of one band: chains from a director point to the kept triangles."""
+    (da, ca), (db, cb) = pa, pb
+    edge = 1.0 if upper else 0.0
+    near = lambda c: len(c) and abs(T[c[0]] - edge) <= 1e-12  # noqa: E731
+    ids_a = ca if near(ca) else np.concatenate([[da], ca]).astype(np.int64)
+    ids_b = cb if near(cb) else np.concatenate([[db], cb]).astype(np.int64)
+    if len(ids_a) + len(ids_b) < 3:
+        return np.zeros((0, 3), np.int64)
+    ta, tb = T[ids_a], T[ids_b]
+    if upper:                      # walk from t = 1 downwards, then flip orientation
+        tri = _strip_triangles(-ta, -tb)[:, ::-1]
+    else:
+        tri = _strip_triangles(ta, tb)
+    return np.concatenate([ids_a, ids_b])[tri]
+
+
+def _to_mesh(V, T, G, faces, kinds, warnings) -> Mesh:
+    """Mesh from fixed-valence face arrays; members along the generators."""
+    offs, idxs = [np.zeros(1, np.int64)], []
+    total = 0
+    for f in faces:
+        k = f.shape[1]
+        offs.append(np.arange(1, len(f) + 1, dtype=np.int64) * k + total)
+        idxs.append(f.reshape(-1))
+        total += f.size
+    off = np.concatenate(offs)
+    idx = np.concatenate(idxs).astype(np.int64)
+    kind = np.concatenate(kinds).astype(np.uint8)
+    # Members: consecutive used vertices along each generator.
+    used = np.zeros(len(V), bool)
+    used[idx] = True
+    ids = np.flatnonzero(used & (G >= 0))
+    order = ids[np.lexsort((T[ids], G[ids]))]
+    same = G[order[1:]] == G[order[:-1]]
+    members = np.stack([order[:-1][same], order[1:][same]], axis=1)
+    member_id = G[order[:-1][same]]
+    mesh = Mesh(V, off, idx, kind, members.astype(np.int64), member_id.astype(np.int64),
+                {"t": T, "generator": G}, {"construction": "pq (paper §4.3)", "warnings": warnings})
+    return mesh.compact()
+
+
+# ---------------------------------------------------------------- design files
+_MESH_KEYS = ("method", "rows", "primary", "option", "extend", "trim", "max_extend")
+
+
+@mesh_method("pq")
+def build_pq(rulings, table: Mapping[str, Any], ctx: BuildContext) -> Built:
+    """Design-file builder for ``[mesh] method = "pq"``."""
+    check_keys(table, _MESH_KEYS, "mesh", err=DesignError)
+    rows = check_int(table.get("rows", 20), "mesh.rows", lo=1, hi=100_000, err=DesignError)
+    primary = table.get("primary", "middle")
+    m = len(rulings.a)
+    if isinstance(primary, str):
+        if primary != "middle":
+            raise DesignError(f'expected "middle" or an index, got {describe(primary)}', "mesh.primary")
+    else:
+        primary = check_int(primary, "mesh.primary", lo=-m, hi=m - 1, err=DesignError)
+    option = check_int(table.get("option", 0), "mesh.option", lo=0, hi=1, err=DesignError)
+    extend = table.get("extend", "auto")
+    if extend != "auto":
+        if isinstance(extend, str):
+            raise DesignError(f'expected "auto" or a number >= 0, got {describe(extend)}', "mesh.extend")
+        extend = check_float(extend, "mesh.extend", lo=0.0, hi=1e3, err=DesignError)
+    trim = check_bool(table.get("trim", True), "mesh.trim", err=DesignError)
+    max_extend = check_float(table.get("max_extend", 20.0), "mesh.max_extend", lo=0.0, hi=1e3,
+                             err=DesignError)
+    mesh = pq_mesh(rulings.a, rulings.b, rows=rows, primary=primary, option=option, extend=extend,
+                   trim=trim, max_extend=max_extend)
+    reference = None
+    if getattr(rulings, "surface", None) is not None:
+        from .analysis.surface import RuledReference
+
+        reference = RuledReference(rulings.surface)
+    return Built(mesh.with_info(source=ctx.source), reference, rulings)
