@@ -38,6 +38,7 @@ from typing import Any
 
 import numpy as np
 from scipy.interpolate import CubicSpline, PchipInterpolator
+from scipy.optimize import brentq
 
 from ._validation import (
     check_choice,
@@ -384,7 +385,7 @@ def between(c1: Curve, c2: Curve, count: int, distribution: Distribution | str =
 
 
 def _check_line(value: Any, name: str, err: type = ParameterError) -> np.ndarray:
-    d = check_points(value, name, min_count=2, err=err)
+    d = check_points(value, name, err=err)
     if len(d) != 2:
         raise err(f"expected 2 points of the line, got {len(d)}", name)
     if np.linalg.norm(d[1] - d[0]) <= DEFAULT.degenerate * max(np.abs(d).max(), 1e-300):
@@ -469,14 +470,26 @@ class _PencilAngle:
 
     def level(self, curve: Curve, name: str, tol: Tolerances) -> _Level:
         grid = np.unique(np.concatenate([curve._level_grid(), curve._breaks()]))
+        # the closest approach to d, polished between the neighbours of the
+        # nearest sample (there the pencil angle jumps by pi)
+        i = int(np.argmin(self.radius(curve._eval(grid))))
+        lo, hi = grid[max(i - 1, 0)], grid[min(i + 1, len(grid) - 1)]
+        def approach(x):  # d/dx of radius^2 / 2: smooth, zero at the closest approach
+            x = np.float64(x)
+            px, py = self.xy(curve._eval(x))
+            dx, dy = self.xy(curve._deriv(x, 1) + self.d0)
+            return float(px * dx + py * dy)
+
+        xm = grid[i]
+        if approach(lo) < 0 < approach(hi):
+            xm = brentq(approach, lo, hi, xtol=1e-16, rtol=8.9e-16)
+        rmin = float(self.radius(curve._eval(np.float64(xm))))
+        if rmin <= tol.degenerate * curve._size:
+            raise GeometryError(
+                f"linear-directrix: {name} meets the directrix d at u = {xm:.6g}: "
+                "every plane through d contains that point")
         for _ in range(6):
             pts = curve._eval(grid)
-            r = self.radius(pts)
-            near = np.argmin(r)
-            if r[near] <= tol.degenerate * curve._size:
-                raise GeometryError(
-                    f"linear-directrix: {name} meets the directrix d at u = {grid[near]:.6g}: "
-                    "every plane through d contains that point")
             ref = np.unwrap(self.raw(pts))
             if np.max(np.abs(np.diff(ref))) < 0.5:
                 break
