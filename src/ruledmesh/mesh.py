@@ -343,6 +343,28 @@ class Mesh:
         return replace(self, vertices=self.vertices[keep], face_indices=remap[self.face_indices],
                        members=remap[self.members], vertex_data=vdata)
 
+    def drop_repeated_corners(self) -> "Mesh":
+        """Remove corners equal to the next corner of their face; drop faces left with < 3.
+
+        After :meth:`merge_vertices` a face whose corners collapsed loses them
+        (a quad with two merged corners becomes a triangle, a triangle with two
+        merged corners disappears); members between merged vertices go too.
+        """
+        idx = self.face_indices
+        nxt = np.arange(idx.size) + 1
+        nxt[self.face_offsets[1:] - 1] = self.face_offsets[:-1]
+        keep = idx != idx[nxt]
+        if keep.all() and np.all(self.members[:, 0] != self.members[:, 1]):
+            return self
+        face_of = np.repeat(np.arange(self.n_faces), self.valences)
+        val = np.bincount(face_of[keep], minlength=self.n_faces)
+        ok_face = val >= 3
+        keep &= ok_face[face_of]
+        mem_ok = self.members[:, 0] != self.members[:, 1]
+        return replace(self, face_offsets=_offsets_from_valences(val[ok_face]),
+                       face_indices=idx[keep], face_kind=self.face_kind[ok_face],
+                       members=self.members[mem_ok], member_id=self.member_id[mem_ok])
+
     def __repr__(self) -> str:
         kinds = ", ".join(f"{k}={c}" for k, c in self.count_kinds().items())
         return f"Mesh(vertices={self.n_vertices}, faces={self.n_faces} [{kinds}], members={len(self.members)})"

@@ -381,7 +381,7 @@ def pq_mesh(a, b, rows: int = 20, primary: int | str = "middle", option: int = 0
 
 
 def _assemble(parts, a, d, rows, trim, tol, warnings, bounds, run_of) -> Mesh:
-    """Join the runs; keep convex quads, halves, fill bands; add members."""
+    """Join the runs; keep convex quads and valid halves; fill the gaps; add members."""
     from .analysis.faces import quad_diagonal_crossing
 
     m = len(a)
@@ -391,15 +391,23 @@ def _assemble(parts, a, d, rows, trim, tol, warnings, bounds, run_of) -> Mesh:
     FAR = np.concatenate([r.far for r in parts]) if parts else np.zeros(0, bool)
     offs = np.cumsum([0] + [len(r.vertices) for r in parts])
     shift = lambda f, o: np.where(f >= 0, f + o, -1)  # noqa: E731
-    L = np.concatenate([shift(r.left, o) for r, o in zip(parts, offs)]) if parts else np.zeros((0, 3), np.int64)
-    R = np.concatenate([shift(r.right, o) for r, o in zip(parts, offs)]) if parts else np.zeros((0, 3), np.int64)
+    L = (np.concatenate([shift(r.left, o) for r, o in zip(parts, offs)]) if parts
+         else np.zeros((0, 3), np.int64))
+    R = (np.concatenate([shift(r.right, o) for r, o in zip(parts, offs)]) if parts
+         else np.zeros((0, 3), np.int64))
     POLE = np.concatenate([r.pole for r in parts]) if parts else np.zeros(0, bool)
     CG = np.concatenate([r.centre_gen for r in parts]) if parts else np.zeros(0, np.int64)
     lo_t, hi_t = (0.0, 1.0) if trim else (-np.inf, np.inf)
     good_v = ~FAR & (T >= lo_t) & (T <= hi_t)
-    has_l, has_r = L[:, 0] >= 0, R[:, 0] >= 0
-    ok_l = has_l & ~POLE & good_v[np.maximum(L, 0)].all(axis=1)
-    ok_r = has_r & ~POLE & good_v[np.maximum(R, 0)].all(axis=1)
+    ok_l = (L[:, 0] >= 0) & ~POLE & good_v[np.maximum(L, 0)].all(axis=1)
+    ok_r = (R[:, 0] >= 0) & ~POLE & good_v[np.maximum(R, 0)].all(axis=1)
+    if trim:
+        V, T, G, ok_l, ok_r, fill = _strip_paths(V, T, G, good_v, a, d, m, L, R, ok_l, ok_r, CG)
+    else:
+        # Untrimmed: rows must still increase along each generator inside a face.
+        ok_l &= T[np.maximum(L[:, 2], 0)] > T[np.maximum(L[:, 1], 0)]
+        ok_r &= T[np.maximum(R[:, 2], 0)] > T[np.maximum(R[:, 0], 0)]
+        fill = np.zeros((0, 3), np.int64)
     both = ok_l & ok_r
     quads = np.stack([L[both, 0], L[both, 1], R[both, 1], L[both, 2]], axis=1)
     # Bow-ties: the diagonals must cross inside both; else keep the two halves.
@@ -409,112 +417,152 @@ def _assemble(parts, a, d, rows, trim, tol, warnings, bounds, run_of) -> Mesh:
     whole = np.zeros(len(L), bool)
     whole[np.flatnonzero(both)[convex]] = True
     nsplit = int(np.count_nonzero(~convex))
-    interior = has_l & has_r
+    interior = (L[:, 0] >= 0) & (R[:, 0] >= 0)
     kind_half = np.where(interior, np.where(both, FaceKind.SPLIT, FaceKind.BORDER),
                          FaceKind.FILL).astype(np.uint8)
-    half_l = ok_l & ~whole
-    half_r = ok_r & ~whole
-    faces = [quads[convex]]
-    kinds = [np.full(int(convex.sum()), FaceKind.QUAD, np.uint8)]
-    tri = np.concatenate([L[half_l], R[half_r]])
-    faces.append(tri)
-    kinds.append(np.concatenate([kind_half[half_l], kind_half[half_r]]))
-    if trim:
-        # Strip k lies between g_k and g_k+1; its kept triangles (whole quads count
-        # with both halves) reach between [lo, hi] on each side; fill the bands
-        # from the director curves (t = 0 and t = 1) to them with zipper triangles.
-        strip_l = CG[ok_l] - 1          # left half of a centre on g_i lies in strip i-1
-        strip_r = CG[ok_r]
-        V, T, G, band_faces = _fill_bands(V, T, G, good_v, a, d, rows, m,
-                                          np.concatenate([L[ok_l], R[ok_r]]),
-                                          np.concatenate([strip_l, strip_r]), run_of)
-        faces.append(band_faces)
-        kinds.append(np.full(len(band_faces), FaceKind.FILL, np.uint8))
+    half_l, half_r = ok_l & ~whole, ok_r & ~whole
+    faces = [quads[convex], np.concatenate([L[half_l], R[half_r], fill])]
+    kinds = [np.full(int(convex.sum()), FaceKind.QUAD, np.uint8),
+             np.concatenate([kind_half[half_l], kind_half[half_r],
+                             np.full(len(fill), FaceKind.FILL, np.uint8)])]
     if nsplit:
         warnings.append(f"{nsplit} quads were not convex (the two chains of §4.3 drifted apart) "
                         "and were kept as two triangles split along their generator diagonal; "
                         "sample the generators more finely there")
+    dropped = int(np.count_nonzero((L[:, 0] >= 0) & ~POLE & good_v[np.maximum(L, 0)].all(axis=1) & ~ok_l)
+                  + np.count_nonzero((R[:, 0] >= 0) & ~POLE & good_v[np.maximum(R, 0)].all(axis=1) & ~ok_r))
+    if dropped:
+        warnings.append(f"{dropped} half-faces ran against the order of their strip (rows reversing "
+                        "or overlapping) and were replaced by fill triangles")
     return _to_mesh(V, T, G, faces, kinds, warnings)
 
 
-def _fill_bands(V, T, G, good_v, a, d, rows, m, tris, strip, run_of):
-    """Zipper triangles between the director curves and the kept triangles of each strip."""
-    # Per strip and side (left generator, right generator): t range used by kept triangles.
-    nstrip = m - 1
-    lo = np.full((nstrip, 2), np.inf)
-    hi = np.full((nstrip, 2), -np.inf)
-    if len(tris):
-        gl = G[tris]                                  # generators of the 3 corners
-        side = (gl == (strip + 1)[:, None]).astype(np.int64)
-        tt = T[tris]
-        sidx = np.broadcast_to(strip[:, None], tt.shape)
-        np.minimum.at(lo, (sidx.ravel(), side.ravel()), tt.ravel())
-        np.maximum.at(hi, (sidx.ravel(), side.ravel()), tt.ravel())
-    # Points at t = 0 and t = 1 on every generator: the discrete director curves.
-    base = len(V)
-    V = np.concatenate([V, a, a + d])
-    T = np.concatenate([T, np.zeros(m), np.ones(m)])
-    G = np.concatenate([G, np.arange(m), np.arange(m)])
+def _group_starts(keys: np.ndarray) -> np.ndarray:
+    """(n,) bool: first element of each run of equal sorted keys."""
+    return np.r_[True, keys[1:] != keys[:-1]] if keys.size else np.zeros(0, bool)
+
+
+def _strip_paths(V, T, G, good_v, a, d, m, L, R, ok_l, ok_r, CG):
+    """Make every strip between consecutive generators one conforming zipper.
+
+    In strip s (between g_s and g_s+1) the vertices of each generator inside the
+    patch, plus the director points at t = 0 and t = 1, form two chains sorted
+    by t.  A triangulation of the strip is a monotone lattice path through
+    (rank on g_s, rank on g_s+1); each PQ half-face is one step of it.  Steps
+    that do not fit a monotone path are dropped, and every gap between the kept
+    runs (and from the director curves to them) is filled by zipper steps.
+    """
+    # Director points, unless a grid vertex already sits at t = 0 or t = 1.
+    eps = 1e-12
     inside = np.flatnonzero(good_v)
-    order = inside[np.lexsort((T[inside], G[inside]))]
-    gen_sorted = G[order]
-    starts = np.searchsorted(gen_sorted, np.arange(m + 1))
-    out = []
-    for k in range(nstrip):
-        chains = []
-        for sd, g in ((0, k), (1, k + 1)):
-            ids = order[starts[g]:starts[g + 1]]
-            chains.append(ids)
-        ca, cb = chains
-        ta, tb = T[ca], T[cb]
-        if np.isfinite(lo[k]).all():
-            # Lower band: from the director curve c1 up to the lowest kept vertices.
-            for pa, pb in (((base + k, ca[ta <= lo[k, 0]]), (base + k + 1, cb[tb <= lo[k, 1]])),
-                           ((base + m + k, ca[ta >= hi[k, 0]][::-1]),
-                            (base + m + k + 1, cb[tb >= hi[k, 1]][::-1]))):
-                out.append(_band(V, T, pa, pb, upper=pa[0] >= base + m))
-        else:
-            ids_a = _with_ends(T, ca, base + k, base + m + k)
-            ids_b = _with_ends(T, cb, base + k + 1, base + m + k + 1)
-            tri = _strip_triangles(T[ids_a], T[ids_b])
-            out.append(np.concatenate([ids_a, ids_b])[tri])
-    faces = np.concatenate(out) if out else np.zeros((0, 3), np.int64)
-    # A zipper step between two points of equal t on one generator gives a sliver of
-    # zero area: drop it (its two edges coincide, so the mesh stays conforming).
-    pts = V[faces]
-    e1, e2 = pts[:, 1] - pts[:, 0], pts[:, 2] - pts[:, 0]
-    area2 = np.einsum("ij,ij->i", *(np.cross(e1, e2),) * 2)
-    longest = np.max(np.stack([np.einsum("ij,ij->i", e, e) for e in (e1, e2, pts[:, 2] - pts[:, 1])]), axis=0)
-    faces = faces[area2 > 1e-18 * longest ** 2]
-    return V, T, G, faces
+    has0 = np.zeros(m, bool)
+    has1 = np.zeros(m, bool)
+    has0[G[inside][T[inside] <= eps]] = True
+    has1[G[inside][T[inside] >= 1 - eps]] = True
+    new0, new1 = np.flatnonzero(~has0), np.flatnonzero(~has1)
+    base = len(V)
+    V = np.concatenate([V, a[new0], a[new1] + d[new1]])
+    T = np.concatenate([T, np.zeros(len(new0)), np.ones(len(new1))])
+    G = np.concatenate([G, new0, new1])
+    members = np.concatenate([inside, base + np.arange(len(new0) + len(new1))])
+    chain = members[np.lexsort((T[members], G[members]))]
+    gstart = np.searchsorted(G[chain], np.arange(m + 1))
+    rank = np.full(len(V), -1, np.int64)
+    rank[chain] = np.arange(len(chain)) - gstart[G[chain]]
+    clen = np.diff(gstart)                       # chain length per generator (>= 2)
+    # Steps: right halves [A_k, B_l, A_k+1] in strip CG; left halves [A_k, B_l, B_l+1] in CG-1.
+    rk = rank[np.maximum(R, 0)]
+    lk = rank[np.maximum(L, 0)]
+    ok_r = ok_r & (rk[:, 2] == rk[:, 0] + 1)
+    ok_l = ok_l & (lk[:, 2] == lk[:, 1] + 1)
+    ir, il = np.flatnonzero(ok_r), np.flatnonzero(ok_l)
+    st_strip = np.concatenate([CG[ir], CG[il] - 1])
+    st_k = np.concatenate([rk[ir, 0], lk[il, 0]])
+    st_l = np.concatenate([rk[ir, 1], lk[il, 1]])
+    st_a = np.concatenate([np.ones(len(ir), bool), np.zeros(len(il), bool)])
+    st_id = np.concatenate([ir, il])
+    # Order steps along each strip's path; keep a step only if it starts at or
+    # beyond where every earlier step of its strip ended (monotone path).
+    order = np.lexsort((st_k + st_l, st_strip))
+    st_strip, st_k, st_l, st_a, st_id = (x[order] for x in (st_strip, st_k, st_l, st_a, st_id))
+    end_k = st_k + st_a
+    end_l = st_l + ~st_a
+    big = 1 << 40
+    prev_k = np.maximum.accumulate(st_strip * big + end_k) - st_strip * big
+    prev_l = np.maximum.accumulate(st_strip * big + end_l) - st_strip * big
+    first = _group_starts(st_strip)
+    pk = np.where(first, -1, np.r_[-1, prev_k[:-1]])
+    pl = np.where(first, -1, np.r_[-1, prev_l[:-1]])
+    keep = (st_k >= pk) & (st_l >= pl)
+    # A kept step cancels an overlapping predecessor only if both were kept; the
+    # accumulate above already counted dropped steps, which is conservative.
+    st_strip, st_k, st_l, st_a, st_id = (x[keep] for x in (st_strip, st_k, st_l, st_a, st_id))
+    keep_r = np.zeros(len(R), bool)
+    keep_l = np.zeros(len(L), bool)
+    keep_r[st_id[st_a]] = True
+    keep_l[st_id[~st_a]] = True
+    # Gaps: from (0, 0) to the first step, between steps, from the last to the ends.
+    nstrip = m - 1
+    s_all = np.arange(nstrip)
+    end_k, end_l = st_k + st_a, st_l + ~st_a
+    g_strip = np.concatenate([st_strip, s_all])
+    g_k0 = np.concatenate([end_k, np.zeros(nstrip, np.int64)])
+    g_l0 = np.concatenate([end_l, np.zeros(nstrip, np.int64)])
+    # The next step's start, or the chain ends for the last gap of each strip.
+    order = np.lexsort((g_k0 + g_l0, g_strip))
+    g_strip, g_k0, g_l0 = g_strip[order], g_k0[order], g_l0[order]
+    nxt_strip = np.r_[g_strip[1:], -1]
+    last = nxt_strip != g_strip
+    # Start of the step that follows each gap: steps sorted by (strip, path index).
+    step_key = st_strip * big + st_k + st_l
+    gap_key = g_strip * big + g_k0 + g_l0
+    j = np.searchsorted(step_key, gap_key, side="left")
+    j = np.minimum(j, max(len(step_key) - 1, 0))
+    has_next = (~last) & (len(step_key) > 0)
+    g_k1 = np.where(has_next, st_k[j] if len(st_k) else 0, clen[g_strip] - 1)
+    g_l1 = np.where(has_next, st_l[j] if len(st_l) else 0, clen[g_strip + 1] - 1)
+    na = np.maximum(g_k1 - g_k0, 0)
+    nb = np.maximum(g_l1 - g_l0, 0)
+    fill = _zippers(T, chain, gstart, g_strip, g_k0, g_l0, na, nb)
+    return V, T, G, keep_l, keep_r, fill
 
 
-def _with_ends(T, chain, start, end, eps: float = 1e-12):
-    """A generator's chain with its director points, unless a vertex already sits there."""
-    parts = []
-    if not (len(chain) and T[chain[0]] <= eps):
-        parts.append([start])
-    parts.append(chain)
-    if not (len(chain) and T[chain[-1]] >= 1 - eps):
-        parts.append([end])
-    return np.concatenate(parts).astype(np.int64)
+def _zippers(T, chain, gstart, strip, k0, l0, na, nb) -> np.ndarray:
+    """Zipper triangles of many gaps at once.
 
-
-def _band(V, T, pa, pb, upper: bool) -> np.ndarray:
-    """Zipper triangles of one band: chains from a director point to the kept triangles."""
-    (da, ca), (db, cb) = pa, pb
-    edge = 1.0 if upper else 0.0
-    near = lambda c: len(c) and abs(T[c[0]] - edge) <= 1e-12  # noqa: E731
-    ids_a = ca if near(ca) else np.concatenate([[da], ca]).astype(np.int64)
-    ids_b = cb if near(cb) else np.concatenate([[db], cb]).astype(np.int64)
-    if len(ids_a) + len(ids_b) < 3:
+    Gap g runs from (k0, l0) to (k0 + na, l0 + nb) in strip ``strip[g]``;
+    chain A is generator ``strip``, chain B is ``strip + 1``.
+    """
+    ng = len(strip)
+    if ng == 0 or (na.sum() + nb.sum()) == 0:
         return np.zeros((0, 3), np.int64)
-    ta, tb = T[ids_a], T[ids_b]
-    if upper:                      # walk from t = 1 downwards, then flip orientation
-        tri = _strip_triangles(-ta, -tb)[:, ::-1]
-    else:
-        tri = _strip_triangles(ta, tb)
-    return np.concatenate([ids_a, ids_b])[tri]
+    gid_a = np.repeat(np.arange(ng), na)
+    gid_b = np.repeat(np.arange(ng), nb)
+    ka = np.arange(gid_a.size) - np.repeat(np.cumsum(na) - na, na)   # 0..na-1 within the gap
+    lb = np.arange(gid_b.size) - np.repeat(np.cumsum(nb) - nb, nb)
+    A = lambda g, k: chain[gstart[strip[g]] + k]          # noqa: E731
+    B = lambda g, l: chain[gstart[strip[g] + 1] + l]      # noqa: E731
+    key_a = T[A(gid_a, k0[gid_a] + ka + 1)]
+    key_b = T[B(gid_b, l0[gid_b] + lb + 1)]
+    gid = np.concatenate([gid_a, gid_b])
+    is_a = np.concatenate([np.ones(gid_a.size, bool), np.zeros(gid_b.size, bool)])
+    key = np.concatenate([key_a, key_b])
+    order = np.lexsort((key, gid))
+    gid, is_a = gid[order], is_a[order]
+    # Position before each step: gap start plus the steps of each kind already taken.
+    first = _group_starts(gid)
+    ca = np.cumsum(is_a) - is_a
+    cb = np.cumsum(~is_a) - ~is_a
+    start_idx = np.flatnonzero(first)
+    run = np.cumsum(first) - 1
+    ca = ca - ca[start_idx][run]
+    cb = cb - cb[start_idx][run]
+    k = k0[gid] + ca
+    l = l0[gid] + cb
+    a_k, b_l = A(gid, k), B(gid, l)
+    # Evaluate each branch only where it applies (the other index may be past the chain end).
+    third = np.where(is_a, A(gid, np.where(is_a, k + 1, k)), B(gid, np.where(is_a, l, l + 1)))
+    return np.stack([a_k, b_l, third], axis=1)
 
 
 def _to_mesh(V, T, G, faces, kinds, warnings) -> Mesh:
@@ -539,7 +587,9 @@ def _to_mesh(V, T, G, faces, kinds, warnings) -> Mesh:
     member_id = G[order[:-1][same]]
     mesh = Mesh(V, off, idx, kind, members.astype(np.int64), member_id.astype(np.int64),
                 {"t": T, "generator": G}, {"construction": "pq (paper §4.3)", "warnings": warnings})
-    return mesh.compact()
+    # Generators that share an end point (a torsal pair meeting on a director
+    # curve) give coincident vertices: merge them so no face has zero area.
+    return mesh.compact().merge_vertices(1e-13).drop_repeated_corners()
 
 
 # ---------------------------------------------------------------- design files
