@@ -320,3 +320,13 @@ def test_spec_errors_name_the_field(spec, message):
     with pytest.raises(DesignError) as err:
         rulings_from_spec(spec, CURVES)
     assert str(err.value).startswith(message), str(err.value)
+
+
+@pytest.mark.parametrize("dist, kw", [
+    ("director-plane", {"director_plane": [1, 0, 0]}),
+    ("linear-directrix", {"directrix": [[5, -3, 8], [5, 6, 8]]}),
+    ("arc-length", {}),
+])
+def test_reference_surface_does_not_depend_on_the_generator_count(dist, kw):
+    areas = [between(C1, C2, count, dist, **kw).surface.area() for count in (3, 17, 60)]
+    assert np.ptp(areas) <= 1e-10 * areas[0]

@@ -37,7 +37,7 @@ from enum import Enum
 from typing import Any
 
 import numpy as np
-from scipy.interpolate import CubicSpline, PchipInterpolator
+from scipy.interpolate import CubicHermiteSpline, CubicSpline, PchipInterpolator
 from scipy.optimize import brentq
 
 from ._validation import (
@@ -106,10 +106,16 @@ class _ArcLength:
 class _Pchip:
     """sigma(u): monotone C1 interpolant of dense samples of a correspondence."""
 
-    interp: PchipInterpolator
+    interp: Any
 
     @classmethod
-    def of(cls, u: np.ndarray, sigma: np.ndarray) -> "_Pchip":
+    def of(cls, u: np.ndarray, sigma: np.ndarray, dsigma: np.ndarray | None = None) -> "_Pchip":
+        """PCHIP of the samples, or, given exact slopes ``dsigma`` (implicit
+        differentiation of the correspondence), the cubic Hermite interpolant:
+        fourth order, so the surface hardly depends on the sampling."""
+        if dsigma is not None and np.all(np.isfinite(dsigma)) and (
+                np.all(dsigma >= 0) or np.all(dsigma <= 0)):
+            return cls(CubicHermiteSpline(u, sigma, dsigma))
         return cls(PchipInterpolator(u, sigma))
 
     def value(self, u):
@@ -435,7 +441,10 @@ def _director_plane(c1: Curve, c2: Curve, count: int, normal: np.ndarray, info: 
                          ": the planes n . x = s meet it more than once (or not at all) over "
                          f"s in [{lo:g}, {hi:g}]; choose another director plane")
         sig.append(u)
-    s1, s2 = _Pchip.of(grid, sig[0]), _Pchip.of(grid, sig[1])
+    ds = (s[-1] - s[0])
+    with np.errstate(divide="ignore", invalid="ignore"):  # n . c' = 0 at a range end: PCHIP
+        slopes = [ds / (c._deriv(u, 1) @ n) for c, u in zip((c1, c2), sig)]
+    s1, s2 = _Pchip.of(grid, sig[0], slopes[0]), _Pchip.of(grid, sig[1], slopes[1])
     info = {**info, "levels": s[::k].copy(), "director_plane": n}
     return _curve_rulings(c1, s1, c2, s2, count, info, tol, sig[0][::k].copy(), sig[1][::k].copy())
 
@@ -554,8 +563,13 @@ def _linear_directrix(c1: Curve, c2: Curve, count: int, d: np.ndarray, info: dic
         raise _ended("linear-directrix", "c2", end, k, count,
                      ": the planes through d and the points of c1 stop meeting c2 along one "
                      "branch; move d or shorten c1")
+    # d sigma2 / du = theta1'(u) / g2'(sigma2), theta1' through the arc length of c1
+    x1, y1 = pencil.xy(pts1)
+    dx1, dy1 = pencil.xy(c1._deriv(sig1, 1) * arc1.deriv(grid)[:, None] + pencil.d0)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        slope2 = (x1 * dy1 - y1 * dx1) / (x1 * x1 + y1 * y1) / lev2.dg(sig2)
     info = {**info, "directrix": d}
-    return _curve_rulings(c1, arc1, c2, _Pchip.of(grid, sig2), count, info, tol,
+    return _curve_rulings(c1, arc1, c2, _Pchip.of(grid, sig2, slope2), count, info, tol,
                           sig1[::k].copy(), sig2[::k].copy())
 
 
@@ -691,7 +705,16 @@ def three_directrices(c1: Curve, c2: Curve, c3: Curve, count: int, *,
                                       "the surface's director curves)", g, sig1, grid, k, count)
         cur[:2] = np.clip(cur[:2], 0.0, 1.0)
         sol[i] = cur
-    s2, s3 = _Pchip.of(grid, sol[:, 0]), _Pchip.of(grid, sol[:, 1])
+    # implicit differentiation of c3(w) - p - lam (c2(v) - p) = 0 in p = c1(sigma1(u)):
+    # J dx/du = (1 - lam) dp/du
+    v, w, lam = sol.T
+    jac = np.stack([-lam[:, None] * c2._deriv(v, 1), c3._deriv(w, 1), pts1 - c2._eval(v)], axis=-1)
+    dp = c1._deriv(sig1, 1) * arc1.deriv(grid)[:, None]
+    try:
+        dx = np.linalg.solve(jac, ((1 - lam)[:, None] * dp)[..., None])[..., 0]
+    except np.linalg.LinAlgError:
+        dx = np.full((len(grid), 3), np.nan)
+    s2 = _Pchip.of(grid, sol[:, 0], dx[:, 0])
     info = {"distribution": "three-directrices", "warnings": [],
             "c3_params": sol[::k, 1].copy(), "c3_t": sol[::k, 2].copy()}
     return _curve_rulings(c1, arc1, c2, s2, count, info, tol, sig1[::k].copy(),
