@@ -119,7 +119,8 @@ def dumpb(mesh: Mesh, shading: str = "flat", quads: str = "shorter") -> bytes:
     if mesh.n_faces == 0:
         raise ExportError("the mesh has no faces; a glTF file needs at least one triangle")
     centre = mesh.bounding_box().mean(axis=0)
-    normals, areas = face_normals(mesh)
+    # Newell sums lose digits far from the origin: take normals of the centred mesh.
+    normals, areas = face_normals(mesh.with_vertices(mesh.vertices - centre))
     corner_face = np.repeat(np.arange(mesh.n_faces), mesh.valences)
     if shading == "flat":
         corner_normal = normals[corner_face]

@@ -39,7 +39,9 @@ def dumpb(mesh: Mesh, quads: str = "shorter") -> bytes:
         80-byte header, uint32 triangle count, 50-byte records.
     """
     tri = triangulate(mesh, quads)
-    normals, _ = face_normals(mesh)
+    # Newell sums of absolute positions lose digits far from the origin
+    # (site coordinates); the normals of the centred mesh are the same vectors.
+    normals, _ = face_normals(mesh.with_vertices(mesh.vertices - mesh.bounding_box().mean(axis=0)))
     rec = np.zeros(tri.n_triangles, dtype=RECORD)
     rec["normal"] = normals[tri.face_of]
     rec["corners"] = mesh.vertices[tri.triangles]
