@@ -4,7 +4,7 @@ import math
 
 import numpy as np
 import pytest
-from hypothesis import HealthCheck, given, settings
+from hypothesis import HealthCheck, assume, given, settings
 from hypothesis import strategies as st
 from scipy.integrate import quad
 
@@ -239,6 +239,8 @@ def test_plane_roots_satisfy_the_plane_equation(c, frac, normal):
 @given(splines(), st.floats(0.02, 0.98))
 def test_spline_derivative_matches_finite_differences(c, u):
     h = 1e-6
+    if c.degree == 1:  # the derivative jumps at the knots (a polyline)
+        assume(np.all(np.abs(c._breaks() - u) > 2 * h))
     fd = (c.evaluate(u + h) - c.evaluate(u - h)) / (2 * h)
     d = c.derivative(u)
     assert np.allclose(d, fd, atol=1e-6 * max(np.abs(d).max(), 1.0))

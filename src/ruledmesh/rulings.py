@@ -17,14 +17,19 @@ Constructors, one per way the paper gives a ruled surface:
 * :func:`rulings_from_spec`: the ``[rulings]`` table of a design file.
 
 The smooth reference surface.  For curve-based rulings ``A(u) = c1(sigma1(u))``
-lies exactly on c1: ``sigma`` is the identity (parameter distribution), the
-exact arc-length inverse (arc length), or a PCHIP interpolant (monotone, C1)
-of a dense sampling of the correspondence, at least 1025 samples that include
-the generators (director plane, linear directrix, three directrices).  For
-explicit lines, ``A`` and ``B`` are C2 cubic splines (``scipy`` ``CubicSpline``,
-not-a-knot) through the endpoints, with ``u`` the cumulative mean chord length
-of the endpoints, ``(|a_{i+1} - a_i| + |b_{i+1} - b_i|) / 2``, normalised:
-uneven spacing of the given lines is then followed rather than smoothed over.
+lies exactly on c1 (likewise B on c2); only the correspondence ``sigma`` is
+interpolated.  ``sigma`` is the identity (parameter distribution), the
+closed-form arc-length inverse (lines, polylines, arcs, helices), or a cubic
+Hermite interpolant of a dense sampling (at least 1025 samples, including the
+generators) with *exact* slopes from implicit differentiation of the
+correspondence (B-spline arc length, director plane, linear directrix, three
+directrices): fourth order, so the surface does not depend on ``count`` to
+~1e-12.  PCHIP replaces it where a slope is infinite (a range end at a
+tangency).  For explicit lines, ``A`` and ``B`` are C2 cubic splines
+(``scipy`` ``CubicSpline``, not-a-knot) through the endpoints, with ``u`` the
+cumulative mean chord length of the endpoints,
+``(|a_{i+1} - a_i| + |b_{i+1} - b_i|) / 2``, normalised: uneven spacing of the
+given lines is then followed rather than smoothed over.
 """
 
 from __future__ import annotations
@@ -48,7 +53,7 @@ from ._validation import (
     check_vector,
     describe,
 )
-from .curves import Curve, _Level, _LiesInLevel, _perpendicular
+from .curves import BSpline, Curve, _Level, _LiesInLevel, _perpendicular
 from .errors import DesignError, GeometryError, ParameterError
 from .tolerances import DEFAULT, Tolerances
 
@@ -100,6 +105,21 @@ class _ArcLength:
 
     def deriv(self, u):
         return self.curve.length() / self.curve._speed(self.value(u))
+
+
+def _arc_sigma(curve: Curve, count: int) -> Any:
+    """sigma(u) = the curve parameter at arc-length fraction u.
+
+    Exact where the inverse is closed-form (lines, polylines, arcs, helices);
+    for B-splines a cubic Hermite interpolant of exact samples and slopes on
+    the dense grid (which holds the generators), so that evaluating the
+    reference surface needs no Newton solve.
+    """
+    exact = _ArcLength(curve)
+    if not isinstance(curve, BSpline):
+        return exact
+    grid, _ = _dense_grid(count)
+    return _Pchip.of(grid, exact.value(grid), exact.deriv(grid))
 
 
 @dataclass(frozen=True, eq=False)
@@ -378,7 +398,7 @@ def between(c1: Curve, c2: Curve, count: int, distribution: Distribution | str =
     if dist is Distribution.PARAMETER:
         return _curve_rulings(c1, _Identity(), c2, _Identity(), count, info, tol)
     if dist is Distribution.ARC_LENGTH:
-        return _curve_rulings(c1, _ArcLength(c1), c2, _ArcLength(c2), count, info, tol)
+        return _curve_rulings(c1, _arc_sigma(c1, count), c2, _arc_sigma(c2, count), count, info, tol)
     if dist is Distribution.DIRECTOR_PLANE:
         if director_plane is None:
             raise ParameterError('required with distribution "director-plane"', "director_plane")
@@ -525,7 +545,7 @@ def _linear_directrix(c1: Curve, c2: Curve, count: int, d: np.ndarray, info: dic
                       tol: Tolerances) -> Rulings:
     pencil = _PencilAngle(d)
     grid, k = _dense_grid(count)
-    arc1 = _ArcLength(c1)
+    arc1 = _arc_sigma(c1, count)
     sig1 = arc1.value(grid)
     pts1 = c1._eval(sig1)
     r1 = pencil.radius(pts1)
@@ -662,7 +682,7 @@ def three_directrices(c1: Curve, c2: Curve, c3: Curve, count: int, *,
     count = check_int(count, "count", lo=2)
     size = max(c1._size, c2._size, c3._size)
     grid, k = _dense_grid(count)
-    arc1 = _ArcLength(c1)
+    arc1 = _arc_sigma(c1, count)
     sig1 = arc1.value(grid)
     pts1 = c1._eval(sig1)
     candidates = _first_transversal(c2, c3, pts1[0], size)
@@ -766,7 +786,7 @@ def conoid(curve: Curve, directrix: Any, director_plane: Any, count: int, *,
         raise GeometryError(
             "conoid: the directrix d is parallel to the director plane: the planes parallel to "
             "the director plane never meet it (or contain it)")
-    arc = _ArcLength(curve)
+    arc = _arc_sigma(curve, count)
     u = np.linspace(0.0, 1.0, count)
     sig = arc.value(u)
     rail_a = _CurveTrack(curve, arc)
