@@ -53,7 +53,7 @@ from ._validation import (
     check_vector,
     describe,
 )
-from .curves import BSpline, Curve, _Level, _LiesInLevel, _perpendicular
+from .curves import BSpline, Curve, _Level, _perpendicular
 from .errors import DesignError, GeometryError, ParameterError
 from .tolerances import DEFAULT, Tolerances
 
