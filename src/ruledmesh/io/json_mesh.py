@@ -31,12 +31,40 @@ import numpy as np
 from ..errors import ParameterError
 from ..mesh import FaceKind, Mesh
 
-__all__ = ["FORMAT", "DESIGN_FORMAT", "VERSION", "to_dict", "dumpb", "loadb", "from_dict",
+__all__ = ["FORMAT", "DESIGN_FORMAT", "VERSION", "SCHEMA", "to_dict", "dumpb", "loadb", "from_dict",
            "dump_design"]
 
 FORMAT = "ruledmesh.mesh"
 DESIGN_FORMAT = "ruledmesh.design"
 VERSION = 1
+
+_INDEX = {"type": "integer", "minimum": 0}
+SCHEMA = {
+    "$schema": "https://json-schema.org/draft/2020-12/schema",
+    "title": "ruledmesh mesh",
+    "type": "object",
+    "required": ["format", "version", "vertices", "faces", "kinds", "members", "member_ids"],
+    "properties": {
+        "format": {"const": FORMAT},
+        "version": {"const": VERSION},
+        "vertices": {"type": "array",
+                     "items": {"type": "array", "items": {"type": "number"},
+                               "minItems": 3, "maxItems": 3}},
+        "faces": {"type": "array", "items": {"type": "array", "items": _INDEX, "minItems": 3}},
+        "kinds": {"type": "array",
+                  "items": {"enum": [k.label for k in FaceKind]}},
+        "members": {"type": "array",
+                    "items": {"type": "array", "items": _INDEX, "minItems": 2, "maxItems": 2}},
+        "member_ids": {"type": "array", "items": {"type": "integer"}},
+        "vertex_data": {"type": "object", "additionalProperties": {"type": "array"}},
+        "info": {"type": "object"},
+        "design": {"type": "object"},
+    },
+    "additionalProperties": False,
+}
+"""JSON Schema (draft 2020-12) of the mesh document; counts that must agree
+(one kind per face, one id per member, indices below the vertex count) are
+checked by :func:`from_dict`."""
 
 
 def _jsonable(value: Any) -> Any:
