@@ -129,21 +129,24 @@ def crossing_maps(a0, d0, a1, d1, a2, d2) -> np.ndarray:
 
 
 def coplanarity(a: np.ndarray, d: np.ndarray, scale: float) -> np.ndarray:
-    """How far consecutive generators are from meeting (0: coplanar, a torsal pair).
+    """Signed twist between consecutive generators (0: coplanar, a torsal pair).
+
+    The sign is the sense in which the generators twist; it changes across a
+    torsal generator of the surface, where hops across reverse the rows.
 
     Parameters
     ----------
     a, d : (m, 3) float64
         Generator points and directions.
     scale : float
-        The patch size; the measure is ``|det(d_k, d_k+1, a_k+1 - a_k)|``
+        The patch size; the measure is ``det(d_k, d_k+1, a_k+1 - a_k)``
         divided by ``|d_k| |d_k+1| scale``, a scale-free volume.
 
     Returns
     -------
     (m - 1,) float64
     """
-    vol = np.abs(_dot(np.cross(d[:-1], d[1:]), a[1:] - a[:-1]))
+    vol = _dot(np.cross(d[:-1], d[1:]), a[1:] - a[:-1])
     norms = np.linalg.norm(d, axis=1)
     return vol / np.maximum(norms[:-1] * norms[1:] * scale, 1e-300)
 

@@ -337,7 +337,8 @@ def pq_mesh(a, b, rows: int = 20, primary: int | str = "middle", option: int = 0
     rows = check_int(rows, "rows", lo=1)
     option = check_int(option, "option", lo=0, hi=1)
     trim = check_bool(trim, "trim")
-    if isinstance(primary, str):
+    middle = isinstance(primary, str)
+    if middle:
         if primary != "middle":
             raise ParameterError(f'expected "middle" or an index, got {describe(primary)}', "primary")
         p = m // 2
@@ -359,20 +360,33 @@ def pq_mesh(a, b, rows: int = 20, primary: int | str = "middle", option: int = 0
         raise GeometryError(f"generator {int(short[0])} has zero length (its end points coincide)"
                             + (f", and {short.size - 1} more" if short.size > 1 else ""))
     warnings: list[str] = []
-    # Torsal pairs: consecutive generators (nearly) coplanar cut the generators into runs.
-    cop = coplanarity(a, d, scale)
-    cut = np.flatnonzero(cop <= tol.degenerate)
+    # Torsal generators cut the generators into runs: a pair of consecutive
+    # generators that (nearly) meet, or a change of sign of the twist between
+    # pairs (a torsal generator lies between them; hops across it would reverse
+    # the rows).  The strips at the cuts are filled with triangles (§4.3).
+    twist = coplanarity(a, d, scale)
+    flat = np.abs(twist) <= tol.degenerate
+    sign = np.sign(np.where(flat, 0.0, twist))
+    # Carry the last non-zero sign forward so a flat pair does not hide a change.
+    idx = np.where(sign != 0, np.arange(len(sign)), 0)
+    np.maximum.accumulate(idx, out=idx)
+    carried = sign[idx]
+    change = np.zeros(len(sign), bool)
+    change[1:] = (carried[1:] != carried[:-1]) & (carried[:-1] != 0) & (sign[1:] != 0)
+    cut = np.flatnonzero(flat | change)
     bounds = np.concatenate([[0], cut + 1, [m]])
     if cut.size:
-        warnings.append(f"{cut.size} torsal pairs of generators (at {', '.join(map(str, cut[:8].tolist()))}"
-                        f"{' ...' if cut.size > 8 else ''}): strips filled with triangles")
+        listed = ", ".join(f"{k}-{k + 1}" for k in cut[:8].tolist()) + (" ..." if cut.size > 8 else "")
+        warnings.append(f"{cut.size} torsal strips (generators {listed}: coplanar, or the twist "
+                        "changes sign there): filled with triangles")
     parts = []          # (vertices, t, gen, faces_list, kinds)
     offset = 0
     run_of = np.full(m, -1)
     for r0, r1 in zip(bounds[:-1], bounds[1:]):
         if r1 - r0 < 3:
             continue
-        pr = p - r0 if r0 <= p < r1 else (r1 - r0) // 2
+        # "middle" means the middle of each run: chains drift with the number of hops.
+        pr = p - r0 if (not middle and r0 <= p < r1) else (r1 - r0) // 2
         run = _mesh_run(a[r0:r1], d[r0:r1], r0, pr, rows, option, extend, max_extend, tol,
                         scale, warnings)
         run_of[r0:r1] = len(parts)
