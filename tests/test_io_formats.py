@@ -103,28 +103,26 @@ def test_obj_read_by_meshio(tmp_path, name):
     np.testing.assert_array_equal(np.array(lines) - 1, mesh.members)
 
 
-# Known incompatibilities of io/ply.py with meshio 5.3 (reported to the owner of
-# ply.py; strict xfail so the tests flag the fix): meshio's binary PLY reader
-# assumes a face record is only the index list (ply.py appends a ``kind`` byte),
-# and rejects any element besides vertex and face (ply.py writes ``edge``).
-@pytest.mark.xfail(strict=True, raises=ValueError,
-                   reason="meshio cannot parse the extra 'kind' face property")
-def test_ply_read_by_meshio_without_members(tmp_path):
+# PLY keeps to the vertex and face elements every reader knows; face kinds and
+# members travel in comment lines, so meshio reads faces and vertices exactly.
+def test_ply_read_by_meshio(tmp_path):
     meshio = pytest.importorskip("meshio")
-    src = MESHES["mixed"]
-    mesh = type(src).from_arrays(src.vertices, src.face_offsets, src.face_indices, src.face_kind)
+    mesh = MESHES["mixed"]
     save(tmp_path / "m.ply", mesh)
     got = meshio.read(tmp_path / "m.ply")
     np.testing.assert_array_equal(got.points, mesh.vertices)
     assert sum(len(c.data) for c in got.cells) == mesh.n_faces
+    faces = sorted(tuple(f) for c in got.cells for f in c.data.tolist())
+    assert faces == sorted(tuple(f) for f in mesh.face_list())
 
 
-@pytest.mark.xfail(strict=True, reason="meshio rejects the 'edge' element holding the members")
-def test_ply_with_members_read_by_meshio(tmp_path):
-    meshio = pytest.importorskip("meshio")
-    save(tmp_path / "m.ply", MESHES["mixed"])
-    got = meshio.read(tmp_path / "m.ply")
-    assert sum(len(c.data) for c in got.cells if c.type != "line") == MESHES["mixed"].n_faces
+def test_ply_keeps_kinds_and_members_for_ruledmesh(tmp_path):
+    mesh = MESHES["mixed"]
+    save(tmp_path / "m.ply", mesh)
+    back = load(tmp_path / "m.ply")
+    np.testing.assert_array_equal(back.face_kind, mesh.face_kind)
+    np.testing.assert_array_equal(back.members, mesh.members)
+    np.testing.assert_array_equal(back.member_id, mesh.member_id)
 
 
 # ---------------------------------------------------------------- DXF

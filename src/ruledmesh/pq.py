@@ -83,6 +83,9 @@ def row_maps(a: np.ndarray, d: np.ndarray, primary: int) -> np.ndarray:
         each matrix scaled to unit max-norm.
     """
     m = len(a)
+    if primary + 2 >= m and primary - 2 < 0:
+        # Three generators with the primary in the middle: no hop starts there.
+        primary = 0
     M = np.zeros((m, 2, 2))
     M[primary] = np.eye(2)
     # Landing maps g_k -> g_{k+2} (forward) and g_k -> g_{k-2} (backward), all at once.

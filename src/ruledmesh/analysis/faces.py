@@ -165,7 +165,10 @@ def face_normals(mesh: Mesh) -> tuple[np.ndarray, np.ndarray]:
     idx = mesh.face_indices
     nxt = np.arange(idx.size) + 1
     nxt[mesh.face_offsets[1:] - 1] = mesh.face_offsets[:-1]
-    cr = np.cross(v[idx], v[idx[nxt]])
+    # Relative to each face's first corner: cross products of site coordinates
+    # (1e6 and more) would cancel catastrophically.
+    origin = v[idx[np.repeat(mesh.face_offsets[:-1], mesh.valences)]]
+    cr = np.cross(v[idx] - origin, v[idx[nxt]] - origin)
     vec = 0.5 * np.add.reduceat(cr, mesh.face_offsets[:-1], axis=0) if idx.size else np.zeros((0, 3))
     area = np.linalg.norm(vec, axis=1)
     normals = vec / np.maximum(area, _TINY)[:, None]

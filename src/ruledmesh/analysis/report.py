@@ -13,6 +13,7 @@ Figures (relative ones are divided by the bounding-box diagonal):
 
 from __future__ import annotations
 
+import inspect
 from typing import Any, Mapping
 
 import numpy as np
@@ -109,7 +110,9 @@ def analyze(mesh: Mesh, reference=None, extras: Mapping[str, Any] | None = None,
             }
     _load_hooks()
     for name, hook in METRIC_HOOKS.items():
-        value = hook(mesh)
+        # Hooks that compare with the smooth surface take it as ``reference``.
+        takes_ref = "reference" in inspect.signature(hook).parameters
+        value = hook(mesh, reference=reference) if takes_ref else hook(mesh)
         if value is not None:
             report[name] = value
     if extras:

@@ -1,14 +1,16 @@
 """Stanford PLY (binary little-endian): polygons kept, kinds and generators too.
 
-Layout::
+Layout, kept to the two elements every PLY reader knows (meshio, Blender,
+MeshLab, Open3D)::
 
-    element vertex V      float64 x, y, z
-    element face F        list uchar int vertex_indices, uchar kind
-    element edge E        int vertex1, int vertex2, int generator
+    element vertex V      double x, y, z
+    element face F        list uchar int vertex_indices
 
-``kind`` is the :class:`~ruledmesh.mesh.FaceKind` value; ``edge`` elements
-(the convention of several PLY tools) carry the members.  Readers that do not
-know ``kind`` or ``edge`` skip them.
+The face kinds and the members (generator segments) travel in ``comment``
+lines that other readers skip: ``comment ruledmesh kinds K N K N ...`` gives
+run lengths of :class:`~ruledmesh.mesh.FaceKind` values in face order, and
+``comment ruledmesh members i j g i j g ...`` (several lines) the members'
+vertex pairs and generator ids.
 """
 
 from __future__ import annotations
@@ -16,9 +18,15 @@ from __future__ import annotations
 import numpy as np
 
 from ..errors import ParameterError
-from ..mesh import Mesh
+from ..mesh import FaceKind, Mesh
 
 __all__ = ["dumpb", "loadb"]
+
+
+def _comment_lines(tag: str, values: np.ndarray, per_line: int) -> list[str]:
+    values = values.astype(np.int64)
+    return [f"comment ruledmesh {tag} " + " ".join(map(str, values[i:i + per_line].tolist()))
+            for i in range(0, len(values), per_line)]
 
 
 def dumpb(mesh: Mesh) -> bytes:
@@ -35,42 +43,31 @@ def dumpb(mesh: Mesh) -> bytes:
     val = mesh.valences
     if val.size and val.max() > 255:
         raise ParameterError("PLY faces are limited to 255 vertices", "mesh")
-    header = [
-        "ply",
-        "format binary_little_endian 1.0",
-        "comment ruledmesh PLY; face kind: " + ", ".join(
-            f"{k.value}={k.label}" for k in __import__("ruledmesh.mesh", fromlist=["FaceKind"]).FaceKind),
-        f"element vertex {mesh.n_vertices}",
-        "property double x",
-        "property double y",
-        "property double z",
-        f"element face {mesh.n_faces}",
-        "property list uchar int vertex_indices",
-        "property uchar kind",
-    ]
+    kinds = mesh.face_kind
+    starts = np.flatnonzero(np.r_[True, kinds[1:] != kinds[:-1]]) if kinds.size else np.zeros(0, int)
+    runs = np.column_stack([kinds[starts], np.diff(np.r_[starts, kinds.size])]).reshape(-1)
+    header = ["ply", "format binary_little_endian 1.0",
+              "comment ruledmesh PLY; face kinds: " + ", ".join(f"{k.value}={k.label}" for k in FaceKind)]
+    header += _comment_lines("kinds", runs, 400)
     if len(mesh.members):
-        header += [f"element edge {len(mesh.members)}", "property int vertex1",
-                   "property int vertex2", "property int generator"]
-    header.append("end_header")
+        header += _comment_lines("members", np.column_stack([mesh.members, mesh.member_id]).reshape(-1), 600)
+    header += [f"element vertex {mesh.n_vertices}", "property double x", "property double y",
+               "property double z", f"element face {mesh.n_faces}",
+               "property list uchar int vertex_indices", "end_header"]
     head = ("\n".join(header) + "\n").encode("ascii")
     verts = mesh.vertices.astype("<f8").tobytes()
-    # Each face record: uchar count, count x int32, uchar kind -- built as one byte array.
-    nbytes = 1 + 4 * val + 1
+    # Each face record: uchar count, then count x int32 -- built as one byte array.
+    nbytes = 1 + 4 * val
     rec_off = np.zeros(len(val) + 1, np.int64)
     np.cumsum(nbytes, out=rec_off[1:])
     buf = np.zeros(int(rec_off[-1]), np.uint8)
     buf[rec_off[:-1]] = val.astype(np.uint8)
-    buf[rec_off[1:] - 1] = mesh.face_kind
     idx_bytes = mesh.face_indices.astype("<i4").view(np.uint8).reshape(-1, 4)
     corner_face = np.repeat(np.arange(len(val)), val)
     corner_pos = np.arange(mesh.face_indices.size) - mesh.face_offsets[corner_face]
     start = rec_off[corner_face] + 1 + 4 * corner_pos
     buf[start[:, None] + np.arange(4)] = idx_bytes
-    parts = [head, verts, buf.tobytes()]
-    if len(mesh.members):
-        edges = np.column_stack([mesh.members, mesh.member_id]).astype("<i4")
-        parts.append(edges.tobytes())
-    return b"".join(parts)
+    return head + verts + buf.tobytes()
 
 
 _TYPES = {"char": "i1", "uchar": "u1", "short": "<i2", "ushort": "<u2", "int": "<i4",
@@ -88,9 +85,15 @@ def loadb(data: bytes) -> Mesh:
     if "format binary_little_endian 1.0" not in lines:
         raise ParameterError("only binary little-endian PLY is read", "ply")
     elements: list[tuple[str, int, list[tuple]]] = []
+    runs: list[int] = []
+    mem: list[int] = []
     for line in lines:
         parts = line.split()
-        if parts[:1] == ["element"]:
+        if parts[:3] == ["comment", "ruledmesh", "kinds"]:
+            runs.extend(int(x) for x in parts[3:])
+        elif parts[:3] == ["comment", "ruledmesh", "members"]:
+            mem.extend(int(x) for x in parts[3:])
+        elif parts[:1] == ["element"]:
             elements.append((parts[1], int(parts[2]), []))
         elif parts[:1] == ["property"]:
             elements[-1][2].append(tuple(parts[1:]))
@@ -127,12 +130,15 @@ def loadb(data: bytes) -> Mesh:
         out[name]["__lists__"] = lists
     vert = out.get("vertex", {})
     vertices = np.column_stack([vert["x"], vert["y"], vert["z"]]).astype(np.float64)
-    face = out.get("face", {"__lists__": []})
-    faces = face["__lists__"]
-    kinds = face.get("kind")
-    edge = out.get("edge")
+    faces = out.get("face", {"__lists__": []})["__lists__"]
+    kinds = None
+    if runs:
+        pairs = np.array(runs, np.int64).reshape(-1, 2)
+        kinds = np.repeat(pairs[:, 0], pairs[:, 1]).astype(np.uint8)
+        if kinds.size != len(faces):
+            kinds = None
     members = member_id = None
-    if edge is not None:
-        members = np.column_stack([edge["vertex1"], edge["vertex2"]]).astype(np.int64)
-        member_id = edge["generator"].astype(np.int64) if "generator" in edge else None
+    if mem:
+        triples = np.array(mem, np.int64).reshape(-1, 3)
+        members, member_id = triples[:, :2], triples[:, 2]
     return Mesh.from_faces(vertices, faces, kinds, members=members, member_id=member_id)

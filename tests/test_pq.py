@@ -1,0 +1,223 @@
+"""Invariants of the §4.3 PQ mesher (constructions.md §1-3)."""
+
+import numpy as np
+import pytest
+from hypothesis import HealthCheck, given, settings, strategies as st
+
+from ruledmesh import GeometryError, ParameterError
+from ruledmesh.analysis.faces import convexity, face_areas, planarity
+from ruledmesh.hop import hop
+from ruledmesh.mesh import FaceKind
+from ruledmesh.pq import pq_mesh
+from ruledmesh.tolerances import DEFAULT
+
+
+def hyperboloid_lines(a, c, phi0, phi1, m, h=1.0):
+    """Generators of one regulus of (x^2 + y^2)/a^2 - z^2/c^2 = 1 between z = -h c and h c."""
+    phi = np.linspace(phi0, phi1, m)
+    p = lambda s: np.stack([a * (np.cos(phi) - s * h * np.sin(phi)),
+                            a * (np.sin(phi) + s * h * np.cos(phi)),
+                            np.full(m, s * h * c)], axis=1)
+    return p(-1.0), p(1.0)
+
+
+def hp_lines(a, b, x0, x1, m, y=1.0):
+    """Generators x = const of the hyperbolic paraboloid z = x y / (a b)."""
+    x = np.linspace(x0, x1, m)
+    A = np.stack([x, np.full(m, -y), -x * y / (a * b)], axis=1)
+    B = np.stack([x, np.full(m, y), x * y / (a * b)], axis=1)
+    return A, B
+
+
+def check_mesh(mesh, tol=DEFAULT):
+    assert np.all(np.isfinite(mesh.vertices))
+    assert planarity(mesh).max() <= tol.planarity
+    assert convexity(mesh).all()
+    assert face_areas(mesh).min() > 0
+    assert mesh.euler_characteristic() == 1
+
+
+@settings(max_examples=40, deadline=None, suppress_health_check=[HealthCheck.too_slow])
+@given(a=st.floats(0.5, 3), c=st.floats(0.5, 3), phi0=st.floats(0, 6.3), span=st.floats(0.6, 3.0),
+       m=st.integers(5, 40), rows=st.integers(2, 30), option=st.integers(0, 1),
+       primary=st.floats(0, 0.999))
+def test_hyperboloid_regulus_vertices_on_quadric(a, c, phi0, span, m, rows, option, primary):
+    A, B = hyperboloid_lines(a, c, phi0, phi0 + span, m)
+    mesh = pq_mesh(A, B, rows=rows, option=option, primary=int(primary * m))
+    v = mesh.vertices
+    scale = mesh.diagonal()
+    # Distance to the quadric, to first order: |F| / |grad F|.
+    F = (v[:, 0] ** 2 + v[:, 1] ** 2) / a**2 - v[:, 2] ** 2 / c**2 - 1
+    grad = 2 * np.sqrt((v[:, 0] ** 2 + v[:, 1] ** 2) / a**4 + v[:, 2] ** 2 / c**4)
+    assert np.max(np.abs(F) / grad) / scale <= 1e-10
+    check_mesh(mesh)
+    if m >= 10 and rows >= 6:
+        assert np.count_nonzero(mesh.face_kind == FaceKind.QUAD) > 0
+
+
+@settings(max_examples=40, deadline=None)
+@given(a=st.floats(0.3, 3), b=st.floats(0.3, 3), x0=st.floats(-3, 0), w=st.floats(0.5, 4),
+       m=st.integers(3, 40), rows=st.integers(1, 30), option=st.integers(0, 1))
+def test_hp_regulus_vertices_on_quadric(a, b, x0, w, m, rows, option):
+    A, B = hp_lines(a, b, x0, x0 + w, m)
+    mesh = pq_mesh(A, B, rows=rows, option=option)
+    v = mesh.vertices
+    F = v[:, 2] - v[:, 0] * v[:, 1] / (a * b)
+    grad = np.sqrt(1 + (v[:, 0] ** 2 + v[:, 1] ** 2) / (a * b) ** 2)
+    assert np.max(np.abs(F) / grad) / mesh.diagonal() <= 1e-10
+    check_mesh(mesh)
+
+
+def test_hp_mesh_is_all_quads_inside():
+    """A gently twisted patch: rows stay near t = const, interior faces are all PQ quads."""
+    A, B = hp_lines(1, 1, -1, 1, 21)
+    mesh = pq_mesh(A, B, rows=20)
+    kinds = mesh.count_kinds()
+    assert kinds["quad"] == 180 and "split" not in kinds
+    # Every quad has one diagonal on a generator: its corners 1 and 3 share a generator.
+    ids, quads = mesh.faces_of_valence(4)
+    gen = mesh.vertex_data["generator"]
+    assert np.all(gen[quads[:, 1]] == gen[quads[:, 3]])
+    assert np.all(np.abs(gen[quads[:, 0]] - gen[quads[:, 2]]) == 2)
+
+
+def test_members_are_generator_segments():
+    A, B = hyperboloid_lines(1, 1, 0, 2, 15)
+    mesh = pq_mesh(A, B, rows=12)
+    gen = mesh.vertex_data["generator"]
+    m0, m1 = mesh.members.T
+    assert np.all(gen[m0] == mesh.member_id) and np.all(gen[m1] == mesh.member_id)
+    # Each member lies on its generator line.
+    d = B - A
+    for end in (m0, m1):
+        g = mesh.member_id
+        rel = mesh.vertices[end] - A[g]
+        assert np.abs(np.cross(rel, d[g])).max() < 1e-12
+    # Every generator's members chain from t = 0 to t = 1: total length = generator length.
+    lengths = np.linalg.norm(mesh.vertices[m1] - mesh.vertices[m0], axis=1)
+    per_gen = np.bincount(mesh.member_id, lengths)
+    np.testing.assert_allclose(per_gen, np.linalg.norm(d, axis=1), rtol=1e-12)
+
+
+def test_affine_maps_commute_with_the_construction():
+    rng = np.random.default_rng(3)
+    A, B = hyperboloid_lines(1.2, 0.8, 0.3, 2.5, 17)
+    M = rng.normal(size=(3, 3)) + 3 * np.eye(3)
+    t = rng.normal(size=3)
+    f = lambda p: p @ M.T + t
+    direct = pq_mesh(A, B, rows=10)
+    mapped = pq_mesh(f(A), f(B), rows=10)
+    assert mapped.n_faces == direct.n_faces
+    np.testing.assert_array_equal(mapped.face_indices, direct.face_indices)
+    np.testing.assert_allclose(mapped.vertices, f(direct.vertices), atol=1e-11 * mapped.diagonal())
+
+
+def test_projective_maps_commute_with_the_hop():
+    rng = np.random.default_rng(5)
+    a, d = rng.normal(size=(3, 3)), rng.normal(size=(3, 3))
+    P = a[0] + rng.uniform(-1, 1, size=(20, 1)) * d[0]
+    H = np.eye(4) + 0.1 * rng.normal(size=(4, 4))
+
+    def proj(x):
+        xh = np.c_[x, np.ones(len(x))] @ H.T
+        return xh[:, :3] / xh[:, 3:]
+
+    Q, R, ok = hop(P, a[1], d[1], a[2], d[2])
+    assert ok.all()
+    # Map the lines by mapping two points of each.
+    a2 = proj(a)
+    d2 = proj(a + d) - a2
+    Qp, Rp, ok2 = hop(proj(P), a2[1], d2[1], a2[2], d2[2])
+    assert ok2.all()
+    np.testing.assert_allclose(Qp, proj(Q), atol=1e-9)
+    np.testing.assert_allclose(Rp, proj(R), atol=1e-9)
+
+
+def test_hop_at_infinity_is_flagged_not_nan():
+    # g2 parallel to the plane through P and g1: Q at infinity.
+    P = np.array([[0.0, 0.0, 0.0]])
+    a1, d1 = np.array([1.0, 0, 0]), np.array([0, 1.0, 0])
+    a2, d2 = np.array([2.0, 0, 1]), np.array([1.0, 0, 0])
+    Q, R, ok = hop(P, a1, d1, a2, d2)
+    assert not ok[0] and np.all(np.isfinite(Q)) and np.all(np.isfinite(R))
+
+
+def test_torsal_pair_builds_with_fill_triangles():
+    A, B = hp_lines(1, 1, -1, 1, 21)
+    # Generators 10 and 11 meet: they share their end point on c2.
+    B[11] = B[10]
+    mesh = pq_mesh(A, B, rows=20)
+    check_mesh(mesh)
+    assert any("torsal" in w for w in mesh.info["warnings"])
+    assert mesh.count_kinds().get("fill", 0) > 0
+
+
+def test_sign_change_of_twist_is_a_torsal_cut():
+    # Rotate the generator direction one way, then back: the twist changes sign in the middle.
+    m = 31
+    u = np.linspace(0, 1, m)
+    ang = 0.8 * np.sin(np.pi * u)
+    A = np.stack([4 * u, np.zeros(m), np.zeros(m)], 1)
+    B = A + np.stack([np.zeros(m), np.cos(ang), np.sin(ang)], 1) * 2
+    mesh = pq_mesh(A, B, rows=16)
+    check_mesh(mesh)
+    assert any("torsal" in w for w in mesh.info["warnings"])
+
+
+def test_parallel_generators_cylinder_is_refused_to_hop_but_meshed():
+    m = 12
+    phi = np.linspace(0, 2, m)
+    A = np.stack([np.cos(phi), np.sin(phi), np.zeros(m)], 1)
+    B = A + [0, 0, 2]
+    mesh = pq_mesh(A, B, rows=8)
+    check_mesh(mesh)
+    assert mesh.count_kinds() == {"fill": mesh.n_faces}
+
+
+def test_untrimmed_mesh_keeps_the_extension():
+    A, B = hp_lines(1, 1, -1, 1, 11)
+    trimmed = pq_mesh(A, B, rows=10, extend=0.5)
+    untrimmed = pq_mesh(A, B, rows=10, extend=0.5, trim=False)
+    t = untrimmed.vertex_data["t"]
+    assert t.min() < -0.4 and t.max() > 1.4
+    assert trimmed.vertex_data["t"].min() >= 0 and trimmed.vertex_data["t"].max() <= 1
+    check_mesh(untrimmed)
+
+
+def test_bad_arguments_name_the_parameter():
+    A, B = hp_lines(1, 1, -1, 1, 5)
+    with pytest.raises(ParameterError, match="option"):
+        pq_mesh(A, B, option=2)
+    with pytest.raises(ParameterError, match="primary"):
+        pq_mesh(A, B, primary=9)
+    with pytest.raises(ParameterError, match="extend"):
+        pq_mesh(A, B, extend="lots")
+    with pytest.raises(ParameterError, match="b"):
+        pq_mesh(A, B[:4])
+    B2 = B.copy()
+    B2[2] = A[2]
+    with pytest.raises(GeometryError, match="generator 2 has zero length"):
+        pq_mesh(A, B2)
+    with pytest.raises(ParameterError, match="finite"):
+        pq_mesh(np.where(A == A[0, 0], np.nan, A), B)
+
+
+def test_huge_grid_is_refused_up_front_with_its_memory():
+    A, B = hp_lines(1, 1, -1, 1, 1_000_000)
+    with pytest.raises(GeometryError, match="GiB"):
+        pq_mesh(A, B, rows=200)
+
+
+def test_far_rows_are_never_emitted():
+    # A strongly twisted set of lines: rows run off to infinity on some generators.
+    rng = np.random.default_rng(11)
+    A = rng.normal(size=(15, 3))
+    B = A + rng.normal(size=(15, 3))
+    mesh = pq_mesh(A, B, rows=12)
+    assert np.all(np.isfinite(mesh.vertices))
+    lo = np.minimum(A.min(0), B.min(0))
+    hi = np.maximum(A.max(0), B.max(0))
+    # Trimmed vertices lie on the generator segments, so inside the lines' bounding box.
+    assert np.all(mesh.vertices >= lo - 1e-9) and np.all(mesh.vertices <= hi + 1e-9)
+    assert planarity(mesh).max() <= DEFAULT.planarity
+    assert convexity(mesh).all()
