@@ -1,0 +1,60 @@
+"""``ruledmesh design [DESIGN.toml]``: the interactive designer in the browser."""
+
+from __future__ import annotations
+
+import sys
+
+
+def add_parser(sub) -> None:
+    p = sub.add_parser(
+        "design",
+        help="interactive designer in the browser",
+        description="Start the designer: a local web page with a 3-D view of the director "
+                    "curves, generators and mesh, handles and sliders, live figures, undo/redo, "
+                    "save and export. Serves on 127.0.0.1 only unless --host is given.",
+        epilog="example: ruledmesh design examples/skew.toml --port 8765",
+    )
+    p.add_argument("design", nargs="?", help="design file (.toml); a skew surface if omitted "
+                   "(saved as <name>.toml in the working folder)")
+    p.add_argument("--port", type=int, default=0, help="port (default: a free one)")
+    p.add_argument("--host", default=None,
+                   help="interface to bind (default 127.0.0.1; other interfaces expose the "
+                        "designer, which can write files, to the network)")
+    p.add_argument("--no-browser", action="store_true", help="do not open a browser")
+    p.set_defaults(run=run)
+
+
+def run(args) -> int:
+    from pathlib import Path
+
+    from ..errors import ParameterError
+    from ..web.server import DEFAULT_HOST, make_server
+    from ..web.session import Session
+
+    if not 0 <= args.port <= 65535:
+        raise ParameterError(f"expected a port in 0..65535, got {args.port}", "--port")
+    text = path = None
+    if args.design:
+        path = Path(args.design)
+        try:
+            text = path.read_text(encoding="utf-8")
+        except FileNotFoundError:
+            raise ParameterError(f"no such design file: {path}", "design") from None
+    session = Session(text, path)
+    host = args.host if args.host is not None else DEFAULT_HOST
+    server = make_server(session, host, args.port)
+    print(f"ruledmesh designer: {server.url}  (Ctrl+C to stop)", flush=True)
+    if args.host is not None and not server.loopback:
+        print(f"warning: serving on {host}: anyone who can reach it can edit and write files",
+              file=sys.stderr)
+    if not args.no_browser:
+        import webbrowser
+
+        webbrowser.open(server.url)
+    try:
+        server.serve_forever()
+    except KeyboardInterrupt:
+        print("ruledmesh designer: stopped", file=sys.stderr)
+    finally:
+        server.server_close()
+    return 0

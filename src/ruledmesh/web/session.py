@@ -1,0 +1,612 @@
+"""The designer's state: the current design, its build, undo and redo.
+
+A :class:`Session` holds the current design as a plain dictionary (the TOML
+tables) and the mesh built from it.  Every edit makes a new candidate design,
+builds it and only then makes it current, so the state always holds a design
+that builds; a bad edit raises (with the design file's dotted field path) and
+leaves the state as it was.  :meth:`Session.payload` encodes the mesh for the
+page as one binary message (see :func:`encode_message`).
+"""
+
+from __future__ import annotations
+
+import copy
+import importlib
+import json
+import math
+import threading
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any, Mapping, Sequence
+
+import numpy as np
+
+from ..design import Design, build_design, parse_design
+from ..errors import DesignError, ExportError, ParameterError
+from ..mesh import FaceKind, Mesh
+from ..registry import Built
+from .toml_writer import dumps
+
+__all__ = ["Session", "DEFAULT_DESIGN", "fan_triangles", "unique_edges", "fast_figures", "encode_message",
+           "set_path"]
+
+# Shown when the designer starts without a design file (paper Fig. 10, a skew surface).
+DEFAULT_DESIGN = """\
+name = "skew"
+description = "B-spline and polyline director curves, arc-length distribution, PQ mesh"
+
+[curves.c1]
+type = "bspline"
+degree = 3
+points = [[0, 0, 0], [3, 1, 0], [6, -1, 0], [10, 0, 0]]
+
+[curves.c2]
+type = "polyline"
+points = [[0, 2, 4], [3, 4, 5], [6, 3, 3], [10, 3, 4]]
+
+[rulings]
+between = ["c1", "c2"]
+distribution = "arc-length"
+count = 41
+
+[mesh]
+method = "pq"
+rows = 40
+primary = "middle"
+option = 0
+extend = "auto"
+trim = true
+"""
+
+# Undo steps kept; older ones are dropped so a long session stays bounded in memory.
+UNDO_LIMIT = 200
+# Points sampled along each director curve for display.
+CURVE_SAMPLES = 160
+
+
+def set_path(data: dict, path: Sequence[str | int], value: Any) -> None:
+    """Set ``data[path[0]][path[1]]... = value`` in place; ``value=None`` deletes.
+
+    Missing tables along the way are created.  Raises :class:`DesignError`
+    naming the dotted path when a step does not exist or has the wrong type.
+    """
+    if not path:
+        raise DesignError("expected a non-empty path", "edit")
+    dotted = ".".join(str(p) for p in path)
+    node: Any = data
+    for step in path[:-1]:
+        if isinstance(node, dict) and isinstance(step, str):
+            node = node.setdefault(step, {})
+        elif isinstance(node, list) and isinstance(step, int) and -len(node) <= step < len(node):
+            node = node[step]
+        else:
+            raise DesignError(f"no such field (at {step!r})", dotted)
+    last = path[-1]
+    if isinstance(node, dict) and isinstance(last, str):
+        if value is None:
+            node.pop(last, None)
+        else:
+            node[last] = value
+    elif isinstance(node, list) and isinstance(last, int) and -len(node) <= last < len(node):
+        if value is None:
+            raise DesignError("cannot delete a list item", dotted)
+        node[last] = value
+    else:
+        raise DesignError(f"no such field (at {last!r})", dotted)
+
+
+def fan_triangles(mesh: Mesh) -> tuple[np.ndarray, np.ndarray]:
+    """Triangles of every face for display (a fan from each face's first corner).
+
+    Returns
+    -------
+    triangles : (T, 3) int64
+        Vertex indices.
+    face : (T,) int64
+        The face each triangle belongs to.
+    """
+    off = mesh.face_offsets
+    idx = mesh.face_indices
+    val = np.diff(off)
+    ntri = np.maximum(val - 2, 0)
+    face = np.repeat(np.arange(len(val)), ntri)
+    # j = 1 .. k-2 within each face: running index minus the start of the face's run.
+    start = np.repeat(np.cumsum(ntri) - ntri, ntri)
+    j = np.arange(face.size) - start + 1
+    base = off[:-1][face]
+    tris = np.stack([idx[base], idx[base + j], idx[base + j + 1]], axis=1)
+    return tris, face
+
+
+def unique_edges(mesh: Mesh) -> np.ndarray:
+    """(E, 2) int64: the mesh's undirected edges, each once (low, high).
+
+    Same set as :meth:`Mesh.edges`, faster: the unique runs on one int64 key
+    per edge instead of on rows.
+    """
+    idx = mesh.face_indices
+    if idx.size == 0:
+        return np.zeros((0, 2), dtype=np.int64)
+    nxt = np.arange(1, idx.size + 1)
+    nxt[mesh.face_offsets[1:] - 1] = mesh.face_offsets[:-1]
+    lo = np.minimum(idx, idx[nxt])
+    hi = np.maximum(idx, idx[nxt])
+    key = np.unique(lo * np.int64(mesh.n_vertices) + hi)
+    return np.stack([key // mesh.n_vertices, key % mesh.n_vertices], axis=1)
+
+
+def fast_figures(mesh: Mesh) -> tuple[dict[str, Any], np.ndarray]:
+    """The figures cheap enough for every edit (faces, triangles, planarity, convexity).
+
+    Returns
+    -------
+    figures : dict
+    planarity : (F,) float64
+        Per-face planarity (:func:`ruledmesh.analysis.faces.planarity`).
+    """
+    from ..analysis import faces as F
+    from ..tolerances import DEFAULT
+
+    plan = F.planarity(mesh)
+    convex = F.convexity(mesh, DEFAULT.convexity)
+    return {
+        "vertices": mesh.n_vertices,
+        "faces": mesh.n_faces,
+        "triangles": int(np.count_nonzero(mesh.valences == 3)),
+        "kinds": mesh.count_kinds(),
+        "planarity_max": float(plan.max()) if plan.size else 0.0,
+        "planarity_tolerance": DEFAULT.planarity,
+        "non_convex": int(np.count_nonzero(~convex)),
+        "members": int(len(mesh.members)),
+        "warnings": [str(w) for w in mesh.info.get("warnings", [])],
+    }, plan
+
+
+def slow_figures(built: Built) -> tuple[dict[str, Any], np.ndarray | None]:
+    """Closeness, coverage and panel count: too slow for every edit on some designs.
+
+    Returns the figures and the (F,) per-face closeness of the face centroids
+    (relative to the bounding-box diagonal) or ``None`` without a reference.
+    """
+    from ..analysis import faces as F
+    from ..fabricate.panels import congruence_classes
+
+    mesh = built.mesh
+    figures: dict[str, Any] = {}
+    per_face = None
+    diag = mesh.diagonal() or 1.0
+    if built.reference is not None and mesh.n_faces:
+        per_face = built.reference.distance(F.face_centroids(mesh)) / diag
+        vert = built.reference.distance(mesh.vertices[np.unique(mesh.face_indices)]) / diag
+        figures["closeness"] = {"centroids_max": float(per_face.max()),
+                                "centroids_mean": float(per_face.mean()),
+                                "vertices_max": float(vert.max())}
+        patch = built.reference.area()
+        if patch:
+            _, areas = F.face_normals(mesh)
+            figures["coverage"] = float(areas.sum() / patch)
+    if mesh.n_faces:
+        classes = congruence_classes(mesh)
+        figures["panels"] = int(classes.max()) + 1
+    return figures, per_face
+
+
+def _json_default(value: Any) -> Any:
+    if isinstance(value, np.generic):
+        return value.item()
+    if isinstance(value, np.ndarray):
+        return value.tolist()
+    if isinstance(value, Path):
+        return str(value)
+    return str(value)
+
+
+def _clean(value: Any) -> Any:
+    """JSON cannot hold NaN or infinity: send them as strings."""
+    if isinstance(value, float) and not math.isfinite(value):
+        return str(value)
+    if isinstance(value, dict):
+        return {k: _clean(v) for k, v in value.items()}
+    if isinstance(value, (list, tuple)):
+        return [_clean(v) for v in value]
+    return value
+
+
+def encode_message(header: Mapping[str, Any], arrays: Sequence[tuple[str, np.ndarray]]) -> bytes:
+    """One binary message: a JSON header and little-endian arrays.
+
+    Layout: ``uint32`` length of the JSON text, the UTF-8 JSON padded with
+    spaces to a multiple of 4 bytes, then each array's bytes (each padded to 4
+    bytes).  The header's ``arrays`` list gives each array's name, dtype,
+    shape and byte offset from the start of the array section, so the page
+    views them without copying.
+    """
+    table = []
+    chunks = []
+    offset = 0
+    for name, arr in arrays:
+        arr = np.ascontiguousarray(arr)
+        if arr.dtype.byteorder == ">":
+            arr = arr.astype(arr.dtype.newbyteorder("<"))
+        raw = arr.tobytes()
+        pad = (-len(raw)) % 4
+        table.append({"name": name, "dtype": arr.dtype.name, "shape": list(arr.shape),
+                      "offset": offset})
+        chunks.append(raw + b"\0" * pad)
+        offset += len(raw) + pad
+    text = json.dumps(_clean({**header, "arrays": table}), default=_json_default,
+                      allow_nan=False).encode("utf-8")
+    text += b" " * ((-len(text)) % 4)
+    return np.uint32(len(text)).tobytes() + text + b"".join(chunks)
+
+
+@dataclass
+class _Snapshot:
+    design: dict
+    built: Built
+    version: int
+
+
+class Session:
+    """The designer's state.
+
+    Parameters
+    ----------
+    text : str, optional
+        Design TOML; the built-in skew design when omitted.
+    path : path-like, optional
+        Where the design was read from and is saved to by default.
+    base_dir : path-like, optional
+        Folder that relative paths in the design resolve against (default: the
+        design's folder, else the working folder).
+
+    Raises
+    ------
+    DesignError, GeometryError
+        When the starting design does not build.
+    """
+
+    def __init__(self, text: str | None = None, path: str | Path | None = None,
+                 base_dir: str | Path | None = None):
+        self.path = Path(path) if path is not None else None
+        if base_dir is None:
+            base_dir = self.path.parent if self.path is not None else Path(".")
+        self.base_dir = Path(base_dir)
+        self.source = self.path.name if self.path is not None else "<designer>"
+        design = parse_design(DEFAULT_DESIGN if text is None else text, self.source, self.base_dir)
+        data = _plain(design.data)
+        self._lock = threading.RLock()
+        self._current = _Snapshot(data, self._build(data), 0)
+        self._undo: list[dict] = []
+        self._redo: list[dict] = []
+        self._coalesce: str | None = None
+
+    # ------------------------------------------------------------- state
+    @property
+    def design(self) -> dict:
+        """A copy of the current design dictionary."""
+        with self._lock:
+            return copy.deepcopy(self._current.design)
+
+    def snapshot(self) -> tuple[int, dict]:
+        """``(version, design)`` read together (a copy of the design)."""
+        with self._lock:
+            return self._current.version, copy.deepcopy(self._current.design)
+
+    @property
+    def built(self) -> Built:
+        return self._current.built
+
+    @property
+    def version(self) -> int:
+        """Increases with every change of the current design (edits, undo, redo)."""
+        return self._current.version
+
+    @property
+    def can_undo(self) -> bool:
+        return bool(self._undo)
+
+    @property
+    def can_redo(self) -> bool:
+        return bool(self._redo)
+
+    def _build(self, data: dict) -> Built:
+        return build_design(Design(data, self.source, self.base_dir))
+
+    def _make_current(self, data: dict, built: Built) -> None:
+        self._current = _Snapshot(data, built, self._current.version + 1)
+
+    # ------------------------------------------------------------- edits
+    def replace(self, data: Mapping[str, Any], coalesce: str | None = None) -> int:
+        """Make ``data`` the current design if it builds; returns the new version.
+
+        Parameters
+        ----------
+        data : mapping
+            The whole design (TOML tables as dictionaries).
+        coalesce : str, optional
+            Consecutive edits with the same key (one handle drag, one slider
+            gesture) make a single undo step.
+
+        Raises
+        ------
+        DesignError, GeometryError, ParameterError
+            The edit is refused and the state is unchanged.
+        """
+        if not isinstance(data, Mapping):
+            raise DesignError(f"expected a table, got {type(data).__name__}", "design")
+        candidate = _plain(data)
+        # Parsing the TOML we would save checks the top level and that the design can be written.
+        parse_design(dumps(candidate), self.source, self.base_dir)
+        # Edits are built one at a time, so they apply in the order they arrive.
+        with self._lock:
+            built = self._build(candidate)
+            if coalesce is None or coalesce != self._coalesce:
+                self._undo.append(self._current.design)
+                del self._undo[:-UNDO_LIMIT]
+            self._coalesce = coalesce
+            self._redo.clear()
+            self._make_current(candidate, built)
+            return self.version
+
+    def edit(self, changes: Sequence[tuple[Sequence[str | int], Any]],
+             coalesce: str | None = None) -> int:
+        """Apply ``(path, value)`` changes to a copy of the design, then :meth:`replace`.
+
+        ``path`` is a list of keys and list indices, e.g. ``["curves", "c1",
+        "points", 2]``; ``value=None`` deletes the key.
+        """
+        with self._lock:
+            data = self.design
+            for path, value in changes:
+                if not isinstance(path, (list, tuple)):
+                    raise DesignError(f"expected a list of keys, got {path!r}", "edit")
+                set_path(data, list(path), value)
+            return self.replace(data, coalesce)
+
+    def load_text(self, text: str) -> int:
+        """Replace the design by TOML ``text`` (one undo step)."""
+        design = parse_design(text, self.source, self.base_dir)
+        return self.replace(design.data)
+
+    def undo(self) -> int:
+        """Go back one edit; raises :class:`ParameterError` when there is none."""
+        with self._lock:
+            if not self._undo:
+                raise ParameterError("nothing to undo", "undo")
+            data = self._undo[-1]
+            built = self._build(data)
+            self._undo.pop()
+            self._redo.append(self._current.design)
+            self._coalesce = None
+            self._make_current(data, built)
+            return self.version
+
+    def redo(self) -> int:
+        """Repeat the last undone edit; raises :class:`ParameterError` when there is none."""
+        with self._lock:
+            if not self._redo:
+                raise ParameterError("nothing to redo", "redo")
+            data = self._redo[-1]
+            built = self._build(data)
+            self._redo.pop()
+            self._undo.append(self._current.design)
+            self._coalesce = None
+            self._make_current(data, built)
+            return self.version
+
+    # ------------------------------------------------------------- files
+    def toml(self) -> str:
+        """The current design as TOML text."""
+        return dumps(self._current.design)
+
+    def _target(self, path: str | Path | None, suffix: str) -> Path:
+        if path:
+            target = Path(path).expanduser()
+            return target if target.is_absolute() else self.base_dir / target
+        stem = self.path.stem if self.path is not None else str(
+            self._current.design.get("name") or "design")
+        return self.base_dir / f"{stem}{suffix}"
+
+    def save(self, path: str | Path | None = None) -> Path:
+        """Write the current design as TOML (atomically); returns the path written.
+
+        Without ``path``: the file the design came from, else
+        ``<name>.toml`` in the base folder.  A relative ``path`` is relative to
+        the base folder.
+        """
+        from ..io import write_atomic
+
+        target = self._target(path or self.path, ".toml")
+        if target.suffix.lower() != ".toml":
+            raise ParameterError(f'expected a ".toml" file name, got "{target.name}"', "path")
+        write_atomic(target, self.toml().encode("utf-8"))
+        if self.path is None:
+            self.path = target
+        return target
+
+    def export_bytes(self, ext: str) -> bytes:
+        """The current mesh in the format of extension ``ext`` (see ``ruledmesh.io.WRITERS``)."""
+        from .. import io
+
+        ext = ext.lower() if ext.startswith(".") else f".{ext.lower()}"
+        if ext not in io.WRITERS:
+            raise ParameterError(f'cannot write "{ext}" files; known: '
+                                 f'{", ".join(io.formats())}', "format")
+        mesh = self._current.built.mesh
+        io.check_finite(mesh)
+        try:
+            module = importlib.import_module(f"ruledmesh.io.{io.WRITERS[ext]}")
+        except ImportError as exc:
+            raise ExportError(f"{ext} export needs an optional package that is not installed "
+                              f"({exc.name or exc}); see the install extras") from None
+        try:
+            return module.dumpb(mesh)
+        except ImportError as exc:
+            raise ExportError(f"{ext} export needs an optional package that is not installed "
+                              f"({exc.name or exc}); see the install extras") from None
+
+    def export(self, ext: str, path: str | Path | None = None) -> Path:
+        """Write the current mesh as ``ext`` (atomically); returns the path written."""
+        from ..io import write_atomic
+
+        ext = ext.lower() if ext.startswith(".") else f".{ext.lower()}"
+        data = self.export_bytes(ext)
+        target = self._target(path, ext)
+        if target.suffix.lower() != ext:
+            raise ParameterError(f'expected a file name ending in "{ext}", got "{target.name}"',
+                                 "path")
+        return write_atomic(target, data)
+
+    # ------------------------------------------------------------- page
+    def describe(self) -> dict[str, Any]:
+        """State for the page besides the mesh: design, undo flags, choices."""
+        from .. import io
+        from ..curves import CurveType
+        from ..registry import MESH_METHODS, SURFACE_KINDS, load_plugins
+        from ..rulings import Distribution
+
+        load_plugins()
+        return {
+            "version": self.version,
+            "design": self._current.design,
+            "toml": self.toml(),
+            "path": str(self.path) if self.path else None,
+            "can_undo": self.can_undo,
+            "can_redo": self.can_redo,
+            "choices": {
+                "kinds": sorted(SURFACE_KINDS),
+                "methods": sorted(MESH_METHODS),
+                "formats": io.formats(),
+                "distributions": [d.value for d in Distribution],
+                "curve_types": [c.value for c in CurveType],
+                "face_kinds": [k.label for k in FaceKind],
+            },
+        }
+
+    def payload(self) -> bytes:
+        """The current state and mesh as one binary message (:func:`encode_message`)."""
+        with self._lock:
+            snap = self._current
+            header = self.describe()
+        built = snap.built
+        mesh = built.mesh
+        figures, plan = fast_figures(mesh)
+        tris, tri_face = fan_triangles(mesh)
+        arrays: list[tuple[str, np.ndarray]] = [
+            ("vertices", mesh.vertices.astype(np.float32)),
+            ("triangles", tris.astype(np.uint32)),
+            ("triangle_face", tri_face.astype(np.uint32)),
+            ("planarity", plan.astype(np.float32)),
+            ("kind", mesh.face_kind.astype(np.uint8)),
+            ("edges", unique_edges(mesh).astype(np.uint32)),
+        ]
+        rulings = built.rulings
+        if rulings is not None and getattr(rulings, "a", None) is not None:
+            gens = np.stack([rulings.a, rulings.b], axis=1)
+        elif len(mesh.members):
+            gens = mesh.vertices[mesh.members]
+        else:
+            gens = np.zeros((0, 2, 3))
+        arrays.append(("generators", gens.astype(np.float32)))
+        header["figures"] = figures
+        header["curves"] = _curve_polylines(snap.design)
+        header["handles"] = _handles(snap.design, mesh)
+        bbox = mesh.bounding_box() if mesh.n_vertices else np.zeros((2, 3))
+        header["bbox"] = bbox.tolist()
+        return encode_message(header, arrays)
+
+
+def _plain(value: Any) -> Any:
+    """Deep copy of TOML data as plain dicts and lists (tomllib may return other mappings)."""
+    if isinstance(value, Mapping):
+        return {str(k): _plain(v) for k, v in value.items()}
+    if isinstance(value, (list, tuple)):
+        return [_plain(v) for v in value]
+    if isinstance(value, np.generic):
+        return value.item()
+    return value
+
+
+def _is_point(value: Any) -> bool:
+    return (isinstance(value, list) and len(value) == 3
+            and all(isinstance(x, (int, float)) and not isinstance(x, bool) for x in value))
+
+
+def _is_points(value: Any) -> bool:
+    return isinstance(value, list) and len(value) >= 1 and all(_is_point(p) for p in value)
+
+
+def _curve_polylines(design: Mapping) -> list[dict[str, Any]]:
+    """Sampled director curves ``[{name, points}]`` (curves that fail to build are skipped)."""
+    from ..curves import curve_from_spec
+
+    out = []
+    curves = design.get("curves", {})
+    if not isinstance(curves, Mapping):
+        return out
+    for name, spec in curves.items():
+        try:
+            curve = curve_from_spec(spec, f"curves.{name}")
+            pts = curve.sample(CURVE_SAMPLES)
+        except Exception:  # noqa: BLE001 - display only; the build reports real errors
+            continue
+        out.append({"name": name, "points": np.asarray(pts, dtype=float).round(9).tolist()})
+    return out
+
+
+# Point-valued keys of [surface] tables that are positions (dragging them makes sense);
+# other 3-vectors (axes, normals) are directions and stay fields of the TOML pane.
+_POSITION_KEYS = ("center", "origin", "apex", "base", "start", "end")
+
+
+def _handles(design: Mapping, mesh: Mesh) -> list[dict[str, Any]]:
+    """Draggable points of the design: control points, directrix points, plane normal.
+
+    Each handle is ``{path, position, kind}`` with ``kind`` ``"point"`` (the
+    position is the value at ``path``) or ``"normal"`` (the value at ``path``
+    is the direction from ``anchor`` to the position).
+    """
+    handles: list[dict[str, Any]] = []
+
+    def points(path: list, value: Any, label: str) -> None:
+        if _is_points(value):
+            for i, p in enumerate(value):
+                handles.append({"path": [*path, i], "position": p, "kind": "point",
+                                "label": f"{label}[{i}]"})
+        elif _is_point(value):
+            handles.append({"path": path, "position": value, "kind": "point", "label": label})
+
+    curves = design.get("curves", {})
+    if isinstance(curves, Mapping):
+        for name, spec in curves.items():
+            if isinstance(spec, Mapping):
+                points(["curves", name, "points"], spec.get("points"), f"{name}.points")
+                points(["curves", name, "center"], spec.get("center"), f"{name}.center")
+    rulings = design.get("rulings", {})
+    if isinstance(rulings, Mapping):
+        points(["rulings", "directrix"], rulings.get("directrix"), "directrix")
+        conoid = rulings.get("conoid")
+        if isinstance(conoid, Mapping):
+            points(["rulings", "conoid", "directrix"], conoid.get("directrix"), "directrix")
+        for path, normal in ((["rulings", "director_plane"], rulings.get("director_plane")),
+                             (["rulings", "conoid", "director_plane"],
+                              conoid.get("director_plane") if isinstance(conoid, Mapping) else None)):
+            if _is_point(normal) and mesh.n_vertices:
+                n = np.asarray(normal, dtype=float)
+                norm = float(np.linalg.norm(n))
+                if norm > 0:
+                    box = mesh.bounding_box()
+                    anchor = box.mean(axis=0)
+                    length = 0.35 * (mesh.diagonal() or 1.0)
+                    handles.append({"path": path, "kind": "normal", "anchor": anchor.tolist(),
+                                    "position": (anchor + n / norm * length).tolist(),
+                                    "label": "director plane normal"})
+    surface = design.get("surface", {})
+    if isinstance(surface, Mapping):
+        for key, value in surface.items():
+            if _is_points(value) and len(value) >= 2:
+                points(["surface", key], value, key)
+            elif key in _POSITION_KEYS:
+                points(["surface", key], value, key)
+    return handles
