@@ -25,7 +25,7 @@ from typing import Mapping
 import numpy as np
 
 from .._validation import check_bool, check_choice, check_float, check_int
-from ..errors import DesignError
+from ..errors import DesignError, GeometryError
 from ..mesh import FaceKind, Mesh, _offsets_from_valences
 from ..registry import BuildContext, Built, surface_kind
 from ._grid import grid_mesh
@@ -135,6 +135,8 @@ def hyperbolic_paraboloid_mesh(a: float, b: float, size: float, u: int, v: int,
         is_ = np.flatnonzero(used[:, j])
         members.append(np.stack([vid[is_[:-1], j], vid[is_[1:], j]], axis=1))
         mid.append(np.full(len(is_) - 1, u + 1 + j))
+    if sum(len(f) for f in faces) == 0:
+        raise GeometryError(f"u = {u}, v = {v} without fill leave no face: raise u or v")
     val = np.concatenate([np.full(len(f), f.shape[1]) for f in faces])
     mesh = Mesh(X, _offsets_from_valences(val), np.concatenate([f.ravel() for f in faces]),
                 np.concatenate(kinds), np.concatenate(members).astype(np.int64),
@@ -161,7 +163,10 @@ def _build(table: Mapping, mesh_table: Mapping, ctx: BuildContext) -> Built:
     fill = f.bool("fill", True)
     if style is HPStyle.GENERATORS and min(u, v) < 2:
         raise DesignError(f"expected u, v >= 2 for style \"generators\", got {u}, {v}", "mesh")
-    mesh = hyperbolic_paraboloid_mesh(a, b, size, u, v, style, fill=fill)
+    try:
+        mesh = hyperbolic_paraboloid_mesh(a, b, size, u, v, style, fill=fill)
+    except GeometryError as exc:
+        raise DesignError(str(exc), "mesh") from None
     if style is HPStyle.PARABOLAS:
         def partials(x, y):
             return (np.stack([np.ones_like(x), 0 * x, 2 * x / a ** 2], axis=1),
