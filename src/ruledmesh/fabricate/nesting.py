@@ -77,7 +77,7 @@ def auto_sheet(box: np.ndarray, gap: float) -> tuple[float, float]:
     gap : float
     """
     padded = box + gap
-    side = max(float(np.sqrt(np.prod(padded, axis=1).sum()) * 1.3), float(padded.max()) + gap)
+    side = max(float(np.sqrt(np.prod(padded, axis=1).sum()) * 1.3), float(padded.max()) + 2 * gap)
     return side, side
 
 

@@ -109,7 +109,7 @@ def _check_unit(unit: str) -> str:
 
 
 def _fmt(x: float) -> str:
-    return f"{x:.10g}"
+    return f"{x:.15g}"
 
 
 def sheet_svg(layout: Layout, s: int, *, labels: Labels | None = None, unit: str = "",
