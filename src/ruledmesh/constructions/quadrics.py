@@ -66,14 +66,15 @@ def ellipsoid_mesh(a: float, b: float, c: float, u: int, v: int):
     Returns
     -------
     Mesh
-        Trapezoids, triangles at the poles.
+        Trapezoids, triangles at the poles; normals point outwards.
     """
     a, b, c = (_positive(x, n) for x, n in ((a, "a"), (b, "b"), (c, "c")))
     u, v = check_int(u, "u", lo=3), check_int(v, "v", lo=2)
-    t = np.pi * np.arange(v + 1) / v
+    # South to north, so that the faces' normals point outwards.
+    t = np.pi * np.arange(v, -1, -1) / v
     s, h = np.sin(t), c * np.cos(t)
     s[[0, -1]] = 0.0  # exact poles (sin(pi) is not 0 in floating point)
-    h[[0, -1]] = [c, -c]
+    h[[0, -1]] = [-c, c]
     return grid_mesh(_sections(s, h, a, b, u), wrap_u=True, info={"construction": "ellipsoid"})
 
 
