@@ -40,6 +40,8 @@ def circularity(q):
     """(Q,) distance of corner 3 from the circle through corners 0, 1, 2, relative to its radius."""
     out = []
     for a, b, c, d in q:
+        # Relative to a: |b|^2 - |a|^2 would cancel catastrophically far from the origin.
+        a, b, c, d = 0 * a, b - a, c - a, d - a
         n = np.cross(b - a, c - a)
         m = np.array([2 * (b - a), 2 * (c - a), n])
         rhs = np.array([b @ b - a @ a, c @ c - a @ a, n @ a])
