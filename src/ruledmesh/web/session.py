@@ -234,8 +234,12 @@ def encode_message(header: Mapping[str, Any], arrays: Sequence[tuple[str, np.nda
                       "offset": offset})
         chunks.append(raw + b"\0" * pad)
         offset += len(raw) + pad
-    text = json.dumps(_clean({**header, "arrays": table}), default=_json_default,
-                      allow_nan=False).encode("utf-8")
+    try:
+        text = json.dumps({**header, "arrays": table}, default=_json_default, allow_nan=False)
+    except ValueError:  # NaN or infinity somewhere (a figure of a degenerate mesh): as strings
+        text = json.dumps(_clean({**header, "arrays": table}), default=_json_default,
+                          allow_nan=False)
+    text = text.encode("utf-8")
     text += b" " * ((-len(text)) % 4)
     return np.uint32(len(text)).tobytes() + text + b"".join(chunks)
 
@@ -259,6 +263,8 @@ class Session:
     base_dir : path-like, optional
         Folder that relative paths in the design resolve against (default: the
         design's folder, else the working folder).
+    undo_limit : int
+        Undo steps kept (older ones are dropped, so memory stays bounded).
 
     Raises
     ------
@@ -267,7 +273,7 @@ class Session:
     """
 
     def __init__(self, text: str | None = None, path: str | Path | None = None,
-                 base_dir: str | Path | None = None):
+                 base_dir: str | Path | None = None, undo_limit: int = UNDO_LIMIT):
         self.path = Path(path) if path is not None else None
         if base_dir is None:
             base_dir = self.path.parent if self.path is not None else Path(".")
@@ -280,6 +286,7 @@ class Session:
         self._undo: list[dict] = []
         self._redo: list[dict] = []
         self._coalesce: str | None = None
+        self.undo_limit = int(undo_limit)
 
     # ------------------------------------------------------------- state
     @property
@@ -343,7 +350,7 @@ class Session:
             built = self._build(candidate)
             if coalesce is None or coalesce != self._coalesce:
                 self._undo.append(self._current.design)
-                del self._undo[:-UNDO_LIMIT]
+                del self._undo[:-self.undo_limit]
             self._coalesce = coalesce
             self._redo.clear()
             self._make_current(candidate, built)
@@ -510,7 +517,9 @@ class Session:
             gens = np.zeros((0, 2, 3))
         arrays.append(("generators", gens.astype(np.float32)))
         header["figures"] = figures
-        header["curves"] = _curve_polylines(snap.design)
+        names, counts, points = _curve_polylines(snap.design)
+        header["curves"] = [{"name": n, "count": c} for n, c in zip(names, counts)]
+        arrays.append(("curve_points", points.astype(np.float32)))
         header["handles"] = _handles(snap.design, mesh)
         bbox = mesh.bounding_box() if mesh.n_vertices else np.zeros((2, 3))
         header["bbox"] = bbox.tolist()
@@ -537,22 +546,28 @@ def _is_points(value: Any) -> bool:
     return isinstance(value, list) and len(value) >= 1 and all(_is_point(p) for p in value)
 
 
-def _curve_polylines(design: Mapping) -> list[dict[str, Any]]:
-    """Sampled director curves ``[{name, points}]`` (curves that fail to build are skipped)."""
+def _curve_polylines(design: Mapping) -> tuple[list[str], list[int], np.ndarray]:
+    """Sampled director curves: names, point counts and the (n, 3) points, concatenated.
+
+    Curves that do not build are left out (the build reports their errors).
+    """
     from ..curves import curve_from_spec
 
-    out = []
+    names: list[str] = []
+    counts: list[int] = []
+    chunks = [np.zeros((0, 3))]
     curves = design.get("curves", {})
-    if not isinstance(curves, Mapping):
-        return out
-    for name, spec in curves.items():
-        try:
-            curve = curve_from_spec(spec, f"curves.{name}")
-            pts = curve.sample(CURVE_SAMPLES)
-        except Exception:  # noqa: BLE001 - display only; the build reports real errors
-            continue
-        out.append({"name": name, "points": np.asarray(pts, dtype=float).round(9).tolist()})
-    return out
+    if isinstance(curves, Mapping):
+        for name, spec in curves.items():
+            try:
+                pts = np.asarray(curve_from_spec(spec, f"curves.{name}").sample(CURVE_SAMPLES),
+                                 dtype=np.float64).reshape(-1, 3)
+            except Exception:  # noqa: BLE001 - display only
+                continue
+            names.append(name)
+            counts.append(len(pts))
+            chunks.append(pts)
+    return names, counts, np.concatenate(chunks)
 
 
 # Point-valued keys of [surface] tables that are positions (dragging them makes sense);

@@ -9,7 +9,6 @@ original file are not kept (TOML parsers drop them).
 
 from __future__ import annotations
 
-import json
 import math
 import re
 from typing import Any, Mapping
@@ -21,11 +20,27 @@ __all__ = ["dumps"]
 _BARE = re.compile(r"^[A-Za-z0-9_-]+$")
 
 
+_ESCAPES = {'"': '\\"', "\\": "\\\\", "\b": "\\b", "\t": "\\t", "\n": "\\n",
+            "\f": "\\f", "\r": "\\r"}
+
+
+def _string(text: str) -> str:
+    """A TOML basic string: quotes, backslashes and every control character escaped."""
+    out = []
+    for ch in text:
+        if ch in _ESCAPES:
+            out.append(_ESCAPES[ch])
+        elif ord(ch) < 0x20 or ord(ch) == 0x7F:  # TOML refuses raw control characters
+            out.append(f"\\u{ord(ch):04X}")
+        else:
+            out.append(ch)
+    return '"' + "".join(out) + '"'
+
+
 def _key(key: Any) -> str:
     if not isinstance(key, str):
         raise ParameterError(f"expected string keys, got {key!r}", "design")
-    # JSON string escapes (\" \\ \n \uXXXX ...) are all valid TOML basic-string escapes.
-    return key if _BARE.match(key) else json.dumps(key, ensure_ascii=False)
+    return key if _BARE.match(key) else _string(key)
 
 
 def _value(value: Any, path: str) -> str:
@@ -40,7 +55,7 @@ def _value(value: Any, path: str) -> str:
             return "inf" if value > 0 else "-inf"
         return repr(value)  # repr always has "." or "e": a TOML float, exact round trip
     if isinstance(value, str):
-        return json.dumps(value, ensure_ascii=False)
+        return _string(value)
     if isinstance(value, Mapping):
         inner = ", ".join(f"{_key(k)} = {_value(v, f'{path}.{k}')}" for k, v in value.items())
         return "{ " + inner + " }" if inner else "{}"

@@ -209,8 +209,12 @@ function drawScene() {
   clearGroup(layers.generators);
   layers.generators.add(lines(arrays.generators, null, 0x1f5fbf, 0.8));
   clearGroup(layers.curves);
+  let start = 0;
   for (const c of header.curves) {
-    const geom = new THREE.BufferGeometry().setFromPoints(c.points.map((p) => new THREE.Vector3(...p)));
+    const geom = new THREE.BufferGeometry();
+    geom.setAttribute('position', new THREE.BufferAttribute(
+      arrays.curve_points.slice(3 * start, 3 * (start + c.count)), 3));
+    start += c.count;
     layers.curves.add(new THREE.Line(geom, new THREE.LineBasicMaterial({ color: 0xd0308a })));
   }
   drawHandles();

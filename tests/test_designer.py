@@ -1,0 +1,332 @@
+"""Designer server without a browser: session, TOML writer, HTTP API, safety, memory."""
+
+from __future__ import annotations
+
+import http.client
+import json
+import math
+import socket
+import threading
+import time
+import tomllib
+import tracemalloc
+from pathlib import Path
+
+import numpy as np
+import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
+
+from ruledmesh import io
+from ruledmesh.design import build_design, parse_design
+from ruledmesh.errors import DesignError, ParameterError
+from ruledmesh.web.server import make_server
+from ruledmesh.web.session import Session, fan_triangles, unique_edges
+from ruledmesh.web.toml_writer import dumps
+
+ROOT = Path(__file__).resolve().parents[1]
+
+SMALL = """\
+name = "small"
+
+[curves.c1]
+type = "bspline"
+degree = 3
+points = [[0, 0, 0], [3, 1, 0], [6, -1, 0], [10, 0, 0]]
+
+[curves.c2]
+type = "polyline"
+points = [[0, 2, 4], [3, 4, 5], [6, 3, 3], [10, 3, 4]]
+
+[rulings]
+between = ["c1", "c2"]
+distribution = "parameter"
+count = 9
+
+[mesh]
+method = "pq"
+rows = 6
+"""
+
+
+def decode(data: bytes) -> tuple[dict, dict[str, np.ndarray]]:
+    """Read a designer message the way app.js does (independent of encode_message)."""
+    n = int(np.frombuffer(data[:4], "<u4")[0])
+    header = json.loads(data[4:4 + n].decode("utf-8"))
+    base = 4 + n
+    arrays = {}
+    for a in header["arrays"]:
+        dt = np.dtype(a["dtype"]).newbyteorder("<")
+        count = int(np.prod(a["shape"]))
+        arrays[a["name"]] = np.frombuffer(data, dt, count, base + a["offset"]).reshape(a["shape"])
+    return header, arrays
+
+
+def same_mesh(m1, m2) -> bool:
+    return (np.array_equal(m1.vertices, m2.vertices) and np.array_equal(m1.face_offsets, m2.face_offsets)
+            and np.array_equal(m1.face_indices, m2.face_indices)
+            and np.array_equal(m1.face_kind, m2.face_kind))
+
+
+# ---------------------------------------------------------------- TOML writer
+toml_keys = st.text(st.characters(codec="utf-8", exclude_categories=("Cs",)), min_size=1, max_size=8)
+toml_scalars = (st.integers(-2**63, 2**63 - 1) | st.floats(allow_nan=False) | st.booleans()
+                | st.text(st.characters(codec="utf-8", exclude_categories=("Cs",)), max_size=12))
+toml_values = st.recursive(toml_scalars, lambda inner: st.lists(inner, max_size=4)
+                           | st.dictionaries(toml_keys, inner, max_size=3), max_leaves=12)
+toml_docs = st.recursive(st.dictionaries(toml_keys, toml_values, max_size=4),
+                         lambda inner: st.dictionaries(toml_keys, inner | toml_values
+                                                       | st.lists(inner, min_size=1, max_size=2),
+                                                       max_size=3), max_leaves=6)
+
+
+@settings(max_examples=80, deadline=None)
+@given(toml_docs)
+def test_toml_writer_round_trips_through_tomllib(doc):
+    assert tomllib.loads(dumps(doc)) == doc
+
+
+def test_toml_writer_keeps_every_example_design():
+    for path in sorted((ROOT / "examples").glob("*.toml")):
+        data = tomllib.loads(path.read_text())
+        assert tomllib.loads(dumps(data)) == data, path.name
+
+
+def test_toml_writer_special_floats_and_refusals():
+    text = dumps({"a": math.inf, "b": -math.inf, "c": 1e-300})
+    back = tomllib.loads(text)
+    assert back["a"] == math.inf and back["b"] == -math.inf and back["c"] == 1e-300
+    assert math.isnan(tomllib.loads(dumps({"x": math.nan}))["x"])
+    with pytest.raises(ParameterError, match="cannot write object"):
+        dumps({"a": object()})
+
+
+# ---------------------------------------------------------------- geometry helpers
+def test_display_triangles_and_edges_cover_every_face():
+    s = Session(SMALL)
+    mesh = s.built.mesh
+    tris, face = fan_triangles(mesh)
+    # a k-gon gives k - 2 triangles, all from its own corners
+    assert np.array_equal(np.bincount(face, minlength=mesh.n_faces), mesh.valences - 2)
+    for t, f in zip(tris, face):
+        assert set(t) <= set(mesh.face(f))
+    assert np.array_equal(unique_edges(mesh), mesh.edges())
+
+
+# ---------------------------------------------------------------- session
+def test_session_edit_undo_redo():
+    s = Session(SMALL)
+    v0, m0 = s.version, s.built.mesh
+    s.edit([(["rulings", "count"], 12)])
+    assert s.design["rulings"]["count"] == 12 and s.version == v0 + 1
+    m1 = s.built.mesh
+    assert not same_mesh(m0, m1)
+    s.undo()
+    assert s.design["rulings"]["count"] == 9 and same_mesh(s.built.mesh, m0)
+    s.redo()
+    assert s.design["rulings"]["count"] == 12 and same_mesh(s.built.mesh, m1)
+    assert not s.can_redo
+    with pytest.raises(ParameterError, match="nothing to redo"):
+        s.redo()
+
+
+def test_session_drag_gesture_is_one_undo_step():
+    s = Session(SMALL)
+    for k in range(5):
+        s.edit([(["curves", "c1", "points", 1], [3, 1 + 0.1 * k, 0])], coalesce="drag:1")
+    s.edit([(["rulings", "count"], 10)])
+    s.undo()
+    s.undo()
+    assert s.design["curves"]["c1"]["points"][1] == [3, 1, 0]
+    assert not s.can_undo
+
+
+def test_bad_edit_is_refused_with_the_field_and_state_kept():
+    s = Session(SMALL)
+    before, v = s.design, s.version
+    with pytest.raises(DesignError, match=r"rulings\.count.*>= 3"):
+        s.edit([(["rulings", "count"], 1)])
+    with pytest.raises(DesignError, match=r"curves\.c1\.degree"):
+        s.edit([(["curves", "c1", "degree"], 9)])
+    with pytest.raises(DesignError, match="no such field"):
+        s.edit([(["curves", "c9", "points", 4], [0, 0, 0])])
+    assert s.design == before and s.version == v and not s.can_undo
+
+
+def test_save_rebuilds_the_same_mesh(tmp_path):
+    s = Session(SMALL, tmp_path / "small.toml")
+    s.edit([(["curves", "c2", "points", 2], [6.5, 3.25, 2.75]), (["mesh", "rows"], 7)])
+    path = s.save()
+    assert path == tmp_path / "small.toml"
+    rebuilt = build_design(parse_design(path.read_text(), path.name, tmp_path))
+    assert same_mesh(rebuilt.mesh, s.built.mesh)
+    with pytest.raises(ParameterError, match=r'\.toml'):
+        s.save("x.obj")
+
+
+@pytest.mark.parametrize("ext", io.formats())
+def test_export_every_format(tmp_path, ext):
+    s = Session(SMALL, tmp_path / "small.toml")
+    try:
+        path = s.export(ext)
+    except Exception as exc:  # an optional writer package missing: a clear message, no file
+        assert "optional package" in str(exc)
+        pytest.skip(f"{ext}: {exc}")
+    assert path == tmp_path / f"small{ext}" and path.stat().st_size > 0
+    if ext in io.READERS:
+        back = io.load(path)
+        mesh = s.built.mesh
+        assert back.n_faces == mesh.n_faces
+        np.testing.assert_allclose(back.vertices, mesh.vertices, rtol=0, atol=1e-9 * mesh.diagonal())
+
+
+def test_payload_matches_the_mesh():
+    s = Session(SMALL)
+    header, arrays = decode(s.payload())
+    mesh = s.built.mesh
+    np.testing.assert_array_equal(arrays["vertices"], mesh.vertices.astype(np.float32))
+    assert arrays["kind"].tolist() == mesh.face_kind.tolist()
+    assert header["figures"]["faces"] == mesh.n_faces
+    assert header["figures"]["triangles"] == int(np.count_nonzero(mesh.valences == 3))
+    assert header["design"] == s.design and header["version"] == s.version
+    paths = [h["path"] for h in header["handles"]]
+    assert ["curves", "c1", "points", 3] in paths and ["curves", "c2", "points", 0] in paths
+    assert [c["name"] for c in header["curves"]] == ["c1", "c2"]
+    assert arrays["curve_points"].shape == (sum(c["count"] for c in header["curves"]), 3)
+    assert arrays["generators"].shape == (9, 2, 3)
+
+
+# ---------------------------------------------------------------- HTTP
+@pytest.fixture
+def server(tmp_path):
+    srv = make_server(Session(SMALL, tmp_path / "small.toml"), port=0)
+    thread = threading.Thread(target=srv.serve_forever, daemon=True)
+    thread.start()
+    yield srv
+    srv.shutdown()
+    srv.server_close()
+
+
+def request(srv, method, path, body=None, headers=None, conn=None):
+    own = conn is None
+    if own:
+        conn = http.client.HTTPConnection(*srv.server_address[:2], timeout=60)
+    hdrs = {"Content-Type": "application/json"} if body is not None else {}
+    hdrs.update(headers or {})
+    conn.request(method, path, None if body is None else json.dumps(body), hdrs)
+    resp = conn.getresponse()
+    data = resp.read()
+    if own:
+        conn.close()
+    return resp.status, resp.getheader("Content-Type"), data
+
+
+def test_default_bind_is_loopback_only(server):
+    host, port = server.server_address[:2]
+    assert host == "127.0.0.1"
+    # the same port on another interface of this machine is not served
+    others = set()
+    try:
+        others = {ai[4][0] for ai in socket.getaddrinfo(socket.gethostname(), None, socket.AF_INET)}
+    except socket.gaierror:
+        pass
+    for addr in others - {"127.0.0.1"}:
+        if addr.startswith("127."):
+            continue
+        with pytest.raises(OSError):
+            socket.create_connection((addr, port), timeout=2).close()
+
+
+def test_http_page_and_api(server, tmp_path):
+    status, ctype, page = request(server, "GET", "/")
+    assert status == 200 and b"app.js" in page and ctype.startswith("text/html")
+    status, ctype, js = request(server, "GET", "/vendor/three-bundle.min.js")
+    assert status == 200 and ctype.startswith("text/javascript") and len(js) > 100_000
+    assert request(server, "GET", "/../../pyproject.toml")[0] == 404
+    status, _, data = request(server, "POST", "/api/edit", {"changes": [[["mesh", "rows"], 8]]})
+    header, arrays = decode(data)
+    assert status == 200 and header["design"]["mesh"]["rows"] == 8
+    assert server.session.design["mesh"]["rows"] == 8
+    status, ctype, data = request(server, "POST", "/api/edit", {"changes": [[["mesh", "rows"], -1]]})
+    assert status == 400 and "mesh.rows" in json.loads(data)["error"]
+    status, _, data = request(server, "POST", "/api/undo", {})
+    assert decode(data)[0]["design"]["mesh"]["rows"] == 6
+    status, _, data = request(server, "POST", "/api/export", {"format": ".ply"})
+    assert status == 200 and io.load(json.loads(data)["path"]).n_faces == server.session.built.mesh.n_faces
+    status, _, data = request(server, "POST", "/api/export", {"format": ".xyz"})
+    assert status == 400 and "known:" in json.loads(data)["error"]
+    status, _, data = request(server, "POST", "/api/save", {})
+    assert status == 200 and Path(json.loads(data)["path"]) == tmp_path / "small.toml"
+    status, _, data = request(server, "POST", "/api/design", {"toml": "[rulings\n"})
+    assert status == 400 and "invalid TOML" in json.loads(data)["error"]
+
+
+def test_slow_figures_in_worker(server):
+    version = server.session.version
+    status, _, data = request(server, "GET", f"/api/figures?version={version}")
+    header, arrays = decode(data)
+    mesh = server.session.built.mesh
+    assert status == 200 and header["version"] == version and header["error"] is None
+    assert header["figures"]["panels"] >= 1 and 0.9 < header["figures"]["coverage"] < 1.1
+    assert arrays["closeness"].shape == (mesh.n_faces,)
+    stale = decode(request(server, "GET", f"/api/figures?version={version - 1}")[2])[0]
+    assert stale["stale"] is True
+
+
+def test_refuses_foreign_hosts_and_cross_site_posts(server):
+    assert request(server, "GET", "/api/state", headers={"Host": "evil.example:80"})[0] == 403
+    status, _, _ = request(server, "POST", "/api/edit", {"changes": []},
+                           headers={"Origin": "http://evil.example"})
+    assert status == 403
+    conn = http.client.HTTPConnection(*server.server_address[:2], timeout=10)
+    conn.request("POST", "/api/undo", "{}", {"Content-Type": "text/plain"})
+    assert conn.getresponse().status == 415
+    conn.close()
+
+
+def _rss_bytes() -> int:
+    with open("/proc/self/statm") as fh:
+        return int(fh.read().split()[1]) * 4096
+
+
+def test_thousand_rapid_updates_without_memory_growth(tmp_path):
+    # A short undo history, so the traced window below sees it turn over completely.
+    server = make_server(Session(SMALL, tmp_path / "small.toml", undo_limit=10), port=0)
+    threading.Thread(target=server.serve_forever, daemon=True).start()
+    conn = http.client.HTTPConnection(*server.server_address[:2], timeout=60)
+
+    def update(k: int) -> None:
+        y = 1 + 0.5 * math.sin(k / 7)
+        body = {"changes": [[["curves", "c1", "points", 1], [3, y, 0]]],
+                "coalesce": None if k % 3 else f"drag:{k // 30}"}
+        status, _, data = request(server, "POST", "/api/edit", body, conn=conn)
+        assert status == 200, data[:200]
+
+    t0 = time.perf_counter()
+    for k in range(50):  # warm up caches and fill the (bounded) undo stack
+        update(k)
+    rss0 = _rss_bytes()
+    for k in range(50, 1150):
+        update(k)
+    rss_grown = _rss_bytes() - rss0
+    t1 = time.perf_counter()
+    # tracemalloc slows every allocation ~10x: trace a window of updates after the thousand,
+    # where any per-update leak (a kept payload, mesh or undo entry) shows as steady growth.
+    tracemalloc.start()
+    for k in range(1150, 1170):
+        update(k)
+    snap0 = tracemalloc.take_snapshot()
+    base = tracemalloc.get_traced_memory()[0]
+    for k in range(1170, 1230):
+        update(k)
+    grown = tracemalloc.get_traced_memory()[0] - base
+    stats = tracemalloc.take_snapshot().compare_to(snap0, "lineno")[:5]
+    tracemalloc.stop()
+    conn.close()
+    server.shutdown()
+    server.server_close()
+    print(f"1100 updates in {t1 - t0:.1f} s, RSS {rss_grown / 1e6:+.1f} MB, traced {grown:+d} B")
+    assert len(server.session._undo) <= 10
+    assert rss_grown < 15_000_000, rss_grown
+    assert grown < 100_000, stats
+    assert server.session.version >= 1230
