@@ -496,9 +496,15 @@ function valueAt(path) {
   return v;
 }
 
+let forceSync = false;
 function syncControls() {
+  // While later edits wait to be sent, this answer is already out of date: showing its values
+  // would move a slider back under the user's hand (and the next key press would start there).
+  if (jobs.length && !forceSync) return;
+  const force = forceSync;
+  forceSync = false;
   for (const el of $('controls').querySelectorAll('[data-path]')) {
-    if (el === activeInput || el === document.activeElement && el.type === 'text') continue;
+    if (!force && (el === activeInput || el === document.activeElement && el.type === 'text')) continue;
     const v = valueAt(el.dataset.path.split('.'));
     if (v === undefined) continue;
     if (el.type === 'checkbox') el.checked = v;
@@ -583,6 +589,7 @@ async function send(name, body) {
   } catch (err) {
     showError(err.message);
     activeInput = null;
+    forceSync = true;  // even the field just typed in shows the server's value again
     await refresh();  // show the design as the server has it (the edit was refused)
     return false;
   }
@@ -775,6 +782,7 @@ window.addEventListener('keydown', (event) => {
 // ------------------------------------------------------------------ test and debugging hooks
 window.designer = {
   version: null, renders: 0, figuresVersion: null, lastExport: null, timings,
+  busy: () => inFlight || jobs.length > 0,
   handles: () => layers.handles.children.filter((o) => o.userData.handle).map((o) => {
     const p = o.position.clone().project(camera);
     const rect = canvas.getBoundingClientRect();
