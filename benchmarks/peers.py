@@ -100,8 +100,8 @@ PEERS: list[Peer] = [
          {"iterations": 1000, "closeness_weight": 1.0}),
     Peer("mpfp-default", "mpfp", "mpfp", "mpfp.make_planar_faces",
          "50 rounds x 10 iterations, closeness 5 (defaults)", _mpfp),
-    Peer("mpfp-200rounds", "mpfp", "mpfp", "mpfp.make_planar_faces", "200 rounds x 20 iterations",
-         _mpfp, {"optimization_rounds": 200, "max_iterations": 20}),
+    Peer("mpfp-100rounds", "mpfp", "mpfp", "mpfp.make_planar_faces", "100 rounds x 20 iterations",
+         _mpfp, {"optimization_rounds": 100, "max_iterations": 20}),
 ]
 
 

@@ -49,7 +49,7 @@ MODES = {
                  latency_n=20, latency_repeats=3, ratio_repeats=1, peer_surfaces=["skew"]),
     "quick": dict(rm=[12, 20, 100], peer=[12], configs="default", timeout=15.0, scaling=[45, 141, 447],
                   ratio=1000, latency_n=100, latency_repeats=20, ratio_repeats=1),
-    "full": dict(rm=[12, 20, 100, 300, 1000], peer=[12, 20, 100], configs="all", timeout=90.0,
+    "full": dict(rm=[12, 20, 100, 300, 1000], peer=[12, 20, 100], configs="all", timeout=60.0,
                  scaling=[45, 141, 447, 1414, 4472], ratio=1000, latency_n=100, latency_repeats=50,
                  ratio_repeats=3),
 }
