@@ -330,3 +330,48 @@ def test_thousand_rapid_updates_without_memory_growth(tmp_path):
     assert rss_grown < 15_000_000, rss_grown
     assert grown < 100_000, stats
     assert server.session.version >= 1230
+
+
+# ---------------------------------------------------------------- command line
+def start_cli(*args: str):
+    """``ruledmesh design ARGS --no-browser`` in its own process; returns (process, url)."""
+    import re
+    import subprocess
+    import sys
+
+    proc = subprocess.Popen([sys.executable, "-m", "ruledmesh.cli", "design", *args, "--no-browser"],
+                            stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    line = proc.stdout.readline()
+    match = re.search(r"http://\S+", line)
+    if not match:
+        proc.kill()
+        raise AssertionError(f"no URL printed: {line!r} {proc.stderr.read()!r}")
+    return proc, match.group(0)
+
+
+def test_cli_serves_on_loopback_and_stops_on_sigterm(tmp_path):
+    from urllib.request import urlopen
+
+    design = tmp_path / "small.toml"
+    design.write_text(SMALL)
+    proc, url = start_cli(str(design))
+    try:
+        assert url.startswith("http://127.0.0.1:")
+        header, _ = decode(urlopen(url + "api/state", timeout=30).read())
+        assert header["path"] == str(design) and header["design"]["rulings"]["count"] == 9
+    finally:
+        proc.terminate()
+        code = proc.wait(timeout=30)
+    assert code == 0, proc.stderr.read()
+
+
+def test_cli_refuses_bad_input(tmp_path, capsys):
+    from ruledmesh.cli import main
+
+    assert main(["design", str(tmp_path / "missing.toml"), "--no-browser"]) == 2
+    assert "no such design file" in capsys.readouterr().err
+    assert main(["design", "--port", "70000", "--no-browser"]) == 2
+    bad = tmp_path / "bad.toml"
+    bad.write_text(SMALL.replace("count = 9", "count = 1"))
+    assert main(["design", str(bad), "--no-browser"]) == 2
+    assert "rulings.count" in capsys.readouterr().err

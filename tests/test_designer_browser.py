@@ -8,7 +8,10 @@ when ``/usr/bin/chromium`` or the ``playwright`` package is missing.
 from __future__ import annotations
 
 import os
+import re
 import statistics
+import subprocess
+import sys
 import threading
 from pathlib import Path
 
@@ -102,6 +105,18 @@ def picture(pg) -> np.ndarray:
     pg.evaluate("() => new Promise(requestAnimationFrame)")
     data = pg.evaluate(PIXELS_JS, [160, 100])
     return np.array(data, dtype=np.uint8).reshape(100, 160, 4)[..., :3].astype(np.int16)
+
+
+def start_cli(*args: str):
+    """``ruledmesh design ARGS --no-browser`` in its own process; returns (process, url)."""
+    proc = subprocess.Popen([sys.executable, "-m", "ruledmesh.cli", "design", *args, "--no-browser"],
+                            stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    line = proc.stdout.readline()
+    match = re.search(r"http://\S+", line)
+    if not match:
+        proc.kill()
+        raise AssertionError(f"no URL printed: {line!r} {proc.stderr.read()!r}")
+    return proc, match.group(0)
 
 
 def wait_version(pg, above: int) -> int:
@@ -206,13 +221,16 @@ def test_saved_design_rebuilds_the_same_mesh(page, designer, tmp_path):
 
 
 def test_update_latency_100_by_100(browser, tmp_path):
-    """Slider step to redrawn view for a 100 x 100 mesh (the issue asks for < 100 ms)."""
-    text = DESIGN.replace("count = 15", "count = 101").replace("rows = 12", "rows = 100")
-    server = make_server(Session(text, tmp_path / "big.toml"), port=0)
-    threading.Thread(target=server.serve_forever, daemon=True).start()
+    """Slider step to redrawn view for a 100 x 100 mesh (the issue asks for < 100 ms).
+
+    The server runs as a user starts it (``ruledmesh design``, its own process).
+    """
+    design = tmp_path / "big.toml"
+    design.write_text(DESIGN.replace("count = 15", "count = 101").replace("rows = 12", "rows = 100"))
+    proc, url = start_cli(str(design))
     pg = browser.new_page()
     try:
-        pg.goto(server.url)
+        pg.goto(url)
         pg.wait_for_selector("body[data-version]", timeout=30_000)
         slider = pg.locator('input[type=range][data-path="mesh.rows"]')
         slider.focus()
@@ -220,12 +238,16 @@ def test_update_latency_100_by_100(browser, tmp_path):
             v = pg.evaluate("window.designer.version")
             pg.keyboard.press(key)
             wait_version(pg, v)
-        times = pg.evaluate("window.designer.timings.slice(-12)")
+        steps = pg.evaluate("window.designer.breakdown.slice(-12)")
+        faces = int(pg.inner_text("[data-fig=faces]"))
     finally:
         pg.close()
-        server.shutdown()
-        server.server_close()
-    median = statistics.median(times)
-    print(f"100 x 100 update: median {median:.0f} ms, min {min(times):.0f} ms, max {max(times):.0f} ms")
+        proc.terminate()
+        proc.wait(timeout=30)
+    total = statistics.median(s["total"] for s in steps)
+    server = statistics.median(s["server"] for s in steps)
+    print(f"100 x 100 ({faces} faces) update: median {total:.0f} ms (server {server:.0f} ms), "
+          f"min {min(s['total'] for s in steps):.0f} ms; load {os.getloadavg()[0]:.1f}")
+    assert faces > 5000
     # A generous bound so a loaded CI machine does not fail; docs/designer.md has the figure.
-    assert median < 400
+    assert total < 400

@@ -51,10 +51,21 @@ def run(args) -> int:
         import webbrowser
 
         webbrowser.open(server.url)
+    import signal
+
+    def stop(signum, frame):  # SIGTERM: shut down like Ctrl+C (stops the figures process too)
+        raise KeyboardInterrupt
+
+    try:
+        previous = signal.signal(signal.SIGTERM, stop)
+    except ValueError:  # not the main thread (e.g. called from a test): leave signals alone
+        previous = None
     try:
         server.serve_forever()
     except KeyboardInterrupt:
         print("ruledmesh designer: stopped", file=sys.stderr)
     finally:
         server.server_close()
+        if previous is not None:
+            signal.signal(signal.SIGTERM, previous)
     return 0

@@ -38,11 +38,15 @@ def _worker_main(conn) -> None:  # pragma: no cover - runs in the child process
         try:
             built = build_design(Design(data, source, Path(base_dir)))
             figures, per_face = slow_figures(built)
-            conn.send((version, figures, per_face, None))
+            reply = (version, figures, per_face, None)
         except RuledMeshError as exc:
-            conn.send((version, {}, None, str(exc)))
+            reply = (version, {}, None, str(exc))
         except Exception as exc:  # noqa: BLE001 - reported to the page, never a dead worker
-            conn.send((version, {}, None, f"internal error: {type(exc).__name__}: {exc}"))
+            reply = (version, {}, None, f"internal error: {type(exc).__name__}: {exc}")
+        try:
+            conn.send(reply)
+        except OSError:  # the server went away: nobody to answer
+            return
 
 
 class FigureWorker:

@@ -29,6 +29,7 @@ import ipaddress
 import json
 import mimetypes
 import threading
+import time
 from http import HTTPStatus
 from http.server import BaseHTTPRequestHandler, ThreadingHTTPServer
 from importlib import resources
@@ -86,6 +87,14 @@ class DesignerServer(ThreadingHTTPServer):
         self.static_root = _static_root()
         self._figures: FigureWorker | None = None
         self._figures_lock = threading.Lock()
+
+    def handle_error(self, request, client_address) -> None:
+        """A client that went away mid-answer is normal (page reloaded); others go to stderr."""
+        import sys
+
+        if isinstance(sys.exc_info()[1], (BrokenPipeError, ConnectionResetError)):
+            return
+        super().handle_error(request, client_address)
 
     @property
     def url(self) -> str:
@@ -185,6 +194,7 @@ class _Handler(BaseHTTPRequestHandler):
 
     # ------------------------------------------------------------ dispatch
     def _handle(self, method: str) -> None:
+        self._started = time.perf_counter()
         try:
             self._check_host()
             url = urlsplit(self.path)
@@ -238,7 +248,11 @@ class _Handler(BaseHTTPRequestHandler):
 
     # ------------------------------------------------------------ API
     def _state(self) -> None:
-        self._send(HTTPStatus.OK, self.server.session.payload(), "application/octet-stream")
+        body = self.server.session.payload()
+        ms = (time.perf_counter() - self._started) * 1000
+        # Server-Timing lets the page tell server time (build + encode) from its own.
+        self._send(HTTPStatus.OK, body, "application/octet-stream",
+                   {"Server-Timing": f"app;dur={ms:.1f}"})
 
     def _get_state(self, query: dict) -> None:
         self._state()

@@ -249,6 +249,7 @@ class _Snapshot:
     design: dict
     built: Built
     version: int
+    toml: str
 
 
 class Session:
@@ -282,7 +283,7 @@ class Session:
         design = parse_design(DEFAULT_DESIGN if text is None else text, self.source, self.base_dir)
         data = _plain(design.data)
         self._lock = threading.RLock()
-        self._current = _Snapshot(data, self._build(data), 0)
+        self._current = _Snapshot(data, self._build(data), 0, dumps(data))
         self._undo: list[dict] = []
         self._redo: list[dict] = []
         self._coalesce: str | None = None
@@ -320,8 +321,9 @@ class Session:
     def _build(self, data: dict) -> Built:
         return build_design(Design(data, self.source, self.base_dir))
 
-    def _make_current(self, data: dict, built: Built) -> None:
-        self._current = _Snapshot(data, built, self._current.version + 1)
+    def _make_current(self, data: dict, built: Built, text: str | None = None) -> None:
+        self._current = _Snapshot(data, built, self._current.version + 1,
+                                  dumps(data) if text is None else text)
 
     # ------------------------------------------------------------- edits
     def replace(self, data: Mapping[str, Any], coalesce: str | None = None) -> int:
@@ -344,7 +346,8 @@ class Session:
             raise DesignError(f"expected a table, got {type(data).__name__}", "design")
         candidate = _plain(data)
         # Parsing the TOML we would save checks the top level and that the design can be written.
-        parse_design(dumps(candidate), self.source, self.base_dir)
+        text = dumps(candidate)
+        parse_design(text, self.source, self.base_dir)
         # Edits are built one at a time, so they apply in the order they arrive.
         with self._lock:
             built = self._build(candidate)
@@ -353,7 +356,7 @@ class Session:
                 del self._undo[:-self.undo_limit]
             self._coalesce = coalesce
             self._redo.clear()
-            self._make_current(candidate, built)
+            self._make_current(candidate, built, text)
             return self.version
 
     def edit(self, changes: Sequence[tuple[Sequence[str | int], Any]],
@@ -405,7 +408,7 @@ class Session:
     # ------------------------------------------------------------- files
     def toml(self) -> str:
         """The current design as TOML text."""
-        return dumps(self._current.design)
+        return self._current.toml
 
     def _target(self, path: str | Path | None, suffix: str) -> Path:
         if path:

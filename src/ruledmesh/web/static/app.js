@@ -41,7 +41,10 @@ async function api(method, name, body) {
     return data;
   }
   if (!response.ok) throw new Error(`${response.status} ${response.statusText}`);
-  return decode(await response.arrayBuffer());
+  const msg = decode(await response.arrayBuffer());
+  const timing = /dur=([0-9.]+)/.exec(response.headers.get('Server-Timing') || '');
+  msg.serverMs = timing ? parseFloat(timing[1]) : null;
+  return msg;
 }
 
 // ------------------------------------------------------------------ status
@@ -552,6 +555,7 @@ let inFlight = false;
 const jobs = [];      // edits waiting to be sent: {changes: Map key -> [path, value], coalesce}
 let sentAt = 0;
 const timings = [];
+const breakdown = [];  // {total, server, page} ms per edit
 
 // Edits go one at a time; while one is on its way, later moves of the same gesture merge
 // (only the newest position matters), so a fast drag never builds a backlog.
@@ -579,12 +583,14 @@ async function send(name, body) {
   sentAt = performance.now();
   try {
     const msg = await api('POST', name, body || {});
+    const received = performance.now();
     showError('');
     applyState(msg);
     const ms = performance.now() - sentAt;
     timings.push(ms);
-    if (timings.length > 50) timings.shift();
-    status(`updated in ${ms.toFixed(0)} ms`);
+    breakdown.push({ total: ms, server: msg.serverMs, page: performance.now() - received });
+    if (timings.length > 50) { timings.shift(); breakdown.shift(); }
+    status(`updated in ${ms.toFixed(0)} ms (server ${msg.serverMs?.toFixed(0)} ms)`);
     return true;
   } catch (err) {
     showError(err.message);
@@ -781,7 +787,7 @@ window.addEventListener('keydown', (event) => {
 
 // ------------------------------------------------------------------ test and debugging hooks
 window.designer = {
-  version: null, renders: 0, figuresVersion: null, lastExport: null, timings,
+  version: null, renders: 0, figuresVersion: null, lastExport: null, timings, breakdown,
   busy: () => inFlight || jobs.length > 0,
   handles: () => layers.handles.children.filter((o) => o.userData.handle).map((o) => {
     const p = o.position.clone().project(camera);
