@@ -349,7 +349,21 @@ def _repair(V: np.ndarray, faces: list[np.ndarray], members: np.ndarray, member_
                     out.append(f)
         return out
 
-    for z in np.nonzero(np.r_[flat_q, flat_t])[0].tolist():
+    flat_ids = np.nonzero(np.r_[flat_q, flat_t])[0]
+    # Flat faces back to back with the same corners (two triangles across a generator
+    # that both neighbours cross at one point) simply vanish together: their other
+    # neighbours then share the edges, and splitting by each other would stack faces.
+    sets = [tuple(sorted(set(current(int(z))))) for z in flat_ids]
+    seen: dict[tuple, int] = {}
+    for s_ in sets:
+        seen[s_] = seen.get(s_, 0) + 1
+    for z, s_ in zip(flat_ids.tolist(), sets):
+        if seen[s_] > 1:
+            alive[z] = False
+            dropped += 1
+    for z in flat_ids.tolist():
+        if not alive[z]:
+            continue
         poly = current(z)
         P = V[poly]
         alive[z] = False
@@ -490,13 +504,13 @@ def hybrid_mesh(a: Any, b: Any, *, midpoints: int = 1, divisions: int = 8, flip:
     A = np.where(reversed_[:, None], b, a)
     B = np.where(reversed_[:, None], a, b)
 
+    K = k + 1
     X = hybrid_grid(A, B, n, k).reshape(-1, 3)
     quads, tris, vertex = checkerboard_faces(C, k, n, flip)
     members, member_id = _generator_members(vertex, n, k + 1)
     quads, tris, members, member_id, dropped = _repair(X, [quads, tris], members, member_id,
                                                        scale, tol)
 
-    K = k + 1
     col = np.arange(len(X)) // K
     v = (np.arange(len(X)) % K) / k
     on_gen = col % n == 0
@@ -505,13 +519,25 @@ def hybrid_mesh(a: Any, b: Any, *, midpoints: int = 1, divisions: int = 8, flip:
     faces = np.concatenate([quads.ravel(), tris.ravel()])
     offsets = np.r_[np.arange(len(quads) + 1) * 4, 4 * len(quads) + np.arange(1, len(tris) + 1) * 3]
     kinds = np.r_[np.full(len(quads), FaceKind.QUAD), np.full(len(tris), FaceKind.TRIANGLE)]
-    warnings = []
+    warnings: list[str] = []
     if dropped:
         warnings.append(f"hybrid: removed {dropped} collapsed faces where generators meet "
                         "(shared end points or crossings at division points)")
+    # Where the end of a neighbour lies inside a generator the strip has zero width along
+    # part of it; that part bounds no face and cannot be a chain of mesh edges there.
+    e = np.concatenate([np.stack([quads, np.roll(quads, -1, axis=1)], axis=2).reshape(-1, 2),
+                        np.stack([tris, np.roll(tris, -1, axis=1)], axis=2).reshape(-1, 2)])
+    e.sort(axis=1)
+    mm = np.sort(members, axis=1)
+    size = len(X)
+    is_edge = np.isin(mm[:, 0] * size + mm[:, 1], e[:, 0] * size + e[:, 1])
+    bare_gens = sorted(set(member_id[~is_edge].tolist())) if not flip else []
+    if bare_gens:
+        warnings.append(f"hybrid: generators {bare_gens}: a segment is not a mesh edge (a "
+                        "neighbouring generator ends inside it or folds onto it); it stays a member")
     info = {"construction": "hybrid", "midpoints": midpoints, "divisions": divisions,
             "flip": flip, "reversed_generators": np.nonzero(reversed_)[0].tolist(),
-            "collapsed_faces": dropped, "warnings": warnings}
+            "collapsed_faces": dropped, "bare_generators": bare_gens, "warnings": warnings}
     mesh = Mesh(X, offsets.astype(np.int64), faces.astype(np.int64), kinds.astype(np.uint8),
                 members.astype(np.int64), member_id.astype(np.int64),
                 {"t": t, "generator": gen, "u": col / n}, info)
