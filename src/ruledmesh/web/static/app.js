@@ -265,7 +265,7 @@ function fitView() {
 // ------------------------------------------------------------------ figures
 const fmt = (v, digits = 3) => (typeof v === 'number'
   ? (Math.abs(v) !== 0 && (Math.abs(v) < 1e-3 || Math.abs(v) >= 1e6) ? v.toExponential(2)
-    : String(+v.toFixed(digits))) : String(v));
+    : String(+v.toPrecision(digits + 1))) : String(v));
 
 function setFig(name, text, pending = false) {
   const cell = document.querySelector(`[data-fig="${name}"]`);
