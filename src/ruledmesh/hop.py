@@ -100,14 +100,19 @@ def landing_maps(a0, d0, a1, d1, a2, d2) -> np.ndarray:
         Not normalised; ``det H`` is the product of the coplanarity
         determinants of (g0, g1) and (g1, g2), zero for a torsal pair.
     """
+    # Written with the differences d0 - d1 and d2 - d1 (d1 x d1 = 0 and both
+    # normals are orthogonal to d1): for finely sampled generators these are
+    # small and exact, where d1 x d0 of nearly parallel directions would lose
+    # relative accuracy in proportion to the sampling step.
     n0 = np.cross(d1, a1 - a0)
-    n1 = np.cross(d1, d0)
+    n1 = np.cross(d1, d0 - d1)
     w = a1 - a2
+    dd = d2 - d1
     H = np.empty((len(a0), 2, 2))
     H[:, 0, 0] = -_dot(n1, w)
     H[:, 0, 1] = _dot(n0, w)
-    H[:, 1, 0] = -_dot(n1, d2)
-    H[:, 1, 1] = _dot(n0, d2)
+    H[:, 1, 0] = -_dot(n1, dd)
+    H[:, 1, 1] = _dot(n0, dd)
     return H
 
 

@@ -196,6 +196,76 @@ class _Run:
     centre_gen: np.ndarray    # (F,) generator index of each centre (global)
 
 
+def _unit_det(H: np.ndarray) -> np.ndarray:
+    """Scale 2x2 maps to |det| = 1 (rows then neither grow nor shrink on average)."""
+    det = np.abs(H[:, 0, 0] * H[:, 1, 1] - H[:, 0, 1] * H[:, 1, 0])
+    scale = np.sqrt(np.where(det > 0, det, np.abs(H).max(axis=(1, 2)) ** 2 + 1e-300))
+    return H / scale[:, None, None]
+
+
+def _propagate(a: np.ndarray, d: np.ndarray, primary: int, tau: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Homogeneous row parameters on every generator, hop by hop.
+
+    Each vertex is the exact image (one rounding) of its neighbour two
+    generators back, so the hop-line diagonal of every face meets its generator
+    to rounding, however many generators the chain crosses.  (Composing the
+    maps first and evaluating them once is faster but lets rounding drift
+    between neighbours: 2e-11 after a thousand hops.)
+
+    Parameters
+    ----------
+    a, d : (m, 3) float64
+    primary : int
+    tau : (m, H) float64
+        Row parameter on the primary generator, per generator's row parity.
+
+    Returns
+    -------
+    num, den : (m, H) float64
+        ``t = num / den``; ``den`` changes sign where a row passes infinity.
+    """
+    m = len(a)
+    if primary + 2 >= m and primary - 2 < 0:
+        primary = 0
+    fwd = _unit_det(landing_maps(a[:-2], d[:-2], a[1:-1], d[1:-1], a[2:], d[2:]))
+    bwd = _unit_det(landing_maps(a[2:], d[2:], a[1:-1], d[1:-1], a[:-2], d[:-2]))
+    root = primary + 1 if primary + 2 < m else primary - 1
+    far_side = root + 1 if root > primary else root - 1
+    C = _unit_det(crossing_maps(a[primary:primary + 1], d[primary:primary + 1], a[root:root + 1],
+                                d[root:root + 1], a[far_side:far_side + 1], d[far_side:far_side + 1]))[0]
+    num = np.empty_like(tau)
+    den = np.empty_like(tau)
+    num[primary], den[primary] = tau[primary], 1.0
+    num[root] = C[0, 0] * tau[root] + C[0, 1]
+    den[root] = C[1, 0] * tau[root] + C[1, 1]
+    # Fronts: (generator, step) for the four chain ends, advanced together.
+    fronts = [(primary, 2), (root, 2), (primary, -2), (root, -2)]
+    k = 0
+    while True:
+        src, dst, Hs = [], [], []
+        for g0, step in fronts:
+            g = g0 + step * (k + 1)
+            if 0 <= g < m:
+                src.append(g - step)
+                dst.append(g)
+                Hs.append(fwd[g - 2] if step > 0 else bwd[g])
+        if not dst:
+            break
+        Hm = np.array(Hs)
+        ps, qs = num[src], den[src]
+        nn = Hm[:, 0, 0, None] * ps + Hm[:, 0, 1, None] * qs
+        dd = Hm[:, 1, 0, None] * ps + Hm[:, 1, 1, None] * qs
+        if k % 8 == 7:
+            # Positive rescaling per row keeps the homogeneous pair finite and its sign.
+            sc = np.maximum(np.abs(nn), np.abs(dd))
+            sc[sc == 0] = 1.0
+            nn /= sc
+            dd /= sc
+        num[dst], den[dst] = nn, dd
+        k += 1
+    return num, den
+
+
 def _mesh_run(a: np.ndarray, d: np.ndarray, first: int, primary: int, rows: int, option: int,
               extend, max_extend: float, tol: Tolerances, scale: float,
               warnings: list[str]) -> _Run:
@@ -214,8 +284,7 @@ def _mesh_run(a: np.ndarray, d: np.ndarray, first: int, primary: int, rows: int,
     i_idx = np.arange(m)
     s = (option - i_idx - j0) % 2
     tau = (j0 + s[:, None] + 2 * np.arange(H)[None, :]) / rows          # (m, H)
-    num = M[:, 0, 0, None] * tau + M[:, 0, 1, None]
-    den = M[:, 1, 0, None] * tau + M[:, 1, 1, None]
+    num, den = _propagate(a, d, primary, tau)
     # Far limit in t: tol.far patch diagonals along each generator.
     glen = np.linalg.norm(d, axis=1)
     tmax = tol.far * scale / np.maximum(glen, 1e-300)
@@ -223,8 +292,7 @@ def _mesh_run(a: np.ndarray, d: np.ndarray, first: int, primary: int, rows: int,
     t = np.where(far, 0.0, num / np.where(far, 1.0, den))
     X = a[:, None, :] + t[..., None] * d[:, None, :]
     vid = np.arange(m * H).reshape(m, H)
-    # Centres (i, j) of the other colour on every generator: on g_i the vertex rows
-    # around centre c are h = c - 1 + (1 - s_i) ... written as h_lo = c + s_i - 1 + ... below.
+    # Centres (i, j) of the other colour on every generator g_i.
     cc = np.arange(H)
     jc = j0 + (1 - s)[:, None] + 2 * cc[None, :]                       # (m, H) centre rows
     h_lo = (jc - 1 - j0 - s[:, None]) // 2                              # vertex row j-1 on g_i
@@ -241,7 +309,7 @@ def _mesh_run(a: np.ndarray, d: np.ndarray, first: int, primary: int, rows: int,
     # A row passes through infinity inside a face when the homogeneous denominator
     # changes sign between the face's two rows on its generator g_i.  (Signs on
     # different generators are not comparable: M and -M are the same map.)
-    sg = np.sign(den)
+    sg = np.signbit(den)
     pole = sg[ic, hl] != sg[ic, hl + 1]
     gen = np.repeat(np.arange(first, first + m), H)
     return _Run(X.reshape(-1, 3), t.reshape(-1), gen, far.reshape(-1), left, right, pole,
@@ -352,6 +420,10 @@ def pq_mesh(a, b, rows: int = 20, primary: int | str = "middle", option: int = 0
             raise ParameterError(f'expected "auto" or a number >= 0, got {describe(extend)}', "extend")
         extend = check_float(extend, "extend", lo=0.0, hi=1e3)
     max_extend = check_float(max_extend, "max_extend", lo=0.0, hi=1e3)
+    if m * (rows + 1) > MAX_GRID_POINTS:
+        need = m * (rows + 1) * _BYTES_PER_GRID_POINT / 2**30
+        raise GeometryError(f"{m} generators x {rows + 1} rows would need at least "
+                            f"{need:.1f} GiB; reduce the generator count or the rows")
     d = b - a
     lo, hi = np.minimum(a.min(0), b.min(0)), np.maximum(a.max(0), b.max(0))
     scale = float(np.linalg.norm(hi - lo))
