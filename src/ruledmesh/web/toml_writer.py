@@ -17,7 +17,7 @@ from ..errors import ParameterError
 
 __all__ = ["dumps"]
 
-_BARE = re.compile(r"^[A-Za-z0-9_-]+$")
+_BARE = re.compile(r"[A-Za-z0-9_-]+")
 
 
 _ESCAPES = {'"': '\\"', "\\": "\\\\", "\b": "\\b", "\t": "\\t", "\n": "\\n",
@@ -40,7 +40,7 @@ def _string(text: str) -> str:
 def _key(key: Any) -> str:
     if not isinstance(key, str):
         raise ParameterError(f"expected string keys, got {key!r}", "design")
-    return key if _BARE.match(key) else _string(key)
+    return key if _BARE.fullmatch(key) else _string(key)
 
 
 def _value(value: Any, path: str) -> str:

@@ -451,7 +451,7 @@ function defaultDirectrix() {
   const along = last.sub(first).normalize();
   const dir = b.clone().sub(a);
   const normal = along.clone().cross(dir).normalize();
-  const mid = a.clone().add(b).multiplyScalar(0.5).addScaledVector(normal, size);
+  const mid = a.clone().add(b).multiplyScalar(0.5).addScaledVector(normal, 0.5 * size);
   const round = (v) => v.toArray().map((x) => +x.toFixed(4));
   return [round(mid.clone().addScaledVector(dir, -0.5)), round(mid.clone().addScaledVector(dir, 0.5))];
 }
