@@ -119,6 +119,8 @@ def _build(design: Design) -> Built:
         method = mesh_table.get("method", "pq")
         if method not in MESH_METHODS:
             raise _unknown("mesh.method", method, MESH_METHODS)
+        if method == "pq":
+            _check_budget(len(rulings), mesh_table.get("rows", 20))
         built = MESH_METHODS[method](rulings, mesh_table, ctx)
     transforms = data.get("transform", [])
     if not isinstance(transforms, list):
@@ -132,6 +134,24 @@ def _build(design: Design) -> Built:
             raise _unknown(f"{path}.type", kind, TRANSFORMS)
         built = TRANSFORMS[kind](built, table, path)
     return built
+
+
+# Refuse builds whose estimated peak memory exceeds this, before allocating anything.
+MAX_BUILD_BYTES = 8 * 2**30
+
+
+def _check_budget(generators: int, rows: Any) -> None:
+    """Refuse a §4.3 grid of ``generators x (rows + 1)`` points too large to build."""
+    from .rulings import BUILD_BYTES_PER_GRID_POINT
+
+    if isinstance(rows, bool) or not isinstance(rows, int) or rows < 1:
+        return  # the mesher reports a malformed value itself
+    need = generators * (rows + 1) * BUILD_BYTES_PER_GRID_POINT
+    if need > MAX_BUILD_BYTES:
+        raise DesignError(
+            f"{generators} generators x {rows + 1} rows would need about {need / 2**30:.1f} GiB "
+            f"of memory (limit {MAX_BUILD_BYTES / 2**30:.0f} GiB); reduce the rows or the "
+            "generator count", "mesh.rows")
 
 
 def _unknown(path: str, value: Any, table: Mapping) -> DesignError:

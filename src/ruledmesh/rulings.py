@@ -905,6 +905,23 @@ def from_csv(path: str | os.PathLike, *, tol: Tolerances = DEFAULT) -> Rulings:
 # --------------------------------------------------------------------------
 
 _SOURCES = ("between", "lines", "file", "conoid")
+
+# Most generators a design may ask for.  Measured peak memory of ``ruledmesh
+# build`` (mesh, analysis against the smooth surface, export) is about 1 KiB per
+# grid point, i.e. per generator and row: 10^5 generators at the default 20 rows
+# already need ~2 GiB, a million ~20 GiB.  Refusing up front beats an
+# out-of-memory kill halfway through.
+MAX_GENERATORS = 100_000
+BUILD_BYTES_PER_GRID_POINT = 1024
+
+
+def _too_many(n: int, what: str, where: str, err: type = DesignError) -> None:
+    """Refuse ``n`` generators above :data:`MAX_GENERATORS`, saying what they would need."""
+    if n > MAX_GENERATORS:
+        need = n * 21 * BUILD_BYTES_PER_GRID_POINT / 2**30
+        raise err(f"expected at most {MAX_GENERATORS} {what}, got {n}: meshing them would need "
+                  f"about {need:.1f} GiB of memory at the default 20 rows "
+                  f"(~{BUILD_BYTES_PER_GRID_POINT} bytes per generator and row)", where)
 _RULINGS_KEYS = ("between", "distribution", "director_plane", "directrix", "count", "lines",
                  "file", "conoid")
 
@@ -967,7 +984,9 @@ def rulings_from_spec(spec: Mapping, curves: Mapping[str, Curve], *, path: str =
         if "count" not in spec:
             raise E("missing; expected an integer >= 3 (the number of generators)",
                     f"{path}.count")
-        return check_int(spec["count"], f"{path}.count", lo=3, err=E)
+        n = check_int(spec["count"], f"{path}.count", lo=3, err=E)
+        _too_many(n, "generators", f"{path}.count", E)
+        return n
 
     try:
         if source in ("lines", "file"):
@@ -984,6 +1003,7 @@ def rulings_from_spec(spec: Mapping, curves: Mapping[str, Curve], *, path: str =
                             f"{describe(raw)}", f"{path}.lines")
                 if not np.all(np.isfinite(arr)):
                     raise E("expected finite coordinates, got NaN or infinity", f"{path}.lines")
+                _too_many(len(arr), "lines", f"{path}.lines", E)
                 return from_lines(arr)
             fname = spec["file"]
             if not isinstance(fname, str) or not fname:
@@ -992,7 +1012,9 @@ def rulings_from_spec(spec: Mapping, curves: Mapping[str, Curve], *, path: str =
             if not os.path.isfile(full):
                 raise E(f'no such file "{fname}" (looked in {os.fspath(base_dir)})',
                         f"{path}.file")
-            return from_csv(full)
+            rulings = from_csv(full)
+            _too_many(len(rulings), "lines (rows)", f"{path}.file", E)
+            return rulings
 
         if source == "conoid":
             refuse("distribution", "director_plane", "directrix",
