@@ -466,10 +466,10 @@ def pq_mesh(a, b, rows: int = 20, primary: int | str = "middle", option: int = 0
                         scale, warnings)
         run_of[r0:r1] = len(parts)
         parts.append(run)
-    return _assemble(parts, a, d, rows, trim, tol, warnings, bounds, run_of)
+    return _assemble(parts, a, d, rows, trim, tol, warnings, bounds, run_of, scale)
 
 
-def _assemble(parts, a, d, rows, trim, tol, warnings, bounds, run_of) -> Mesh:
+def _assemble(parts, a, d, rows, trim, tol, warnings, bounds, run_of, scale) -> Mesh:
     """Join the runs; keep convex quads and valid halves; fill the gaps; add members."""
     from .analysis.faces import quad_diagonal_crossing
 
@@ -491,8 +491,10 @@ def _assemble(parts, a, d, rows, trim, tol, warnings, bounds, run_of) -> Mesh:
     ok_l = (L[:, 0] >= 0) & ~POLE & good_v[np.maximum(L, 0)].all(axis=1)
     ok_r = (R[:, 0] >= 0) & ~POLE & good_v[np.maximum(R, 0)].all(axis=1)
     if trim:
-        V, T, G, ok_l, ok_r, fill = _strip_paths(V, T, G, good_v, a, d, m, L, R, ok_l, ok_r, CG)
+        V, T, G, ok_l, ok_r, fill, chain, gstart = _strip_paths(V, T, G, good_v, a, d, m, L, R,
+                                                                 ok_l, ok_r, CG, scale)
     else:
+        chain = gstart = None
         # Untrimmed: rows must still increase along each generator inside a face.
         ok_l &= T[np.maximum(L[:, 2], 0)] > T[np.maximum(L[:, 1], 0)]
         ok_r &= T[np.maximum(R[:, 2], 0)] > T[np.maximum(R[:, 0], 0)]
@@ -523,7 +525,7 @@ def _assemble(parts, a, d, rows, trim, tol, warnings, bounds, run_of) -> Mesh:
     if dropped:
         warnings.append(f"{dropped} half-faces ran against the order of their strip (rows reversing "
                         "or overlapping) and were replaced by fill triangles")
-    return _to_mesh(V, T, G, faces, kinds, warnings)
+    return _to_mesh(V, T, G, faces, kinds, warnings, chain, gstart, scale)
 
 
 def _group_starts(keys: np.ndarray) -> np.ndarray:
@@ -531,7 +533,51 @@ def _group_starts(keys: np.ndarray) -> np.ndarray:
     return np.r_[True, keys[1:] != keys[:-1]] if keys.size else np.zeros(0, bool)
 
 
-def _strip_paths(V, T, G, good_v, a, d, m, L, R, ok_l, ok_r, CG):
+def _chains(V, T, G, good_v, a, d, m, scale):
+    """Each generator's vertices inside the patch, with director points, sorted by t.
+
+    Returns
+    -------
+    V, T, G : arrays with the director points appended
+    chain : (n,) int64
+        Vertex ids, generator by generator, increasing t.
+    gstart : (m + 1,) int64
+        Start of each generator's chain in ``chain``.
+    """
+    eps = 1e-12
+    inside = np.flatnonzero(good_v)
+    gi, ti = G[inside], T[inside]
+    has0 = np.zeros(m, bool)
+    has1 = np.zeros(m, bool)
+    has0[gi[ti <= eps]] = True
+    has1[gi[ti >= 1 - eps]] = True
+    new0, new1 = np.flatnonzero(~has0), np.flatnonzero(~has1)
+    base = len(V)
+    V = np.concatenate([V, a[new0], a[new1] + d[new1]])
+    T = np.concatenate([T, np.zeros(len(new0)), np.ones(len(new1))])
+    G = np.concatenate([G, new0, new1])
+    # Grid vertices are stored generator by generator in row order; when t grows
+    # with the row on every generator (the usual case) that order is the chain.
+    same = gi[1:] == gi[:-1]
+    if np.all(ti[1:][same] > ti[:-1][same]):
+        counts = np.bincount(gi, minlength=m)
+        first = np.cumsum(counts) - counts
+        need0, need1 = (~has0).astype(np.int64), (~has1).astype(np.int64)
+        clen = counts + need0 + need1
+        gstart = np.zeros(m + 1, np.int64)
+        np.cumsum(clen, out=gstart[1:])
+        chain = np.empty(int(gstart[-1]), np.int64)
+        chain[gstart[:-1][gi] + need0[gi] + np.arange(len(inside)) - first[gi]] = inside
+        chain[gstart[new0]] = base + np.arange(len(new0))
+        chain[gstart[new1 + 1] - 1] = base + len(new0) + np.arange(len(new1))
+    else:
+        ids = np.concatenate([inside, base + np.arange(len(new0) + len(new1))])
+        chain = ids[np.lexsort((T[ids], G[ids]))]
+        gstart = np.searchsorted(G[chain], np.arange(m + 1))
+    return V, T, G, chain, gstart
+
+
+def _strip_paths(V, T, G, good_v, a, d, m, L, R, ok_l, ok_r, CG, scale):
     """Make every strip between consecutive generators one conforming zipper.
 
     In strip s (between g_s and g_s+1) the vertices of each generator inside the
@@ -541,79 +587,70 @@ def _strip_paths(V, T, G, good_v, a, d, m, L, R, ok_l, ok_r, CG):
     that do not fit a monotone path are dropped, and every gap between the kept
     runs (and from the director curves to them) is filled by zipper steps.
     """
-    # Director points, unless a grid vertex already sits at t = 0 or t = 1.
-    eps = 1e-12
-    inside = np.flatnonzero(good_v)
-    has0 = np.zeros(m, bool)
-    has1 = np.zeros(m, bool)
-    has0[G[inside][T[inside] <= eps]] = True
-    has1[G[inside][T[inside] >= 1 - eps]] = True
-    new0, new1 = np.flatnonzero(~has0), np.flatnonzero(~has1)
-    base = len(V)
-    V = np.concatenate([V, a[new0], a[new1] + d[new1]])
-    T = np.concatenate([T, np.zeros(len(new0)), np.ones(len(new1))])
-    G = np.concatenate([G, new0, new1])
-    members = np.concatenate([inside, base + np.arange(len(new0) + len(new1))])
-    chain = members[np.lexsort((T[members], G[members]))]
-    gstart = np.searchsorted(G[chain], np.arange(m + 1))
+    V, T, G, chain, gstart = _chains(V, T, G, good_v, a, d, m, scale)
     rank = np.full(len(V), -1, np.int64)
-    rank[chain] = np.arange(len(chain)) - gstart[G[chain]]
+    rank[chain] = np.arange(len(chain)) - np.repeat(gstart[:-1], np.diff(gstart))
     clen = np.diff(gstart)                       # chain length per generator (>= 2)
     # Steps: right halves [A_k, B_l, A_k+1] in strip CG; left halves [A_k, B_l, B_l+1] in CG-1.
-    rk = rank[np.maximum(R, 0)]
-    lk = rank[np.maximum(L, 0)]
-    ok_r = ok_r & (rk[:, 2] == rk[:, 0] + 1)
-    ok_l = ok_l & (lk[:, 2] == lk[:, 1] + 1)
-    ir, il = np.flatnonzero(ok_r), np.flatnonzero(ok_l)
+    ir = np.flatnonzero(ok_r)
+    il = np.flatnonzero(ok_l)
+    rk = rank[R[ir]]
+    lk = rank[L[il]]
+    gr, gl = rk[:, 2] == rk[:, 0] + 1, lk[:, 2] == lk[:, 1] + 1
+    ir, il, rk, lk = ir[gr], il[gl], rk[gr], lk[gl]
     st_strip = np.concatenate([CG[ir], CG[il] - 1])
-    st_k = np.concatenate([rk[ir, 0], lk[il, 0]])
-    st_l = np.concatenate([rk[ir, 1], lk[il, 1]])
+    st_k = np.concatenate([rk[:, 0], lk[:, 0]])
+    st_l = np.concatenate([rk[:, 1], lk[:, 1]])
     st_a = np.concatenate([np.ones(len(ir), bool), np.zeros(len(il), bool)])
     st_id = np.concatenate([ir, il])
-    # Order steps along each strip's path; keep a step only if it starts at or
-    # beyond where every earlier step of its strip ended (monotone path).
-    order = np.lexsort((st_k + st_l, st_strip))
+    # Order steps along each strip's path by scattering them to their path
+    # position (one slot per position; a second step claiming a slot overlaps).
+    nstrip = m - 1
+    plen = clen[:-1] + clen[1:] - 2                # steps in a full path of each strip
+    pstart = np.zeros(nstrip + 1, np.int64)
+    np.cumsum(plen, out=pstart[1:])
+    slot = np.full(int(pstart[-1]), -1, np.int64)
+    slot[pstart[st_strip] + st_k + st_l] = np.arange(len(st_id))
+    order = slot[slot >= 0]
     st_strip, st_k, st_l, st_a, st_id = (x[order] for x in (st_strip, st_k, st_l, st_a, st_id))
     end_k = st_k + st_a
     end_l = st_l + ~st_a
-    big = 1 << 40
+    # Keep a step only if it starts at or beyond where every earlier step of its
+    # strip ended (a monotone path); counting dropped steps too is conservative.
+    big = np.int64(1) << 40
     prev_k = np.maximum.accumulate(st_strip * big + end_k) - st_strip * big
     prev_l = np.maximum.accumulate(st_strip * big + end_l) - st_strip * big
     first = _group_starts(st_strip)
     pk = np.where(first, -1, np.r_[-1, prev_k[:-1]])
     pl = np.where(first, -1, np.r_[-1, prev_l[:-1]])
     keep = (st_k >= pk) & (st_l >= pl)
-    # A kept step cancels an overlapping predecessor only if both were kept; the
-    # accumulate above already counted dropped steps, which is conservative.
-    st_strip, st_k, st_l, st_a, st_id = (x[keep] for x in (st_strip, st_k, st_l, st_a, st_id))
+    st_strip, st_k, st_l, st_a, st_id, end_k, end_l = (
+        x[keep] for x in (st_strip, st_k, st_l, st_a, st_id, end_k, end_l))
     keep_r = np.zeros(len(R), bool)
     keep_l = np.zeros(len(L), bool)
     keep_r[st_id[st_a]] = True
     keep_l[st_id[~st_a]] = True
-    # Gaps: from (0, 0) to the first step, between steps, from the last to the ends.
-    nstrip = m - 1
-    s_all = np.arange(nstrip)
-    end_k, end_l = st_k + st_a, st_l + ~st_a
-    g_strip = np.concatenate([st_strip, s_all])
-    g_k0 = np.concatenate([end_k, np.zeros(nstrip, np.int64)])
-    g_l0 = np.concatenate([end_l, np.zeros(nstrip, np.int64)])
-    # The next step's start, or the chain ends for the last gap of each strip.
-    order = np.lexsort((g_k0 + g_l0, g_strip))
-    g_strip, g_k0, g_l0 = g_strip[order], g_k0[order], g_l0[order]
-    nxt_strip = np.r_[g_strip[1:], -1]
-    last = nxt_strip != g_strip
-    # Start of the step that follows each gap: steps sorted by (strip, path index).
-    step_key = st_strip * big + st_k + st_l
-    gap_key = g_strip * big + g_k0 + g_l0
-    j = np.searchsorted(step_key, gap_key, side="left")
-    j = np.minimum(j, max(len(step_key) - 1, 0))
-    has_next = (~last) & (len(step_key) > 0)
-    g_k1 = np.where(has_next, st_k[j] if len(st_k) else 0, clen[g_strip] - 1)
-    g_l1 = np.where(has_next, st_l[j] if len(st_l) else 0, clen[g_strip + 1] - 1)
+    # Gaps, in one sweep: before the first step of a strip, between two steps that
+    # do not meet, after the last step, and whole strips without steps.
+    first = _group_starts(st_strip)
+    last = np.r_[first[1:], True] if len(first) else first
+    between = ~first
+    between[1:] &= (end_k[:-1] != st_k[1:]) | (end_l[:-1] != st_l[1:])
+    btw = np.flatnonzero(between)
+    fst = np.flatnonzero(first)
+    lst = np.flatnonzero(last)
+    empty = np.setdiff1d(np.arange(nstrip), st_strip, assume_unique=False)
+    g_strip = np.concatenate([st_strip[fst], st_strip[btw], st_strip[lst], empty])
+    g_k0 = np.concatenate([np.zeros(len(fst), np.int64), end_k[btw - 1], end_k[lst],
+                           np.zeros(len(empty), np.int64)])
+    g_l0 = np.concatenate([np.zeros(len(fst), np.int64), end_l[btw - 1], end_l[lst],
+                           np.zeros(len(empty), np.int64)])
+    g_k1 = np.concatenate([st_k[fst], st_k[btw], clen[st_strip[lst]] - 1, clen[empty] - 1])
+    g_l1 = np.concatenate([st_l[fst], st_l[btw], clen[st_strip[lst] + 1] - 1, clen[empty + 1] - 1])
     na = np.maximum(g_k1 - g_k0, 0)
     nb = np.maximum(g_l1 - g_l0, 0)
     fill = _zippers(T, chain, gstart, g_strip, g_k0, g_l0, na, nb)
-    return V, T, G, keep_l, keep_r, fill
+    return V, T, G, keep_l, keep_r, fill, chain, gstart
 
 
 def _zippers(T, chain, gstart, strip, k0, l0, na, nb) -> np.ndarray:
@@ -654,31 +691,48 @@ def _zippers(T, chain, gstart, strip, k0, l0, na, nb) -> np.ndarray:
     return np.stack([a_k, b_l, third], axis=1)
 
 
-def _to_mesh(V, T, G, faces, kinds, warnings) -> Mesh:
+def _to_mesh(V, T, G, faces, kinds, warnings, chain, gstart, scale) -> Mesh:
     """Mesh from fixed-valence face arrays; members along the generators."""
-    offs, idxs = [np.zeros(1, np.int64)], []
+    off = [np.zeros(1, np.int64)]
     total = 0
     for f in faces:
-        k = f.shape[1]
-        offs.append(np.arange(1, len(f) + 1, dtype=np.int64) * k + total)
-        idxs.append(f.reshape(-1))
+        off.append(np.arange(1, len(f) + 1, dtype=np.int64) * f.shape[1] + total)
         total += f.size
-    off = np.concatenate(offs)
-    idx = np.concatenate(idxs).astype(np.int64)
+    off = np.concatenate(off)
+    idx = np.concatenate([f.reshape(-1) for f in faces]).astype(np.int64)
     kind = np.concatenate(kinds).astype(np.uint8)
-    # Members: consecutive used vertices along each generator.
+    # Generators that share an end point (a torsal pair meeting on a director
+    # curve) give coincident points at t = 0 or 1: merge those, nothing else.
+    ends = np.flatnonzero((T <= 1e-12) | (T >= 1 - 1e-12))
+    if len(ends) > 1:
+        key = np.round(V[ends] / (1e-12 * scale)).astype(np.int64)
+        _, first, inv = np.unique(key, axis=0, return_index=True, return_inverse=True)
+        if len(first) < len(ends):
+            remap = np.arange(len(V))
+            remap[ends] = ends[first[inv.reshape(-1)]]
+            idx = remap[idx]
+            if chain is not None:
+                chain = remap[chain]
     used = np.zeros(len(V), bool)
     used[idx] = True
-    ids = np.flatnonzero(used & (G >= 0))
-    order = ids[np.lexsort((T[ids], G[ids]))]
-    same = G[order[1:]] == G[order[:-1]]
-    members = np.stack([order[:-1][same], order[1:][same]], axis=1)
-    member_id = G[order[:-1][same]]
-    mesh = Mesh(V, off, idx, kind, members.astype(np.int64), member_id.astype(np.int64),
-                {"t": T, "generator": G}, {"construction": "pq (paper §4.3)", "warnings": warnings})
-    # Generators that share an end point (a torsal pair meeting on a director
-    # curve) give coincident vertices: merge them so no face has zero area.
-    return mesh.compact().merge_vertices(1e-13).drop_repeated_corners()
+    if chain is not None:
+        # Members: consecutive chain vertices of a generator, both used by faces.
+        gch = np.repeat(np.arange(len(gstart) - 1), np.diff(gstart))
+        pair = (gch[1:] == gch[:-1]) & used[chain[1:]] & used[chain[:-1]] & (chain[1:] != chain[:-1])
+        members = np.stack([chain[:-1][pair], chain[1:][pair]], axis=1)
+        member_id = gch[:-1][pair]
+    else:
+        ids = np.flatnonzero(used & (G >= 0))
+        order = ids[np.lexsort((T[ids], G[ids]))]
+        same = G[order[1:]] == G[order[:-1]]
+        members = np.stack([order[:-1][same], order[1:][same]], axis=1)
+        member_id = G[order[:-1][same]]
+    # Renumber to the used vertices only.
+    new = np.cumsum(used) - 1
+    mesh = Mesh(V[used], off, new[idx], kind, new[members].astype(np.int64),
+                member_id.astype(np.int64), {"t": T[used], "generator": G[used]},
+                {"construction": "pq (paper §4.3)", "warnings": warnings})
+    return mesh.drop_repeated_corners()
 
 
 # ---------------------------------------------------------------- design files

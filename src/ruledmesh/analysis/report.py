@@ -48,7 +48,7 @@ def _stats(values: np.ndarray) -> dict[str, float]:
 
 
 def analyze(mesh: Mesh, reference=None, extras: Mapping[str, Any] | None = None,
-            tol: Tolerances = DEFAULT) -> dict[str, Any]:
+            tol: Tolerances = DEFAULT, compare: bool = False) -> dict[str, Any]:
     """Measure ``mesh``.
 
     Parameters
@@ -59,6 +59,10 @@ def analyze(mesh: Mesh, reference=None, extras: Mapping[str, Any] | None = None,
     extras : mapping, optional
         Construction-specific figures to include as they are.
     tol : Tolerances
+    compare : bool
+        Also let hooks that compare with the smooth surface run (e.g. the
+        triangulation against the parameter-grid and OCCT tessellations of
+        the same surface); slow, so off by default.
 
     Returns
     -------
@@ -110,8 +114,9 @@ def analyze(mesh: Mesh, reference=None, extras: Mapping[str, Any] | None = None,
             }
     _load_hooks()
     for name, hook in METRIC_HOOKS.items():
-        # Hooks that compare with the smooth surface take it as ``reference``.
-        takes_ref = "reference" in inspect.signature(hook).parameters
+        # Hooks that compare with the smooth surface take it as ``reference``,
+        # only when a comparison was asked for (it tessellates the surface anew).
+        takes_ref = compare and "reference" in inspect.signature(hook).parameters
         value = hook(mesh, reference=reference) if takes_ref else hook(mesh)
         if value is not None:
             report[name] = value

@@ -20,6 +20,9 @@ def add_parser(sub) -> None:
     p.add_argument("file", help="mesh file (.obj, .ply, ...) or design file (.toml)")
     p.add_argument("--design", help="design file the mesh was built from (for closeness, coverage)")
     p.add_argument("--json", action="store_true", help="machine-readable output")
+    p.add_argument("--compare", action="store_true",
+                   help="also triangulate the smooth surface the standard ways (parameter grid, "
+                        "OCCT BRepMesh if installed) and compare triangle quality (slow)")
     p.set_defaults(run=run)
 
 
@@ -39,7 +42,7 @@ def run(args) -> int:
         if args.design:
             built = build_file(args.design)
             reference, extras = built.reference, built.extras
-    report = analyze(mesh, reference=reference, extras=extras)
+    report = analyze(mesh, reference=reference, extras=extras, compare=args.compare)
     report["file"] = str(path)
     if args.json:
         json.dump(report, sys.stdout, indent=2)
