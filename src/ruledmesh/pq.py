@@ -479,7 +479,7 @@ def _assemble(parts, a, d, rows, trim, tol, warnings, bounds, run_of, scale) -> 
     G = np.concatenate([r.gen for r in parts]) if parts else np.zeros(0, np.int64)
     FAR = np.concatenate([r.far for r in parts]) if parts else np.zeros(0, bool)
     offs = np.cumsum([0] + [len(r.vertices) for r in parts])
-    shift = lambda f, o: np.where(f >= 0, f + o, -1)  # noqa: E731
+    shift = lambda f, o: np.where(f >= 0, f + o, -1) if o else f  # noqa: E731
     L = (np.concatenate([shift(r.left, o) for r, o in zip(parts, offs)]) if parts
          else np.zeros((0, 3), np.int64))
     R = (np.concatenate([shift(r.right, o) for r, o in zip(parts, offs)]) if parts
@@ -703,7 +703,9 @@ def _to_mesh(V, T, G, faces, kinds, warnings, chain, gstart, scale) -> Mesh:
     kind = np.concatenate(kinds).astype(np.uint8)
     # Generators that share an end point (a torsal pair meeting on a director
     # curve) give coincident points at t = 0 or 1: merge those, nothing else.
-    ends = np.flatnonzero((T <= 1e-12) | (T >= 1 - 1e-12))
+    used0 = np.zeros(len(V), bool)
+    used0[idx] = True
+    ends = np.flatnonzero(used0 & ((T <= 1e-12) | (T >= 1 - 1e-12)))
     if len(ends) > 1:
         key = np.round(V[ends] / (1e-12 * scale)).astype(np.int64)
         _, first, inv = np.unique(key, axis=0, return_index=True, return_inverse=True)
