@@ -448,12 +448,23 @@ def pq_mesh(a, b, rows: int = 20, primary: int | str = "middle", option: int = 0
     carried = sign[idx]
     change = np.zeros(len(sign), bool)
     change[1:] = (carried[1:] != carried[:-1]) & (carried[:-1] != 0) & (sign[1:] != 0)
-    cut = np.flatnonzero(flat | change)
+    # A kink of a director curve (a polyline corner, say) makes a crease along a
+    # generator; the two chains of §4.3 cross it at different generators and
+    # drift apart, so the rows restart across it too.
+    crease = np.zeros(len(sign), bool)
+    for ends in (a, b):
+        chord = np.diff(ends, axis=0)
+        c0, c1 = chord[:-1], chord[1:]
+        cosang = np.einsum("ij,ij->i", c0, c1) / np.maximum(
+            np.linalg.norm(c0, axis=1) * np.linalg.norm(c1, axis=1), 1e-300)
+        crease[1:] |= cosang < np.cos(np.radians(tol.crease_deg))
+    cut = np.flatnonzero(flat | change | crease)
     bounds = np.concatenate([[0], cut + 1, [m]])
     if cut.size:
         listed = ", ".join(f"{k}-{k + 1}" for k in cut[:8].tolist()) + (" ..." if cut.size > 8 else "")
-        warnings.append(f"{cut.size} torsal strips (generators {listed}: coplanar, or the twist "
-                        "changes sign there): filled with triangles")
+        warnings.append(f"{cut.size} strips at torsal generators or creases (generators {listed}: "
+                        "coplanar, the twist changes sign, or a director curve has a kink): "
+                        "filled with triangles")
     parts = []          # (vertices, t, gen, faces_list, kinds)
     offset = 0
     run_of = np.full(m, -1)
