@@ -225,14 +225,18 @@ def test_far_rows_are_never_emitted():
 
 def test_kink_of_a_director_polyline_restarts_the_rows():
     """A polyline corner makes a crease; rows restarted there keep the quads convex."""
-    from ruledmesh import curves, rulings
+    from pathlib import Path
 
-    c1 = curves.BSpline(np.array([[0, 0, 0], [3, 1, 0], [6, -1, 0], [10, 0, 0]], float), 3)
-    c2 = curves.Polyline(np.array([[0, 2, 4], [3, 4, 5], [6, 3, 3], [10, 3, 4]], float))
-    r = rulings.between(c1, c2, 41, "arc-length")
-    mesh = pq_mesh(r.a, r.b, rows=40)
+    from ruledmesh.design import build_file
+
+    built = build_file(Path(__file__).resolve().parents[1] / "examples" / "skew.toml")
+    mesh = built.mesh
     check_mesh(mesh)
+    assert built.rulings.info["creases"] == [12, 25]     # the two corners of c2
     kinds = mesh.count_kinds()
     assert any("kink" in w for w in mesh.info["warnings"])
     # Without the restart 40 % of the faces were bow-ties split in two; now a few remain.
     assert kinds.get("split", 0) < 0.05 * kinds["quad"]
+    A, B = built.rulings.a, built.rulings.b
+    with pytest.raises(ParameterError, match="creases"):
+        pq_mesh(A, B, creases=[len(A) - 1])

@@ -15,6 +15,8 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any, Mapping
 
+import numpy as np
+
 from ._validation import check_keys, describe
 from .errors import DesignError, RuledMeshError
 from .registry import (MESH_METHODS, SURFACE_KINDS, TRANSFORMS, BuildContext, Built,
@@ -114,8 +116,9 @@ def _build(design: Design) -> Built:
             if not isinstance(spec, Mapping):
                 raise DesignError(f"expected a table, got {describe(spec)}", f"curves.{name}")
             curves[name] = curve_from_spec(spec, f"curves.{name}")
-        rulings = rulings_from_spec(_table(data, "rulings"), curves, path="rulings",
-                                    base_dir=design.base_dir)
+        rulings_table = _table(data, "rulings")
+        rulings = rulings_from_spec(rulings_table, curves, path="rulings", base_dir=design.base_dir)
+        rulings = _with_creases(rulings, rulings_table, curves)
         method = mesh_table.get("method", "pq")
         if method not in MESH_METHODS:
             raise _unknown("mesh.method", method, MESH_METHODS)
@@ -152,6 +155,59 @@ def _check_budget(generators: int, rows: Any) -> None:
             f"{generators} generators x {rows + 1} rows would need about {need / 2**30:.1f} GiB "
             f"of memory (limit {MAX_BUILD_BYTES / 2**30:.0f} GiB); reduce the rows or the "
             "generator count", "mesh.rows")
+
+
+def curve_kinks(curve) -> np.ndarray:
+    """Parameters ``u`` in (0, 1) where a curve has a corner (is only C0).
+
+    Polyline corners, and knots of a B-spline repeated ``degree`` times (every
+    interior knot of a degree-1 spline).
+    """
+    from .curves import BSpline, Polyline
+
+    if isinstance(curve, Polyline):
+        return np.asarray(curve._knots[1:-1], dtype=float)
+    if isinstance(curve, BSpline):
+        k = np.asarray(curve.knots if curve.knots is not None else [], dtype=float)
+        p = curve.degree
+        if k.size == 0:
+            return np.zeros(0)
+        lo, hi = k[p], k[-p - 1]
+        inner = k[(k > lo) & (k < hi)]
+        vals, counts = np.unique(inner, return_counts=True)
+        return (vals[counts >= p] - lo) / (hi - lo)
+    return np.zeros(0)
+
+
+def _with_creases(rulings, table: Mapping, curves: Mapping) -> Any:
+    """Record in ``rulings.info["creases"]`` the strips that contain a kink of a director curve."""
+    from dataclasses import replace
+
+    names = table.get("between")
+    if "conoid" in table and isinstance(table["conoid"], Mapping):
+        names = [table["conoid"].get("curve")]
+    if not isinstance(names, list):
+        return rulings
+    pairs: set[int] = set()
+    for key, name in zip(("c1_params", "c2_params"), names):
+        params = rulings.info.get(key)
+        curve = curves.get(name)
+        if params is None or curve is None:
+            continue
+        kinks = curve_kinks(curve)
+        params = np.asarray(params, dtype=float)
+        if kinks.size == 0 or params.size < 2:
+            continue
+        # Works for parameters increasing or decreasing along the generators.
+        order = np.argsort(params)
+        pos = np.searchsorted(params[order], kinks)
+        ok = (pos > 0) & (pos < params.size)
+        for lo_i, hi_i in zip(order[pos[ok] - 1], order[pos[ok]]):
+            if abs(int(lo_i) - int(hi_i)) == 1:
+                pairs.add(min(int(lo_i), int(hi_i)))
+    if not pairs:
+        return rulings
+    return replace(rulings, info={**rulings.info, "creases": sorted(pairs)})
 
 
 def _unknown(path: str, value: Any, table: Mapping) -> DesignError:

@@ -347,7 +347,7 @@ def _strip_triangles(ta: np.ndarray, tb: np.ndarray) -> np.ndarray:
 
 def pq_mesh(a, b, rows: int = 20, primary: int | str = "middle", option: int = 0,
             extend: float | str = "auto", trim: bool = True, *, max_extend: float = 20.0,
-            tol: Tolerances = DEFAULT) -> Mesh:
+            creases=None, tol: Tolerances = DEFAULT) -> Mesh:
     """The §4.3 PQ mesh of the ruled surface through generators ``a_i b_i``.
 
     Parameters
@@ -369,6 +369,10 @@ def pq_mesh(a, b, rows: int = 20, primary: int | str = "middle", option: int = 0
         Clip the faces to the patch ``0 <= t <= 1`` (clipped faces stay planar).
     max_extend : float
         Cap of the automatic extension.
+    creases : (k,) int, optional
+        Strips ``i`` (between generators ``i`` and ``i + 1``) across which the
+        surface has a crease (a kink of a director curve); the rows restart
+        there and the strip is filled with triangles.
     tol : Tolerances
 
     Returns
@@ -450,14 +454,15 @@ def pq_mesh(a, b, rows: int = 20, primary: int | str = "middle", option: int = 0
     change[1:] = (carried[1:] != carried[:-1]) & (carried[:-1] != 0) & (sign[1:] != 0)
     # A kink of a director curve (a polyline corner, say) makes a crease along a
     # generator; the two chains of §4.3 cross it at different generators and
-    # drift apart, so the rows restart across it too.
+    # drift apart, so the rows restart across it too.  The design knows its
+    # kinks exactly (see ruledmesh.design); measured angles would not commute
+    # with affine maps.
     crease = np.zeros(len(sign), bool)
-    for ends in (a, b):
-        chord = np.diff(ends, axis=0)
-        c0, c1 = chord[:-1], chord[1:]
-        cosang = np.einsum("ij,ij->i", c0, c1) / np.maximum(
-            np.linalg.norm(c0, axis=1) * np.linalg.norm(c1, axis=1), 1e-300)
-        crease[1:] |= cosang < np.cos(np.radians(tol.crease_deg))
+    if creases is not None:
+        cr = np.asarray(creases, dtype=np.int64).reshape(-1)
+        if cr.size and (cr.min() < 0 or cr.max() >= m - 1):
+            raise ParameterError(f"expected pair indices in [0, {m - 2}], got {cr.tolist()}", "creases")
+        crease[cr] = True
     cut = np.flatnonzero(flat | change | crease)
     bounds = np.concatenate([[0], cut + 1, [m]])
     if cut.size:
@@ -774,7 +779,7 @@ def build_pq(rulings, table: Mapping[str, Any], ctx: BuildContext) -> Built:
     max_extend = check_float(table.get("max_extend", 20.0), "mesh.max_extend", lo=0.0, hi=1e3,
                              err=DesignError)
     mesh = pq_mesh(rulings.a, rulings.b, rows=rows, primary=primary, option=option, extend=extend,
-                   trim=trim, max_extend=max_extend)
+                   trim=trim, max_extend=max_extend, creases=rulings.info.get("creases"))
     reference = None
     if getattr(rulings, "surface", None) is not None:
         from .analysis.surface import RuledReference

@@ -46,10 +46,6 @@ class Tolerances:
     far : float
         A vertex farther than ``far`` times the patch diagonal from the patch
         is never emitted (the row through it has run off towards infinity).
-    crease_deg : float
-        A director curve whose chords between consecutive generators turn by
-        more than this angle (degrees) has a kink there; the surface has a
-        crease along that generator and the §4.3 rows are restarted across it.
     """
 
     planarity: float = 1e-12
@@ -58,7 +54,6 @@ class Tolerances:
     degenerate: float = 1e-9
     convexity: float = 1e-9
     far: float = 1e3
-    crease_deg: float = 20.0
 
 
 DEFAULT = Tolerances()
