@@ -47,7 +47,8 @@ from .mesh import FaceKind, Mesh
 from .registry import BuildContext, Built, surface_kind
 from .tolerances import DEFAULT, Tolerances
 
-__all__ = ["c1_step", "compound_net", "c1_residual", "compound_mesh", "CompoundSurface"]
+__all__ = ["c1_step", "compound_net", "c1_residual", "compound_mesh", "CompoundSurface",
+           "CompoundReference"]
 
 
 # --------------------------------------------------------------------------- construction
@@ -401,7 +402,27 @@ def build_compound(surface: Mapping[str, Any], mesh_table: Mapping[str, Any],
                      "corner_gap": gap / scale, "patches": [I, J],
                      "free_numbers": 12 + 3 * (I - 1) + 3 * (J - 1),
                      "net_numbers": 3 * (I + 1) * (J + 1)}}
-    from .analysis.surface import RuledReference
-
     mesh = mesh.with_info(source=ctx.source, warnings=warnings)
-    return Built(mesh, RuledReference(CompoundSurface(P)), None, extras)
+    return Built(mesh, CompoundReference(P), None, extras)
+
+
+class CompoundReference:
+    """Closeness and area of the compound (the :class:`~ruledmesh.registry.Reference` protocol).
+
+    Deliberately without a ``surface`` attribute: the tessellation comparison of
+    the analysis fits one smooth B-spline surface, which a compound with kinks in
+    its curvature is not.
+    """
+
+    def __init__(self, P: np.ndarray):
+        from .analysis.surface import RuledReference
+
+        self._ref = RuledReference(CompoundSurface(np.asarray(P, dtype=np.float64)))
+
+    def distance(self, points: np.ndarray) -> np.ndarray:
+        """(n,) float64: distance of each point from the compound."""
+        return self._ref.distance(points)
+
+    def area(self) -> float:
+        """Area of the compound (sum of its patches)."""
+        return self._ref.area()
