@@ -55,8 +55,71 @@ def _module(ext: str, table: dict[str, str], what: str):
     return importlib.import_module(f"{__name__}.{name}")
 
 
+def _write_all(fd: int, data: bytes) -> None:
+    with os.fdopen(fd, "wb", closefd=False) as fh:
+        fh.write(data)
+        fh.flush()
+        os.fsync(fh.fileno())
+
+
+def _link_fd(fd: int, name: Path) -> bool:
+    """Give the unnamed file ``fd`` the name ``name`` (``linkat`` through /proc).
+
+    ``os.link`` cannot do it: it calls ``link(2)``, which does not follow the
+    /proc/self/fd magic link, so libc's ``linkat`` with AT_SYMLINK_FOLLOW is used.
+    """
+    import ctypes
+
+    try:
+        libc = ctypes.CDLL(None, use_errno=True)
+        linkat = libc.linkat
+    except (OSError, AttributeError):
+        return False
+    at_fdcwd, at_symlink_follow = -100, 0x400
+    return linkat(at_fdcwd, f"/proc/self/fd/{fd}".encode(), at_fdcwd, os.fsencode(name),
+                  at_symlink_follow) == 0
+
+
+def _publish_anonymous(folder: Path, path: Path, data: bytes) -> bool:
+    """Write through an unnamed file (Linux ``O_TMPFILE``), then name it.
+
+    While the bytes are being written the file has no name at all, so a
+    process killed mid-write (even by SIGKILL) leaves nothing behind; it is
+    linked under a hidden name only once complete and renamed over ``path``.
+    Returns False where the system or file system does not support it.
+    """
+    flag = getattr(os, "O_TMPFILE", None)
+    proc = Path("/proc/self/fd")
+    if flag is None or not proc.is_dir():
+        return False
+    try:
+        fd = os.open(folder, flag | os.O_WRONLY, 0o666)
+    except OSError:
+        return False
+    try:
+        _write_all(fd, data)
+        tmp = folder / f".{path.name}.{os.getpid()}.{fd}.{os.urandom(4).hex()}.part"
+        if not _link_fd(fd, tmp):
+            return False
+        try:
+            os.replace(tmp, path)
+        except BaseException:
+            tmp.unlink(missing_ok=True)
+            raise
+    finally:
+        os.close(fd)
+    return True
+
+
 def write_atomic(path: str | os.PathLike, data: bytes) -> Path:
-    """Write ``data`` to ``path`` through a temporary file and a rename.
+    """Write ``data`` to ``path`` completely or not at all.
+
+    The bytes go to a temporary file in the target folder, which is renamed
+    over ``path`` only when complete, so ``path`` never holds a truncated file.
+    On Linux the temporary file is unnamed while it is written (``O_TMPFILE``):
+    an export killed midway leaves no file at all.  Elsewhere it is a hidden
+    ``.NAME.*.part`` file, removed on any error, but left behind if the process
+    is killed outright (SIGKILL, power loss).
 
     Parameters
     ----------
@@ -72,12 +135,14 @@ def write_atomic(path: str | os.PathLike, data: bytes) -> Path:
     folder = path.parent if str(path.parent) else Path(".")
     if not folder.is_dir():
         raise ExportError(f"{path}: folder {folder} does not exist")
+    if _publish_anonymous(folder, path, data):
+        return path
     fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".part", dir=folder)
     try:
-        with os.fdopen(fd, "wb") as fh:
-            fh.write(data)
-            fh.flush()
-            os.fsync(fh.fileno())
+        try:
+            _write_all(fd, data)
+        finally:
+            os.close(fd)
         os.replace(tmp, path)
     except BaseException:
         try:
