@@ -41,7 +41,7 @@ from typing import Any, Mapping
 
 import numpy as np
 
-from ._validation import check_bool, check_int, check_keys, check_points, describe
+from ._validation import check_int, check_keys, check_points, describe
 from .errors import DesignError, GeometryError, ParameterError
 from .mesh import FaceKind, Mesh
 from .registry import BuildContext, Built, surface_kind

@@ -254,12 +254,6 @@ def _merge_coincident(V: np.ndarray, faces: list[np.ndarray], radius: float,
     return rep[label]
 
 
-def _polygon_area_and_size(P: np.ndarray) -> tuple[float, float]:
-    cr = np.cross(P, np.roll(P, -1, axis=0)).sum(axis=0)
-    diam = max(np.linalg.norm(P[:, None] - P[None], axis=2).max(), 1e-300)
-    return 0.5 * float(np.linalg.norm(cr)), float(diam)
-
-
 def _fan(V: np.ndarray, poly: list[int]) -> list[list[int]]:
     """Triangulate a planar polygon (a face with vertices inserted on its edges).
 
