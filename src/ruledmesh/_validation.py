@@ -112,8 +112,16 @@ def check_vector(value: Any, name: str, *, dim: int = 3, nonzero: bool = False,
         raise err(f"expected {dim} numbers, got {describe(value)}", name)
     if not np.all(np.isfinite(arr)):
         raise err("expected finite numbers, got NaN or infinity", name)
-    if nonzero and not np.any(arr):
-        raise err("expected a non-zero vector, got [0, 0, 0]", name)
+    if nonzero:
+        if not np.any(arr):
+            raise err("expected a non-zero vector, got [0, 0, 0]", name)
+        # A direction gets normalised: its length must neither underflow to 0
+        # (denormal components) nor overflow to infinity.
+        big = float(np.abs(arr).max())
+        length = big * float(np.linalg.norm(arr / big))    # scaled: no under/overflow here
+        if not 1e-150 <= length <= 1e150:
+            raise err(f"expected a vector of length between 1e-150 and 1e150, got length "
+                      f"{length:g}", name)
     return arr
 
 
