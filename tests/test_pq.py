@@ -148,7 +148,7 @@ def test_torsal_pair_builds_with_fill_triangles():
     B[11] = B[10]
     mesh = pq_mesh(A, B, rows=20)
     check_mesh(mesh)
-    assert any("torsal generators" in w for w in mesh.info["warnings"])
+    assert any("torsal strips" in w for w in mesh.info["warnings"])
     assert mesh.count_kinds().get("fill", 0) > 0
 
 
@@ -161,7 +161,7 @@ def test_sign_change_of_twist_is_a_torsal_cut():
     B = A + np.stack([np.zeros(m), np.cos(ang), np.sin(ang)], 1) * 2
     mesh = pq_mesh(A, B, rows=16)
     check_mesh(mesh)
-    assert any("torsal generators" in w for w in mesh.info["warnings"])
+    assert any("torsal strips" in w for w in mesh.info["warnings"])
 
 
 def test_parallel_generators_cylinder_is_refused_to_hop_but_meshed():
@@ -234,7 +234,7 @@ def test_kink_of_a_director_polyline_restarts_the_rows():
     check_mesh(mesh)
     assert built.rulings.info["creases"] == [12, 25]     # the two corners of c2
     kinds = mesh.count_kinds()
-    assert any("kink" in w for w in mesh.info["warnings"])
+    assert any("crease strips" in w for w in mesh.info["warnings"])
     # Without the restart 40 % of the faces were bow-ties split in two; now a few remain.
     assert kinds.get("split", 0) < 0.05 * kinds["quad"]
     A, B = built.rulings.a, built.rulings.b

@@ -465,11 +465,17 @@ def pq_mesh(a, b, rows: int = 20, primary: int | str = "middle", option: int = 0
         crease[cr] = True
     cut = np.flatnonzero(flat | change | crease)
     bounds = np.concatenate([[0], cut + 1, [m]])
-    if cut.size:
-        listed = ", ".join(f"{k}-{k + 1}" for k in cut[:8].tolist()) + (" ..." if cut.size > 8 else "")
-        warnings.append(f"{cut.size} strips at torsal generators or creases (generators {listed}: "
-                        "coplanar, the twist changes sign, or a director curve has a kink): "
-                        "filled with triangles")
+    def listed(ks):
+        return ", ".join(f"{k}-{k + 1}" for k in ks[:8].tolist()) + (" ..." if ks.size > 8 else "")
+
+    torsal = np.flatnonzero(flat | change)
+    kinks = np.flatnonzero(crease & ~(flat | change))
+    if torsal.size:
+        warnings.append(f"{torsal.size} torsal strips (generators {listed(torsal)}: consecutive "
+                        "generators coplanar, or the twist changes sign): filled with triangles")
+    if kinks.size:
+        warnings.append(f"{kinks.size} crease strips (generators {listed(kinks)}: a director curve "
+                        "has a corner there): rows restarted, strips filled with triangles")
     parts = []          # (vertices, t, gen, faces_list, kinds)
     offset = 0
     run_of = np.full(m, -1)
