@@ -101,7 +101,7 @@ def _build(design: Design) -> Built:
             raise DesignError("give either [surface] or [rulings], not both", "rulings")
         surface = _table(data, "surface")
         kind = surface.get("kind")
-        if kind not in SURFACE_KINDS:
+        if not isinstance(kind, str) or kind not in SURFACE_KINDS:
             raise _unknown("surface.kind", kind, SURFACE_KINDS)
         built = SURFACE_KINDS[kind](surface, mesh_table, ctx)
     else:
@@ -120,7 +120,7 @@ def _build(design: Design) -> Built:
         rulings = rulings_from_spec(rulings_table, curves, path="rulings", base_dir=design.base_dir)
         rulings = _with_creases(rulings, rulings_table, curves)
         method = mesh_table.get("method", "pq")
-        if method not in MESH_METHODS:
+        if not isinstance(method, str) or method not in MESH_METHODS:
             raise _unknown("mesh.method", method, MESH_METHODS)
         if method == "pq":
             _check_budget(len(rulings), mesh_table.get("rows", 20))
@@ -133,7 +133,7 @@ def _build(design: Design) -> Built:
         if not isinstance(table, Mapping):
             raise DesignError(f"expected a table, got {describe(table)}", path)
         kind = table.get("type")
-        if kind not in TRANSFORMS:
+        if not isinstance(kind, str) or kind not in TRANSFORMS:
             raise _unknown(f"{path}.type", kind, TRANSFORMS)
         built = TRANSFORMS[kind](built, table, path)
     return built
