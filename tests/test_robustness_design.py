@@ -177,6 +177,18 @@ BAD = {
     "file-missing": ('[rulings]\nfile = "nowhere.csv"\n', 'rulings.file: no such file "nowhere.csv"'),
     "two-sources": ('[rulings]\nlines = []\nfile = "x.csv"\n',
                     "rulings.file: give only one of between, lines, file or conoid"),
+    # found by tests/test_fuzz.py (docs/robustness.md)
+    "fuzz-denormal-normal": (SKEW + 'distribution = "director-plane"\n'
+                             "director_plane = [0, 0, 1.7e-298]\n",
+                             "rulings.director_plane: expected a vector of length between"),
+    "fuzz-point-bspline": (SKEW.replace("points = [[0, 0, 0], [3, 1, 0], [6, -1, 0], [10, 0, 0]]",
+                                        "points = [[1, 2, 3], [1, 2, 3], [1, 2, 3], [1, 2, 3]]"),
+                           "curves.c1.points: all control points coincide"),
+    "fuzz-kind-list": (TORUS.replace('kind = "torus"', "kind = []"),
+                       "surface.kind: expected one of"),
+    "fuzz-method-table": (SKEW + "[mesh]\nmethod = {x = 1}\n", "mesh.method: expected one of"),
+    "fuzz-transform-type-number": (TORUS + "[[transform]]\ntype = 3\n",
+                                   "transform[0].type: expected one of"),
     "toml-syntax": ("[mesh\nrows = 3\n", "invalid TOML"),
     "toml-duplicate": ("[mesh]\nrows = 3\nrows = 4\n", "invalid TOML"),
     "empty": ("", "rulings: expected a [rulings] table"),

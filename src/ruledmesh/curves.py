@@ -909,6 +909,10 @@ class BSpline(Curve):
             raise ParameterError(
                 f"a degree-{degree} B-spline needs at least {degree + 1} control points, got {n}",
                 "control_points")
+        if np.ptp(cp, axis=0).max() <= DEFAULT.degenerate * max(float(np.abs(cp).max()), 1e-300):
+            # a point, not a curve: arc length and tangents would divide by zero
+            raise ParameterError("all control points coincide; a curve needs two distinct points",
+                                 "control_points")
         if self.knots is None:
             knots = _default_knots(n, degree)
         else:
