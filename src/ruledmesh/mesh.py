@@ -292,7 +292,7 @@ class Mesh:
     def euler_characteristic(self, n_edges: int | None = None) -> int:
         """V - E + F over the vertices used by faces (``n_edges`` if already known)."""
         used = np.count_nonzero(np.bincount(self.face_indices, minlength=self.n_vertices))
-        return used - (len(self.edges()) if n_edges is None else n_edges) + self.n_faces
+        return int(used - (len(self.edges()) if n_edges is None else n_edges) + self.n_faces)
 
     # -------------------------------------------------------------- modify
     def with_vertices(self, vertices: np.ndarray, **info: Any) -> "Mesh":
