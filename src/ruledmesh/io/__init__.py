@@ -20,7 +20,7 @@ import numpy as np
 from ..errors import ExportError, ParameterError
 from ..mesh import Mesh
 
-__all__ = ["save", "load", "write_atomic", "WRITERS", "READERS", "formats"]
+__all__ = ["save", "load", "write_atomic", "require", "WRITERS", "READERS", "formats"]
 
 # extension -> module (relative to ruledmesh.io) providing dumpb / loadb.
 WRITERS: dict[str, str] = {
@@ -38,6 +38,24 @@ READERS: dict[str, str] = {
     ".ply": "ply",
     ".json": "json_mesh",
 }
+
+
+def require(module: str, extra: str, what: str):
+    """Import an optional dependency of a format, or say which extra installs it.
+
+    Parameters
+    ----------
+    module : str
+        Module to import (dotted names import their parents too).
+    extra : str
+        The ruledmesh extra that provides it.
+    what : str
+        The format, for the message, e.g. ``"DXF export"``.
+    """
+    try:
+        return importlib.import_module(module)
+    except ImportError:
+        raise ExportError(f"{what} needs {module.split('.')[0]}: pip install 'ruledmesh[{extra}]'") from None
 
 
 def formats() -> list[str]:

@@ -16,7 +16,6 @@ import io
 
 import numpy as np
 
-from ..errors import ExportError
 from ..mesh import FaceKind, Mesh
 
 __all__ = ["dumpb", "LAYER_COLOURS", "APPID"]
@@ -33,11 +32,9 @@ def layer_name(kind: FaceKind) -> str:
 
 
 def _import_ezdxf():
-    try:
-        import ezdxf
-    except ImportError:
-        raise ExportError("DXF export needs ezdxf: pip install 'ruledmesh[dxf]'") from None
-    return ezdxf
+    from . import require
+
+    return require("ezdxf", "dxf", "DXF export")
 
 
 def dumpb(mesh: Mesh) -> bytes:

@@ -17,20 +17,17 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..errors import ExportError
 from ..mesh import FaceKind, Mesh
 
 __all__ = ["dumpb"]
 
 
 def _import_ifcopenshell():
-    try:
-        import ifcopenshell
-        import ifcopenshell.api
-        import ifcopenshell.guid
-    except ImportError:
-        raise ExportError("IFC export needs ifcopenshell: pip install 'ruledmesh[ifc]'") from None
-    return ifcopenshell
+    from . import require
+
+    for sub in ("ifcopenshell.api", "ifcopenshell.guid"):
+        require(sub, "ifc", "IFC export")
+    return require("ifcopenshell", "ifc", "IFC export")
 
 
 def dumpb(mesh: Mesh) -> bytes:

@@ -33,11 +33,9 @@ _LAYER_COLOURS = {FaceKind.QUAD: (200, 205, 215), FaceKind.BORDER: (240, 180, 80
 
 
 def _import_rhino3dm():
-    try:
-        import rhino3dm
-    except ImportError:
-        raise ExportError("3DM export needs rhino3dm: pip install 'ruledmesh[rhino]'") from None
-    return rhino3dm
+    from . import require
+
+    return require("rhino3dm", "rhino", "3DM export")
 
 
 def rhino_faces(mesh: Mesh) -> tuple[np.ndarray, np.ndarray]:
