@@ -43,6 +43,8 @@ __all__ = ["pq_mesh", "row_maps", "PQOptions", "MAX_GRID_POINTS"]
 # Grid points (generators x rows) above which a build is refused up front, with
 # the memory it would need, instead of running out of memory half-way.
 MAX_GRID_POINTS = 60_000_000
+# Parameters this close to 0 or 1 are on the patch border (rounding of t).
+_ON_BORDER = 1e-12
 _BYTES_PER_GRID_POINT = 96
 
 
@@ -508,7 +510,9 @@ def _assemble(parts, a, d, rows, trim, tol, warnings, bounds, run_of, scale) -> 
          else np.zeros((0, 3), np.int64))
     POLE = np.concatenate([r.pole for r in parts]) if parts else np.zeros(0, bool)
     CG = np.concatenate([r.centre_gen for r in parts]) if parts else np.zeros(0, np.int64)
-    lo_t, hi_t = (0.0, 1.0) if trim else (-np.inf, np.inf)
+    # A vertex within rounding of the border counts as on it, so the decisions do
+    # not flip when the design is scaled or moved (t is scale-free up to rounding).
+    lo_t, hi_t = (-_ON_BORDER, 1.0 + _ON_BORDER) if trim else (-np.inf, np.inf)
     good_v = ~FAR & (T >= lo_t) & (T <= hi_t)
     ok_l = (L[:, 0] >= 0) & ~POLE & good_v[np.maximum(L, 0)].all(axis=1)
     ok_r = (R[:, 0] >= 0) & ~POLE & good_v[np.maximum(R, 0)].all(axis=1)
@@ -566,7 +570,7 @@ def _chains(V, T, G, good_v, a, d, m, scale):
     gstart : (m + 1,) int64
         Start of each generator's chain in ``chain``.
     """
-    eps = 1e-12
+    eps = _ON_BORDER
     inside = np.flatnonzero(good_v)
     gi, ti = G[inside], T[inside]
     has0 = np.zeros(m, bool)
