@@ -189,6 +189,16 @@ BAD = {
     "fuzz-method-table": (SKEW + "[mesh]\nmethod = {x = 1}\n", "mesh.method: expected one of"),
     "fuzz-transform-type-number": (TORUS + "[[transform]]\ntype = 3\n",
                                    "transform[0].type: expected one of"),
+    "fuzz-linear-bspline-repeat": (SKEW.replace('degree = 3', 'degree = 1').replace(
+        "points = [[0, 0, 0], [3, 1, 0], [6, -1, 0], [10, 0, 0]]",
+        "points = [[0, 0, 0], [0, 0, 0], [10, 0, 1]]"),
+        "curves.c1.points: points 0 and 1 coincide"),
+    "fuzz-flat-circle-level": ('[curves.c1]\ntype = "line"\npoints = [[0, 0, 0], [0, 0, 1]]\n'
+                               '[curves.c2]\ntype = "helix"\ncenter = [0, 0, 0]\n'
+                               "axis = [3, 1, 0]\nradius = 1\npitch = 0\nturns = 1\n"
+                               '[rulings]\nbetween = ["c1", "c2"]\ncount = 3\n'
+                               'distribution = "director-plane"\ndirector_plane = [3, 1, 0]\n',
+                               "director-plane: c1 lies in a plane parallel to the director"),
     "toml-syntax": ("[mesh\nrows = 3\n", "invalid TOML"),
     "toml-duplicate": ("[mesh]\nrows = 3\nrows = 4\n", "invalid TOML"),
     "empty": ("", "rulings: expected a [rulings] table"),

@@ -146,9 +146,16 @@ class _Level:
         # never fake a critical point inside an interval
         delta = 1e-9 * (b - a)
         dl, dr = dg(a + delta), dg(b - delta)
-        crit = [brentq(lambda x: float(dg(np.float64(x))), a[i] + delta[i], b[i] - delta[i],
-                       xtol=1e-16, rtol=8.9e-16)
-                for i in np.nonzero(dl * dr < 0)[0]]
+        def slope(x):
+            return float(dg(np.float64(x)))
+
+        crit = []
+        for i in np.nonzero(dl * dr < 0)[0]:
+            lo, hi = a[i] + delta[i], b[i] - delta[i]
+            # Evaluated one by one, a derivative at rounding level (a curve
+            # lying almost in a level plane) may lose its sign change: no root.
+            if slope(lo) * slope(hi) < 0:
+                crit.append(brentq(slope, lo, hi, xtol=1e-16, rtol=8.9e-16))
         self.g, self.dg = g, dg
         self.tol = float(tol)
         self.nodes = np.unique(np.concatenate([grid, crit]))
@@ -909,6 +916,9 @@ class BSpline(Curve):
             raise ParameterError(
                 f"a degree-{degree} B-spline needs at least {degree + 1} control points, got {n}",
                 "control_points")
+        if degree == 1:
+            # a repeated point makes a piece of zero length (zero speed: no arc length)
+            _check_distinct(cp, "control_points")
         if np.ptp(cp, axis=0).max() <= DEFAULT.degenerate * max(float(np.abs(cp).max()), 1e-300):
             # a point, not a curve: arc length and tangents would divide by zero
             raise ParameterError("all control points coincide; a curve needs two distinct points",
