@@ -421,7 +421,7 @@ def test_json_report_of_a_cone_is_strict_json(tmp_path, capsys):
     json.loads(capsys.readouterr().out, parse_constant=refuse)
 
 
-# Catalogue bugs found by tests/test_fuzz.py (reported; the fuzz skips canal until fixed).
+# Catalogue bugs found by tests/test_fuzz.py, fixed: each spine now meshes or is refused.
 CANAL_BUGS = {
     "zero-length-arc-spine": '{type = "arc", center = [0, 0, 0], radius = 1, start = 1e-121, '
                              'end = 0, plane = "xy"}',
@@ -430,8 +430,6 @@ CANAL_BUGS = {
 }
 
 
-@pytest.mark.xfail(strict=True, reason="constructions/canal.py: division by zero (NaN) instead "
-                   "of a mesh or a clear error for these spines; reported")
 @pytest.mark.parametrize("case", sorted(CANAL_BUGS))
 def test_canal_degenerate_spines_mesh_or_refuse_cleanly(case):
     import warnings

@@ -102,13 +102,23 @@ def canal_mesh(centers: np.ndarray, radii, segments: int):
             ek = e - (e @ n[k]) * n[k]
         ek /= np.linalg.norm(ek)
         e1 = ek - (ek @ n[k + 1]) * n[k + 1]
+        if np.linalg.norm(e1) <= 1e-9:
+            raise GeometryError(f"circles {k} and {k + 1} lie in perpendicular planes (the spine "
+                                f"turns by 90 degrees or more at point {k + 1}): sample the spine "
+                                "more densely there")
         e1 /= np.linalg.norm(e1)
         ends = np.array([c[k] + r[k] * ek, c[k] - r[k] * ek,
                          c[k + 1] + r[k + 1] * e1, c[k + 1] - r[k + 1] * e1]) - o
         # Homogeneous 2-D coordinates in the plane (o; n_k, e_k): apex = a_k a_{k+1} ∩ b_k b_{k+1}.
         h = np.stack([ends @ n[k], ends @ ek, np.ones(4)], axis=1)
         apex = np.cross(np.cross(h[0], h[2]), np.cross(h[1], h[3]))
-        apex /= np.linalg.norm(apex)
+        size = np.linalg.norm(apex)
+        if not np.isfinite(size) or size <= 1e-300 or np.abs(h).max() * 1e-12 > size:
+            # The lines through corresponding points coincide: the two circles coincide
+            # or the spine has no length between them.
+            raise GeometryError(f"circles {k} and {k + 1} coincide (the spine doubles back or has "
+                                f"no length at point {k + 1})")
+        apex /= size
         x = rows[-1] - o
         w = apex[2] * x - (apex[0] * n[k] + apex[1] * ek)
         t = -2.0 * np.einsum("ij,ij->i", w, x) / np.einsum("ij,ij->i", w, w)
