@@ -38,7 +38,7 @@ from .mesh import FaceKind, Mesh
 from .registry import BuildContext, Built, mesh_method
 from .tolerances import DEFAULT, Tolerances
 
-__all__ = ["pq_mesh", "row_maps", "PQOptions", "MAX_GRID_POINTS"]
+__all__ = ["pq_mesh", "row_maps", "MAX_GRID_POINTS"]
 
 # Grid points (generators x rows) above which a build is refused up front, with
 # the memory it would need, instead of running out of memory half-way.
@@ -46,18 +46,6 @@ MAX_GRID_POINTS = 60_000_000
 # Parameters this close to 0 or 1 are on the patch border (rounding of t).
 _ON_BORDER = 1e-12
 _BYTES_PER_GRID_POINT = 96
-
-
-@dataclass(frozen=True)
-class PQOptions:
-    """Options of the §4.3 mesher (see :func:`pq_mesh`)."""
-
-    rows: int = 20
-    primary: int | str = "middle"
-    option: int = 0
-    extend: float | str = "auto"
-    trim: bool = True
-    max_extend: float = 20.0
 
 
 def _normalise(M: np.ndarray) -> np.ndarray:
@@ -318,35 +306,6 @@ def _mesh_run(a: np.ndarray, d: np.ndarray, first: int, primary: int, rows: int,
                 ic + first)
 
 
-def _strip_triangles(ta: np.ndarray, tb: np.ndarray) -> np.ndarray:
-    """Triangulate the strip between two sorted chains by merging their parameters.
-
-    Parameters
-    ----------
-    ta, tb : (p,), (q,) float64
-        Increasing parameters of the chain vertices on the left and right generator.
-
-    Returns
-    -------
-    (p + q - 2, 3) int64
-        Triangles indexing the concatenation [chain a, chain b] (b offset by p),
-        oriented like the PQ faces (left chain, right chain, left chain).
-    """
-    p, q = len(ta), len(tb)
-    # Walk both chains in order of parameter: each step advances one chain and
-    # closes one triangle (the classical zipper).
-    keys = np.concatenate([ta[1:], tb[1:]])
-    which = np.concatenate([np.zeros(p - 1, bool), np.ones(q - 1, bool)])
-    order = np.argsort(keys, kind="stable")
-    step_b = which[order]
-    ia = np.concatenate([[0], np.cumsum(~step_b)])
-    ib = np.concatenate([[0], np.cumsum(step_b)])
-    tri = np.where(step_b[:, None],
-                   np.stack([ia[:-1], p + ib[:-1], p + ib[:-1] + 1], axis=1),
-                   np.stack([ia[:-1], p + ib[:-1], ia[:-1] + 1], axis=1))
-    return tri
-
-
 def pq_mesh(a, b, rows: int = 20, primary: int | str = "middle", option: int = 0,
             extend: float | str = "auto", trim: bool = True, *, max_extend: float = 20.0,
             creases=None, tol: Tolerances = DEFAULT) -> Mesh:
@@ -478,9 +437,7 @@ def pq_mesh(a, b, rows: int = 20, primary: int | str = "middle", option: int = 0
     if kinks.size:
         warnings.append(f"{kinks.size} crease strips (generators {listed(kinks)}: a director curve "
                         "has a corner there): rows restarted, strips filled with triangles")
-    parts = []          # (vertices, t, gen, faces_list, kinds)
-    offset = 0
-    run_of = np.full(m, -1)
+    parts = []          # one _Run per run of at least three generators
     for r0, r1 in zip(bounds[:-1], bounds[1:]):
         if r1 - r0 < 3:
             continue
@@ -488,12 +445,11 @@ def pq_mesh(a, b, rows: int = 20, primary: int | str = "middle", option: int = 0
         pr = p - r0 if (not middle and r0 <= p < r1) else (r1 - r0) // 2
         run = _mesh_run(a[r0:r1], d[r0:r1], r0, pr, rows, option, extend, max_extend, tol,
                         scale, warnings)
-        run_of[r0:r1] = len(parts)
         parts.append(run)
-    return _assemble(parts, a, d, rows, trim, tol, warnings, bounds, run_of, scale)
+    return _assemble(parts, a, d, trim, tol, warnings, scale)
 
 
-def _assemble(parts, a, d, rows, trim, tol, warnings, bounds, run_of, scale) -> Mesh:
+def _assemble(parts, a, d, trim, tol, warnings, scale) -> Mesh:
     """Join the runs; keep convex quads and valid halves; fill the gaps; add members."""
     from .analysis.faces import quad_diagonal_crossing
 
