@@ -916,9 +916,9 @@ class BSpline(Curve):
             raise ParameterError(
                 f"a degree-{degree} B-spline needs at least {degree + 1} control points, got {n}",
                 "control_points")
-        if degree == 1:
-            # a repeated point makes a piece of zero length (zero speed: no arc length)
-            _check_distinct(cp, "control_points")
+        # A repeated point gives a piece of zero length (degree 1) or zero speed
+        # at an end (higher degrees): arc length and tangents divide by zero.
+        _check_distinct(cp, "control_points")
         if np.ptp(cp, axis=0).max() <= DEFAULT.degenerate * max(float(np.abs(cp).max()), 1e-300):
             # a point, not a curve: arc length and tangents would divide by zero
             raise ParameterError("all control points coincide; a curve needs two distinct points",
