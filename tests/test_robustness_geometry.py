@@ -447,3 +447,19 @@ def test_canal_degenerate_spines_mesh_or_refuse_cleanly(case):
             return
     assert np.all(np.isfinite(built.mesh.vertices))
     assert planarity(built.mesh).max() <= 1e-12
+
+
+@pytest.mark.xfail(strict=True, reason="pq.py _normalise divides 0 by 0 (RuntimeWarning on "
+                   "stderr) when a generator repeats two places later next to a torsal one; "
+                   "found by test_fuzz.py, reported to the lead")
+def test_pq_repeated_generator_does_not_warn():
+    import warnings
+
+    from ruledmesh.pq import pq_mesh
+
+    a = np.array([[1, 0, 0], [0, 0, 1], [1, 0, 0]], float)
+    b = np.array([[1, 1, 0], [0, 0, 0], [1, 1, 0]], float)
+    with warnings.catch_warnings():
+        warnings.simplefilter("error", RuntimeWarning)
+        mesh = pq_mesh(a, b, rows=1)
+    assert np.all(np.isfinite(mesh.vertices))
