@@ -16,7 +16,6 @@ multiplies them by ten.
 
 from __future__ import annotations
 
-import math
 import os
 
 import numpy as np
