@@ -138,10 +138,8 @@ ALLOWED = (RuledMeshError,)
 
 
 # ------------------------------------------------------------ §4.3 PQ mesh
-# pq.py warns (0/0 in _normalise) for a generator repeated two places later
-# next to a torsal one; the output stays finite.  Strict xfail in
-# test_robustness_geometry.py (test_pq_repeated_generator_does_not_warn); reported.
-@pytest.mark.filterwarnings("ignore:invalid value encountered in divide:RuntimeWarning:ruledmesh.pq")
+# (A generator repeated two places later next to a torsal one used to warn 0/0 in
+# pq._normalise; fixed, regression test in test_robustness_geometry.py.)
 @fuzz(2500)
 @given(gens=generator_sets(), rows=st.integers(1, 8), option=st.integers(0, 1),
        trim=st.booleans(), primary=st.one_of(st.just("middle"), st.integers(-3, 2)),

@@ -449,9 +449,6 @@ def test_canal_degenerate_spines_mesh_or_refuse_cleanly(case):
     assert planarity(built.mesh).max() <= 1e-12
 
 
-@pytest.mark.xfail(strict=True, reason="pq.py _normalise divides 0 by 0 (RuntimeWarning on "
-                   "stderr) when a generator repeats two places later next to a torsal one; "
-                   "found by test_fuzz.py, reported to the lead")
 def test_pq_repeated_generator_does_not_warn():
     import warnings
 

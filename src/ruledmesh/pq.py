@@ -49,7 +49,9 @@ _BYTES_PER_GRID_POINT = 96
 
 
 def _normalise(M: np.ndarray) -> np.ndarray:
-    return M / np.abs(M).max()
+    # A zero map (a degenerate hop between repeated generators) stays zero, never 0/0.
+    top = np.abs(M).max()
+    return M / top if top > 0 else M
 
 
 def row_maps(a: np.ndarray, d: np.ndarray, primary: int) -> np.ndarray:
