@@ -63,12 +63,7 @@ def _near_miss_cases():
                 continue
             keys = [k for k in table if len(k) > 1]
             if keys:
-                marks = ([pytest.mark.xfail(strict=True, reason="transforms.py: [[transform]] "
-                                            "tables suggest from 'kind' (not a transform key) "
-                                            "and never from 'type'; reported")]
-                         if path.startswith("transform[") and keys[0] == "type" else [])
-                yield pytest.param(example, path, keys[0], id=f"{example.stem}:{path or '<top>'}",
-                                   marks=marks)
+                yield pytest.param(example, path, keys[0], id=f"{example.stem}:{path or '<top>'}")
 
 
 @pytest.mark.parametrize("example, path, key", list(_near_miss_cases()))

@@ -415,7 +415,7 @@ def _fit_affine(before: np.ndarray, after: np.ndarray, fn, params) -> tuple[np.n
 def _fields(table: Mapping, path: str, allowed):
     from .constructions._spec import Fields
 
-    return Fields({k: v for k, v in table.items() if k != "type"}, path, allowed)
+    return Fields(table, path, allowed, selector="type")
 
 
 def _matrix(table: Mapping, key: str, path: str, shapes):

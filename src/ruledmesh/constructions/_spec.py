@@ -27,13 +27,15 @@ class Fields:
     prefix : str
         Its dotted path (``"surface"``).
     allowed : iterable of str
-        Keys the table may have (``kind`` is always allowed).
+        Keys the table may have besides ``selector``.
+    selector : str
+        The key that chose the builder (``kind`` for surfaces, ``type`` for transforms).
     """
 
-    def __init__(self, table: Mapping[str, Any], prefix: str, allowed):
+    def __init__(self, table: Mapping[str, Any], prefix: str, allowed, selector: str = "kind"):
         self.table = table
         self.prefix = prefix
-        check_keys(table, ["kind", *allowed], prefix, err=DesignError)
+        check_keys(table, [selector, *allowed], prefix, err=DesignError)
 
     def path(self, key: str) -> str:
         return f"{self.prefix}.{key}"
