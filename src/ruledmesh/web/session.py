@@ -27,7 +27,7 @@ from ..mesh import FaceKind, Mesh
 from ..registry import Built
 from .toml_writer import dumps
 
-__all__ = ["Session", "DEFAULT_DESIGN", "fan_triangles", "unique_edges", "fast_figures", "encode_message",
+__all__ = ["Session", "DEFAULT_DESIGN", "fan_triangles", "fast_figures", "encode_message",
            "set_path"]
 
 # Shown when the designer starts without a design file (paper Fig. 10, a skew surface).
@@ -116,23 +116,6 @@ def fan_triangles(mesh: Mesh) -> tuple[np.ndarray, np.ndarray]:
     base = off[:-1][face]
     tris = np.stack([idx[base], idx[base + j], idx[base + j + 1]], axis=1)
     return tris, face
-
-
-def unique_edges(mesh: Mesh) -> np.ndarray:
-    """(E, 2) int64: the mesh's undirected edges, each once (low, high).
-
-    Same set as :meth:`Mesh.edges`, faster: the unique runs on one int64 key
-    per edge instead of on rows.
-    """
-    idx = mesh.face_indices
-    if idx.size == 0:
-        return np.zeros((0, 2), dtype=np.int64)
-    nxt = np.arange(1, idx.size + 1)
-    nxt[mesh.face_offsets[1:] - 1] = mesh.face_offsets[:-1]
-    lo = np.minimum(idx, idx[nxt])
-    hi = np.maximum(idx, idx[nxt])
-    key = np.unique(lo * np.int64(mesh.n_vertices) + hi)
-    return np.stack([key // mesh.n_vertices, key % mesh.n_vertices], axis=1)
 
 
 def fast_figures(mesh: Mesh) -> tuple[dict[str, Any], np.ndarray]:
@@ -509,7 +492,7 @@ class Session:
             ("triangle_face", tri_face.astype(np.uint32)),
             ("planarity", plan.astype(np.float32)),
             ("kind", mesh.face_kind.astype(np.uint8)),
-            ("edges", unique_edges(mesh).astype(np.uint32)),
+            ("edges", mesh.edges().astype(np.uint32)),
         ]
         rulings = built.rulings
         if rulings is not None and getattr(rulings, "a", None) is not None:
