@@ -136,6 +136,18 @@ def test_page_loads_and_draws(page, designer):
                            timeout=60_000)
 
 
+def server_reaches(predicate, timeout=10.0) -> bool:
+    """Poll the server-side state until ``predicate`` holds (edits are applied asynchronously)."""
+    import time
+
+    end = time.monotonic() + timeout
+    while time.monotonic() < end:
+        if predicate():
+            return True
+        time.sleep(0.02)
+    return predicate()
+
+
 def test_slider_changes_mesh_and_picture(page, designer):
     before = picture(page)
     v = page.evaluate("window.designer.version")
@@ -145,14 +157,16 @@ def test_slider_changes_mesh_and_picture(page, designer):
         page.keyboard.press("ArrowRight")
     v = wait_version(page, v)
     page.wait_for_function("document.querySelector('[data-path=\"rulings.count\"] input.val').value === '19'")
-    assert designer.session.design["rulings"]["count"] == 19
-    assert page.inner_text("[data-fig=faces]") == str(designer.session.built.mesh.n_faces)
+    # The field shows the value before the server has applied the last queued edit.
+    assert server_reaches(lambda: designer.session.design["rulings"]["count"] == 19)
+    page.wait_for_function(f"document.querySelector('[data-fig=faces]').textContent === "
+                           f"'{designer.session.built.mesh.n_faces}'")
     after = picture(page)
     assert np.count_nonzero(np.abs(after - before).sum(axis=2) > 40) > 50
     # undo in the page goes back on the server
     page.click("#undo")
     page.wait_for_function("document.querySelector('[data-path=\"rulings.count\"] input.val').value === '18'")
-    assert designer.session.design["rulings"]["count"] == 18
+    assert server_reaches(lambda: designer.session.design["rulings"]["count"] == 18)
 
 
 def test_dragging_a_control_point_changes_mesh_and_picture(page, designer):

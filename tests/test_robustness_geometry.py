@@ -460,3 +460,21 @@ def test_pq_repeated_generator_does_not_warn():
         warnings.simplefilter("error", RuntimeWarning)
         mesh = pq_mesh(a, b, rows=1)
     assert np.all(np.isfinite(mesh.vertices))
+
+
+def test_spline_with_a_cusp_meshes_without_warnings():
+    # Regression (fuzz, CI): a degree-2 spline doubling back has zero speed at its cusp; the
+    # arc-length correspondence divided by that speed.
+    import warnings
+
+    from ruledmesh.design import build_design, parse_design
+
+    text = ('[curves.c1]\ntype = "line"\npoints = [[0, 0, 0], [0, 0, 1]]\n'
+            '[curves.c2]\ntype = "bspline"\ndegree = 2\npoints = [[1, 0, 0], [0, 0, 0], [1, 0, 0]]\n'
+            '[rulings]\nbetween = ["c1", "c2"]\ncount = 3\ndistribution = "arc-length"\n'
+            '[mesh]\nmethod = "hybrid"\nmidpoints = 0\ndivisions = 1\n')
+    with warnings.catch_warnings():
+        warnings.simplefilter("error", RuntimeWarning)
+        built = build_design(parse_design(text, "cusp.toml"))
+    assert np.all(np.isfinite(built.mesh.vertices))
+    assert planarity(built.mesh).max() <= 1e-12

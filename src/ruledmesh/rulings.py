@@ -119,7 +119,13 @@ def _arc_sigma(curve: Curve, count: int) -> Any:
     if not isinstance(curve, BSpline):
         return exact
     grid, _ = _dense_grid(count)
-    return _Pchip.of(grid, exact.value(grid), exact.deriv(grid))
+    values = exact.value(grid)
+    speed = curve._speed(values)
+    if np.all(speed > 1e-12 * curve.length()):
+        return _Pchip.of(grid, values, curve.length() / speed)
+    # A cusp (zero speed, e.g. a spline doubling back) has an infinite slope
+    # there: use the monotone interpolant of the samples instead.
+    return _Pchip.of(grid, values)
 
 
 @dataclass(frozen=True, eq=False)
