@@ -88,7 +88,8 @@ def triangle_quality(vertices: np.ndarray, triangles: np.ndarray) -> dict[str, A
         ``triangles``; ``min_angle_deg`` (the smallest angle anywhere);
         ``min_angle_percentiles`` (1, 5, 50 % of the per-triangle smallest
         angle); ``splinters`` (triangles whose smallest angle is below
-        :data:`SPLINTER_ANGLE`); ``aspect_ratio`` (median, 95 %, max) and
+        :data:`SPLINTER_ANGLE`); ``aspect_ratio`` (median, 95 %, max over the
+        non-degenerate triangles), ``degenerate_triangles`` (zero area) and
         ``aspect_histogram`` (counts per :data:`ASPECT_BINS` interval).
     """
     pts = np.asarray(vertices, dtype=np.float64)[np.asarray(triangles, dtype=np.int64)]
@@ -103,8 +104,12 @@ def triangle_quality(vertices: np.ndarray, triangles: np.ndarray) -> dict[str, A
         "min_angle_deg": float(mins.min()),
         "min_angle_percentiles": {f"p{q}": float(np.percentile(mins, q)) for q in (1, 5, 50)},
         "splinters": int(np.count_nonzero(mins < SPLINTER_ANGLE)),
-        "aspect_ratio": {"median": float(np.median(ar)), "p95": float(np.percentile(ar, 95)),
-                         "max": float(ar.max())},
+        # Degenerate triangles (infinite ratio) are counted, not averaged: statistics of
+        # infinities are NaN, and JSON has no infinity.
+        "aspect_ratio": ({"median": float(np.median(fin)), "p95": float(np.percentile(fin, 95)),
+                          "max": float(fin.max())} if (fin := ar[np.isfinite(ar)]).size
+                         else {"median": 0.0, "p95": 0.0, "max": 0.0}),
+        "degenerate_triangles": int(np.count_nonzero(~np.isfinite(ar))),
         "aspect_histogram": dict(zip(labels, counts.tolist())),
     }
 
