@@ -48,10 +48,56 @@ _ON_BORDER = 1e-12
 _BYTES_PER_GRID_POINT = 96
 
 
-def _normalise(M: np.ndarray) -> np.ndarray:
-    # A zero map (a degenerate hop between repeated generators) stays zero, never 0/0.
-    top = np.abs(M).max()
-    return M / top if top > 0 else M
+@dataclass(frozen=True)
+class _ChainMaps:
+    """What both the composed maps and the hop-by-hop rows start from."""
+
+    primary: int            # the a-chain's root (moved to 0 for three generators)
+    root: int               # the b-chain's root, next to the primary
+    fwd: np.ndarray         # (m-2, 2, 2) g_k -> g_k+2, |det| = 1
+    bwd: np.ndarray         # (m-2, 2, 2) g_k+2 -> g_k, |det| = 1
+    crossing: np.ndarray    # (2, 2) primary -> root, |det| = 1
+
+
+def _chain_maps(a: np.ndarray, d: np.ndarray, primary: int) -> _ChainMaps:
+    """Landing maps in both directions and the crossing map that roots chain *b*."""
+    m = len(a)
+    if primary + 2 >= m and primary - 2 < 0:
+        # Three generators with the primary in the middle: no hop starts there.
+        primary = 0
+    # Landing maps g_k -> g_{k+2} (forward) and g_k -> g_{k-2} (backward), all at once.
+    fwd = _unit_det(landing_maps(a[:-2], d[:-2], a[1:-1], d[1:-1], a[2:], d[2:]))
+    bwd = _unit_det(landing_maps(a[2:], d[2:], a[1:-1], d[1:-1], a[:-2], d[:-2]))
+    # Chain b starts where chain a's first hop crosses the neighbour (towards the longer side).
+    root = primary + 1 if primary + 2 < m else primary - 1
+    far = root + 1 if root > primary else root - 1
+    C = _unit_det(crossing_maps(a[primary:primary + 1], d[primary:primary + 1], a[root:root + 1],
+                                d[root:root + 1], a[far:far + 1], d[far:far + 1]))[0]
+    return _ChainMaps(primary, root, fwd, bwd, C)
+
+
+def _product(h: list, m: list) -> list:
+    """2x2 product ``h @ m`` of nested lists, scaled to unit max-norm (a zero map stays zero)."""
+    (h00, h01), (h10, h11) = h
+    (m00, m01), (m10, m11) = m
+    r = (h00 * m00 + h01 * m10, h00 * m01 + h01 * m11, h10 * m00 + h11 * m10, h10 * m01 + h11 * m11)
+    s = max(map(abs, r)) or 1.0
+    return [[r[0] / s, r[1] / s], [r[2] / s, r[3] / s]]
+
+
+def _compose(maps: _ChainMaps, m: int) -> np.ndarray:
+    """The maps of :func:`row_maps` from a :class:`_ChainMaps`."""
+    out = [None] * m
+    out[maps.primary] = [[1.0, 0.0], [0.0, 1.0]]
+    out[maps.root] = _product(maps.crossing.tolist(), out[maps.primary])
+    fwd, bwd = maps.fwd.tolist(), maps.bwd.tolist()
+    # Sequential only along the generators (m small 2x2 products), never per vertex.
+    for start in (maps.primary, maps.root):
+        for i in range(start + 2, m, 2):
+            out[i] = _product(fwd[i - 2], out[i - 2])
+        for i in range(start - 2, -1, -2):
+            out[i] = _product(bwd[i], out[i + 2])
+    return np.array(out)
 
 
 def row_maps(a: np.ndarray, d: np.ndarray, primary: int) -> np.ndarray:
@@ -74,45 +120,7 @@ def row_maps(a: np.ndarray, d: np.ndarray, primary: int) -> np.ndarray:
         ``t_i = (M[i,0,0] tau + M[i,0,1]) / (M[i,1,0] tau + M[i,1,1])``;
         each matrix scaled to unit max-norm.
     """
-    m = len(a)
-    if primary + 2 >= m and primary - 2 < 0:
-        # Three generators with the primary in the middle: no hop starts there.
-        primary = 0
-    M = np.zeros((m, 2, 2))
-    M[primary] = np.eye(2)
-    # Landing maps g_k -> g_{k+2} (forward) and g_k -> g_{k-2} (backward), all at once.
-    fwd = landing_maps(a[:-2], d[:-2], a[1:-1], d[1:-1], a[2:], d[2:])
-    bwd = landing_maps(a[2:], d[2:], a[1:-1], d[1:-1], a[:-2], d[:-2])
-    if primary + 2 < m:
-        root = primary + 1
-        M[root] = _normalise(crossing_maps(a[primary:primary + 1], d[primary:primary + 1],
-                                           a[root:root + 1], d[root:root + 1],
-                                           a[root + 1:root + 2], d[root + 1:root + 2])[0])
-    else:
-        root = primary - 1
-        M[root] = _normalise(crossing_maps(a[primary:primary + 1], d[primary:primary + 1],
-                                           a[root:root + 1], d[root:root + 1],
-                                           a[root - 1:root], d[root - 1:root])[0])
-    # Sequential only along the generators (m small 2x2 products), never per vertex.
-    fwd_l = fwd.tolist()
-    bwd_l = bwd.tolist()
-    out = M.tolist()
-    for start in (primary, root):
-        for i in range(start + 2, m, 2):
-            (h00, h01), (h10, h11) = fwd_l[i - 2]
-            (m00, m01), (m10, m11) = out[i - 2]
-            r = [[h00 * m00 + h01 * m10, h00 * m01 + h01 * m11],
-                 [h10 * m00 + h11 * m10, h10 * m01 + h11 * m11]]
-            s = max(abs(r[0][0]), abs(r[0][1]), abs(r[1][0]), abs(r[1][1])) or 1.0
-            out[i] = [[r[0][0] / s, r[0][1] / s], [r[1][0] / s, r[1][1] / s]]
-        for i in range(start - 2, -1, -2):
-            (h00, h01), (h10, h11) = bwd_l[i]
-            (m00, m01), (m10, m11) = out[i + 2]
-            r = [[h00 * m00 + h01 * m10, h00 * m01 + h01 * m11],
-                 [h10 * m00 + h11 * m10, h10 * m01 + h11 * m11]]
-            s = max(abs(r[0][0]), abs(r[0][1]), abs(r[1][0]), abs(r[1][1])) or 1.0
-            out[i] = [[r[0][0] / s, r[0][1] / s], [r[1][0] / s, r[1][1] / s]]
-    return np.array(out)
+    return _compose(_chain_maps(a, d, primary), len(a))
 
 
 def _patch_preimage(M: np.ndarray, tol: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
@@ -195,19 +203,18 @@ def _unit_det(H: np.ndarray) -> np.ndarray:
     return H / scale[:, None, None]
 
 
-def _propagate(a: np.ndarray, d: np.ndarray, primary: int, tau: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+def _propagate(maps: _ChainMaps, tau: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """Homogeneous row parameters on every generator, hop by hop.
 
     Each vertex is the exact image (one rounding) of its neighbour two
     generators back, so the hop-line diagonal of every face meets its generator
-    to rounding, however many generators the chain crosses.  (Composing the
-    maps first and evaluating them once is faster but lets rounding drift
-    between neighbours: 2e-11 after a thousand hops.)
+    to rounding, however many generators the chain crosses.  (The composed
+    maps of :func:`row_maps` are used only to choose the rows: evaluated
+    directly they let rounding drift between neighbours.)
 
     Parameters
     ----------
-    a, d : (m, 3) float64
-    primary : int
+    maps : _ChainMaps
     tau : (m, H) float64
         Row parameter on the primary generator, per generator's row parity.
 
@@ -216,15 +223,8 @@ def _propagate(a: np.ndarray, d: np.ndarray, primary: int, tau: np.ndarray) -> t
     num, den : (m, H) float64
         ``t = num / den``; ``den`` changes sign where a row passes infinity.
     """
-    m = len(a)
-    if primary + 2 >= m and primary - 2 < 0:
-        primary = 0
-    fwd = _unit_det(landing_maps(a[:-2], d[:-2], a[1:-1], d[1:-1], a[2:], d[2:]))
-    bwd = _unit_det(landing_maps(a[2:], d[2:], a[1:-1], d[1:-1], a[:-2], d[:-2]))
-    root = primary + 1 if primary + 2 < m else primary - 1
-    far_side = root + 1 if root > primary else root - 1
-    C = _unit_det(crossing_maps(a[primary:primary + 1], d[primary:primary + 1], a[root:root + 1],
-                                d[root:root + 1], a[far_side:far_side + 1], d[far_side:far_side + 1]))[0]
+    m = len(tau)
+    primary, root, fwd, bwd, C = maps.primary, maps.root, maps.fwd, maps.bwd, maps.crossing
     num = np.empty_like(tau)
     den = np.empty_like(tau)
     num[primary], den[primary] = tau[primary], 1.0
@@ -263,8 +263,8 @@ def _mesh_run(a: np.ndarray, d: np.ndarray, first: int, primary: int, rows: int,
               warnings: list[str]) -> _Run:
     """Checkerboard PQ grid on generators a, d (a run), before trimming."""
     m = len(a)
-    M = row_maps(a, d, primary)
-    j0, j1 = _row_range(M, rows, extend, max_extend, tol, warnings)
+    maps = _chain_maps(a, d, primary)
+    j0, j1 = _row_range(_compose(maps, m), rows, extend, max_extend, tol, warnings)
     J = j1 - j0 + 1
     if m * J > MAX_GRID_POINTS:
         need = m * J * _BYTES_PER_GRID_POINT / 2**30
@@ -276,7 +276,7 @@ def _mesh_run(a: np.ndarray, d: np.ndarray, first: int, primary: int, rows: int,
     i_idx = np.arange(m)
     s = (option - i_idx - j0) % 2
     tau = (j0 + s[:, None] + 2 * np.arange(H)[None, :]) / rows          # (m, H)
-    num, den = _propagate(a, d, primary, tau)
+    num, den = _propagate(maps, tau)
     # Far limit in t: tol.far patch diagonals along each generator.
     glen = np.linalg.norm(d, axis=1)
     tmax = tol.far * scale / np.maximum(glen, 1e-300)
@@ -472,16 +472,17 @@ def _assemble(parts, a, d, trim, tol, warnings, scale) -> Mesh:
     # not flip when the design is scaled or moved (t is scale-free up to rounding).
     lo_t, hi_t = (-_ON_BORDER, 1.0 + _ON_BORDER) if trim else (-np.inf, np.inf)
     good_v = ~FAR & (T >= lo_t) & (T <= hi_t)
-    ok_l = (L[:, 0] >= 0) & ~POLE & good_v[np.maximum(L, 0)].all(axis=1)
-    ok_r = (R[:, 0] >= 0) & ~POLE & good_v[np.maximum(R, 0)].all(axis=1)
+    cand_l = (L[:, 0] >= 0) & ~POLE & good_v[np.maximum(L, 0)].all(axis=1)
+    cand_r = (R[:, 0] >= 0) & ~POLE & good_v[np.maximum(R, 0)].all(axis=1)
+    ok_l, ok_r = cand_l, cand_r
     if trim:
         V, T, G, ok_l, ok_r, fill, chain, gstart = _strip_paths(V, T, G, good_v, a, d, m, L, R,
                                                                  ok_l, ok_r, CG, scale)
     else:
         chain = gstart = None
         # Untrimmed: rows must still increase along each generator inside a face.
-        ok_l &= T[np.maximum(L[:, 2], 0)] > T[np.maximum(L[:, 1], 0)]
-        ok_r &= T[np.maximum(R[:, 2], 0)] > T[np.maximum(R[:, 0], 0)]
+        ok_l = cand_l & (T[np.maximum(L[:, 2], 0)] > T[np.maximum(L[:, 1], 0)])
+        ok_r = cand_r & (T[np.maximum(R[:, 2], 0)] > T[np.maximum(R[:, 0], 0)])
         fill = np.zeros((0, 3), np.int64)
     both = ok_l & ok_r
     quads = np.stack([L[both, 0], L[both, 1], R[both, 1], L[both, 2]], axis=1)
@@ -504,8 +505,7 @@ def _assemble(parts, a, d, trim, tol, warnings, scale) -> Mesh:
         warnings.append(f"{nsplit} quads were not convex (the two chains of §4.3 drifted apart) "
                         "and were kept as two triangles split along their generator diagonal; "
                         "sample the generators more finely there")
-    dropped = int(np.count_nonzero((L[:, 0] >= 0) & ~POLE & good_v[np.maximum(L, 0)].all(axis=1) & ~ok_l)
-                  + np.count_nonzero((R[:, 0] >= 0) & ~POLE & good_v[np.maximum(R, 0)].all(axis=1) & ~ok_r))
+    dropped = int(np.count_nonzero(cand_l & ~ok_l) + np.count_nonzero(cand_r & ~ok_r))
     if dropped:
         warnings.append(f"{dropped} half-faces ran against the order of their strip (rows reversing "
                         "or overlapping) and were replaced by fill triangles")
