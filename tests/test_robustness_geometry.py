@@ -478,3 +478,14 @@ def test_spline_with_a_cusp_meshes_without_warnings():
         built = build_design(parse_design(text, "cusp.toml"))
     assert np.all(np.isfinite(built.mesh.vertices))
     assert planarity(built.mesh).max() <= 1e-12
+
+
+def test_helicoid_with_a_vanishing_pitch_is_refused():
+    # Regression (fuzz): pitch 2.2e-308 underflowed k^2 and gave 0 * inf = NaN in the area.
+    from ruledmesh.design import build_design, parse_design
+    from ruledmesh.errors import RuledMeshError
+
+    text = ('[surface]\nkind = "helicoid"\nradius = 1.0\npitch = 2.2250738585072014e-308\n'
+            'turns = 1.0\n[mesh]\nu = 3\nv = 3\n')
+    with pytest.raises(RuledMeshError, match="pitch must not vanish against the radius"):
+        build_design(parse_design(text, "helicoid.toml"))

@@ -25,6 +25,7 @@ from .._validation import check_float, check_int
 from ..errors import DesignError, GeometryError
 from ..mesh import Mesh
 from ..registry import BuildContext, Built, surface_kind
+from ..tolerances import DEFAULT
 from ._grid import grid_mesh
 from ._spec import Fields, mesh_counts
 from .reference import ImplicitSurface
@@ -79,8 +80,9 @@ def helicoid_mesh(radius: float, pitch: float, turns: float = 1.0, u: int = 48,
     """
     radius = check_float(radius, "radius", lo=0.0, lo_open=True)
     pitch = check_float(pitch, "pitch")
-    if pitch == 0:
-        raise GeometryError("pitch must be non-zero (pitch 0 is a plane)")
+    if abs(pitch) <= DEFAULT.degenerate * radius:
+        raise GeometryError(f"pitch must not vanish against the radius (pitch {pitch:g} for "
+                            f"radius {radius:g} is a plane)")
     turns = check_float(turns, "turns", lo=0.0, lo_open=True)
     u = check_int(u, "u", lo=2)
     v = u if v is None else check_int(v, "v", lo=2)
