@@ -30,6 +30,7 @@ __all__ = [
     "check_bool",
     "check_choice",
     "check_keys",
+    "near_miss",
 ]
 
 
@@ -47,6 +48,14 @@ def describe(value: Any) -> str:
         text = repr(list(value))
         return text if len(text) <= 60 else f"a list of {len(value)} items"
     return repr(value)
+
+
+def near_miss(value: Any, choices: Iterable[str]) -> str:
+    """`` (did you mean "x"?)`` for the closest of ``choices`` to ``value``, or ``""``."""
+    if not isinstance(value, str):
+        return ""
+    near = difflib.get_close_matches(value, list(choices), n=1)
+    return f' (did you mean "{near[0]}"?)' if near else ""
 
 
 def _as_float_array(value: Any, name: str, err: type) -> np.ndarray:
@@ -189,12 +198,7 @@ def check_choice(value: Any, enum: type[E], name: str, *, err: type = ParameterE
     if isinstance(value, str) and value in choices:
         return enum(value)
     listed = " | ".join(f'"{c}"' for c in choices)
-    hint = ""
-    if isinstance(value, str):
-        near = difflib.get_close_matches(value, choices, n=1)
-        if near:
-            hint = f' (did you mean "{near[0]}"?)'
-    raise err(f"expected one of {listed}, got {describe(value)}{hint}", name)
+    raise err(f"expected one of {listed}, got {describe(value)}{near_miss(value, choices)}", name)
 
 
 def check_keys(table: Mapping[str, Any], allowed: Iterable[str], name: str, *,
@@ -206,7 +210,6 @@ def check_keys(table: Mapping[str, Any], allowed: Iterable[str], name: str, *,
     allowed = list(allowed)
     for key in table:
         if key not in allowed:
-            near = difflib.get_close_matches(str(key), allowed, n=1)
-            hint = f' (did you mean "{near[0]}"?)' if near else ""
+            hint = near_miss(str(key), allowed)
             where = f"{name}.{key}" if name else str(key)
             raise err(f"unknown key{hint}; expected one of: {', '.join(allowed)}", where)

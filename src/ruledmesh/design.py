@@ -17,7 +17,7 @@ from typing import Any, Mapping
 
 import numpy as np
 
-from ._validation import check_keys, describe
+from ._validation import check_keys, describe, near_miss
 from .errors import DesignError, RuledMeshError
 from .registry import (MESH_METHODS, SURFACE_KINDS, TRANSFORMS, BuildContext, Built,
                        load_plugins)
@@ -211,17 +211,10 @@ def _with_creases(rulings, table: Mapping, curves: Mapping) -> Any:
 
 
 def _unknown(path: str, value: Any, table: Mapping) -> DesignError:
-    import difflib
-
     names = sorted(table)
     listed = " | ".join(f'"{n}"' for n in names)
-    hint = ""
-    if isinstance(value, str):
-        near = difflib.get_close_matches(value, names, n=1)
-        if near:
-            hint = f' (did you mean "{near[0]}"?)'
     got = "nothing" if value is None else describe(value)
-    return DesignError(f"expected one of {listed}, got {got}{hint}", path)
+    return DesignError(f"expected one of {listed}, got {got}{near_miss(value, names)}", path)
 
 
 def build_design(design: Design) -> Built:
