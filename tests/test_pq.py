@@ -236,7 +236,8 @@ def test_kink_of_a_director_polyline_gets_a_generator_and_matched_rows():
     mesh = built.mesh
     check_mesh(mesh)
     info = built.rulings.info
-    assert info["inserted"] == 2 and len(built.rulings.a) == 43
+    assert len(info["crease_generators"]) == 2 and info["inserted"] >= 2
+    assert len(built.rulings.a) == 41 + info["inserted"]
     # The two corners of c2 lie exactly on the inserted generators.
     corners = np.array([[3, 4, 5], [6, 3, 3]], float)
     for k, c in zip(info["crease_generators"], corners):

@@ -31,6 +31,8 @@ _RESTART_SHARE = 0.05
 _MIN_RUN = 4
 # A run most of whose faces on the patch would not be convex is not meshed as a run.
 _HOPELESS_SHARE = 0.3
+# A build with more than this share of its area outside quads says why.
+_WARN_SHARE = 0.3
 
 
 @dataclass(frozen=True)
@@ -310,11 +312,54 @@ def pq_mesh(a, b, rows: int = 20, primary: int | str = "middle", option: int = 0
     parts = _build_all(plan, segs, p, middle,
                        Division(rows, option, extend, max_extend), m)
     restarts = len([r for r in parts if len(r.left)]) - len([s for s in segs if s.hi - s.lo >= 2])
+    even = _even_ranges(parts, segs)
+    if even:
+        warnings.append(f"generators {', '.join(even[:8])}{' ...' if len(even) > 8 else ''} carry no "
+                        "§4.3 rows (the rows bunch along the generators there: nearly developable, "
+                        "or next to a torsal generator) and are closed by strip quads or triangles; "
+                        "planarity_tolerance = 1e-3 admits nearly planar strip quads there")
     meet = np.zeros(m, bool)
     meet[:-1] |= flat
     meet[1:] |= flat
     mesh = assemble(parts, a, d, trim, tol, ptol, warnings, scale, meet)
+    _warn_share(mesh, warnings, torsal.size, even, max(restarts, 0), m, rows)
     return mesh.with_info(runs=len(parts), restarts=max(restarts, 0), planarity_tolerance=ptol)
+
+
+def _even_ranges(parts: list[Run], segs: list[_Segment]) -> list[str]:
+    """Generator ranges that carry an even division without hops (not the short segments)."""
+    short = {(s.lo, s.hi) for s in segs if s.hi - s.lo < 2}
+    out = []
+    for r in parts:
+        if len(r.left) == 0 and r.gen.size:
+            lo, hi = int(r.gen.min()), int(r.gen.max())
+            if (lo, hi) not in short:
+                out.append(f"{lo}-{hi}" if hi > lo else f"{lo}")
+    return out
+
+
+def _warn_share(mesh: Mesh, warnings: list[str], torsal: int, even: list[str], restarts: int,
+                m: int, rows: int) -> None:
+    """Say so when much of the area is not in quads, with the causes and what to change."""
+    from ..analysis.faces import area_shares
+
+    if mesh.n_faces == 0:
+        return
+    share = 1.0 - area_shares(mesh)["quads"]
+    if share <= _WARN_SHARE:
+        return
+    causes = []
+    if torsal:
+        causes.append(f"{torsal} torsal generators")
+    if even:
+        causes.append(f"no rows on generators {', '.join(even[:4])}")
+    if restarts:
+        causes.append(f"the two chains drifted apart ({restarts} restarts)")
+    if m < 2 * rows:
+        causes.append(f"few generators for {rows} rows")
+    warnings.append(f"{share:.0%} of the area is not in quads ({'; '.join(causes) or 'border'}): "
+                    "more generators (rulings.count), fewer rows, [mesh] planarity_tolerance = 1e-3 "
+                    "for nearly developable parts, or method = \"hybrid\"")
 
 
 def _nearly_flat(a: np.ndarray, d: np.ndarray, rows: int, ptol: float) -> np.ndarray:

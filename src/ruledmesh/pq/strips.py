@@ -19,11 +19,27 @@ __all__ = ["ON_BORDER", "Gaps", "chains", "group_starts", "strip_paths", "zipper
 
 # Parameters this close to 0 or 1 are on the patch border (rounding of t).
 ON_BORDER = 1e-12
+# A vertex nearer the director curve than this share of the strip width (and
+# this share of the diagonal) is taken as the border point of its generator.
+SNAP_WIDTH = 0.06
+SNAP_GAP = 5e-4
 
 
 def group_starts(keys: np.ndarray) -> np.ndarray:
     """(n,) bool: first element of each run of equal sorted keys."""
     return np.r_[True, keys[1:] != keys[:-1]] if keys.size else np.zeros(0, bool)
+
+
+def _snap(rail: np.ndarray, scale: float) -> np.ndarray:
+    """(m,) distance along each generator within which a vertex stands in for the director point.
+
+    A fraction of the strip width next to it (below it the tooth between two
+    director points and the vertex would be a splinter), capped by what the
+    border may move (``SNAP_GAP`` of the diagonal).
+    """
+    step = np.linalg.norm(np.diff(rail, axis=0), axis=1)
+    w = np.minimum(np.r_[step, np.inf], np.r_[np.inf, step]) if len(step) else np.zeros(len(rail))
+    return np.minimum(SNAP_WIDTH * w, SNAP_GAP * scale)
 
 
 def chains(V, T, G, good_v, a, d, m, scale):
@@ -44,6 +60,15 @@ def chains(V, T, G, good_v, a, d, m, scale):
     has1 = np.zeros(m, bool)
     has0[gi[ti <= eps]] = True
     has1[gi[ti >= 1 - eps]] = True
+    # A vertex this close to the director curve is the border point of its
+    # generator itself: a director point beside it would leave a splinter.
+    glen = np.linalg.norm(d, axis=1)
+    lo_t = np.full(m, np.inf)
+    hi_t = np.full(m, -np.inf)
+    np.minimum.at(lo_t, gi, ti)
+    np.maximum.at(hi_t, gi, ti)
+    has0 |= lo_t * glen < _snap(a, scale)
+    has1 |= (1.0 - hi_t) * glen < _snap(a + d, scale)
     new0, new1 = np.flatnonzero(~has0), np.flatnonzero(~has1)
     base = len(V)
     V = np.concatenate([V, a[new0], a[new1] + d[new1]])
