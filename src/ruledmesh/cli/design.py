@@ -66,25 +66,26 @@ def run(args) -> int:
     except PortInUse as exc:
         print(f"ruledmesh design: {exc}", file=sys.stderr)
         return 2
-    print(f"ruledmesh designer: {server.url}  (Ctrl+C to stop)", flush=True)
-    if not server.loopback:
-        print(f"warning: serving on {host}: anyone who can reach it and has the token in the "
-              "URL above can edit the design and write files in its folder; the connection "
-              "is not encrypted", file=sys.stderr)
-    if not args.no_browser:
-        import webbrowser
-
-        webbrowser.open(server.url)
     import signal
 
     def stop(signum, frame):  # SIGTERM: shut down like Ctrl+C (stops the worker processes too)
         raise KeyboardInterrupt
 
     try:
+        # Before the URL is printed: whoever reads it may stop us at once.
         previous = signal.signal(signal.SIGTERM, stop)
     except ValueError:  # not the main thread (e.g. called from a test): leave signals alone
         previous = None
     try:
+        print(f"ruledmesh designer: {server.url}  (Ctrl+C to stop)", flush=True)
+        if not server.loopback:
+            print(f"warning: serving on {host}: anyone who can reach it and has the token in "
+                  "the URL above can edit the design and write files in its folder; the "
+                  "connection is not encrypted", file=sys.stderr)
+        if not args.no_browser:
+            import webbrowser
+
+            webbrowser.open(server.url)
         server.serve_forever()  # uvicorn stops on SIGINT/SIGTERM, then re-raises the signal
     except KeyboardInterrupt:
         pass

@@ -34,6 +34,8 @@ MAX_BUILD_SECONDS = 20.0
 # A superseded build younger than this is left to finish (and its result dropped): a fresh
 # worker process needs about a second to import numpy and scipy, most builds take milliseconds.
 SUPERSEDE_GRACE = 0.3
+# Seconds a fresh worker process may take to import its modules.
+STARTUP_SECONDS = 120.0
 
 
 class Superseded(RuledMeshError):
@@ -45,8 +47,13 @@ class BuildTimeout(RuledMeshError):
 
 
 def _worker_main(conn) -> None:  # pragma: no cover - runs in the child process
-    from ..design import Design, build_design
+    from ..design import Design, build_design, parse_design
+    from ..registry import load_plugins
+    from .session import DEFAULT_DESIGN
 
+    load_plugins()
+    build_design(parse_design(DEFAULT_DESIGN))  # imports the mesher's modules (lazy elsewhere)
+    conn.send(("ready", None))  # the time limit counts from here
     while True:
         try:
             job = conn.recv()
@@ -130,6 +137,17 @@ class BuildWorker(InProcessBuilder):
         proc.start()
         child.close()
         self._proc, self._conn = proc, parent
+        # Importing numpy and scipy takes a second or more on a busy machine: not build time.
+        try:
+            deadline = time.monotonic() + STARTUP_SECONDS
+            while not parent.poll(0.05):
+                if self._closed or time.monotonic() > deadline or not proc.is_alive():
+                    raise EOFError
+            if parent.recv()[0] != "ready":
+                raise EOFError
+        except (EOFError, OSError):
+            self._stop()
+            raise RuledMeshError("the build process did not start") from None
 
     def _stop(self) -> None:
         if self._proc is not None:
@@ -141,8 +159,11 @@ class BuildWorker(InProcessBuilder):
     def start(self) -> None:
         """Start the worker process now (so the first edit does not wait for it)."""
         with self._run_lock:
-            if self._proc is None:
-                self._start()
+            if self._proc is None and not self._closed:
+                try:
+                    self._start()
+                except RuledMeshError:
+                    pass  # the first build tries again and reports it
 
     # ---------------------------------------------------------------- builds
     def build(self, generation: int, data: dict, source: str, base_dir: str | Path) -> Any:

@@ -90,6 +90,8 @@ MAX_BODY = 2**20
 # connections are closed after this), and to keep an idle keep-alive connection.
 REQUEST_TIMEOUT = 10.0
 KEEP_ALIVE = 5
+# A body over the limit but under this is read and dropped before the 413 answer (see _drain).
+DRAIN_LIMIT = 64 * 2**20
 _LOOPBACK_NAMES = {"localhost", "127.0.0.1", "::1", "[::1]"}
 _SECURITY_HEADERS = [
     (b"cache-control", b"no-store"),
@@ -275,17 +277,29 @@ class _Api:
         self.session = server.session
         self.limits = server.limits
 
+    async def _drain(self, request: Request, size: int) -> None:
+        """Read and drop a too-large body (up to :data:`DRAIN_LIMIT`), so the answer arrives.
+
+        Closing a connection with unread data makes the kernel reset it, and the
+        client would see a network error instead of the message with the limit.
+        """
+        if size > DRAIN_LIMIT:
+            return
+        with anyio.move_on_after(self.limits.request_timeout):
+            async for _ in request.stream():
+                pass
+
     async def body(self, request: Request) -> dict:
+        """The JSON object of a POST, read with the size and time limits."""
         declared = request.headers.get("content-length")
         limit = self.limits.body
-        too_large = (f"request too large: more than {limit:,} bytes (the limit of one edit "
-                     f"or design)")
         if declared is not None:
             try:
                 size = int(declared)
             except ValueError:
                 raise _HttpError(400, "bad Content-Length", close=True) from None
             if size > limit:
+                await self._drain(request, size)
                 raise _HttpError(413, f"request too large: {size:,} bytes; the limit is "
                                  f"{limit:,} bytes", close=True)
         chunks, size = [], 0
@@ -294,7 +308,8 @@ class _Api:
                 async for chunk in request.stream():
                     size += len(chunk)
                     if size > limit:
-                        raise _HttpError(413, too_large, close=True)
+                        raise _HttpError(413, f"request too large: more than {limit:,} bytes; "
+                                         f"the limit is {limit:,} bytes", close=True)
                     chunks.append(chunk)
         except TimeoutError:
             raise _HttpError(408, f"request body not received within "
@@ -509,7 +524,8 @@ class DesignerServer:
 
     def serve_forever(self) -> None:
         """Serve until :meth:`shutdown` (or SIGINT/SIGTERM in the main thread)."""
-        self._builder.start()
+        # The worker imports numpy and scipy meanwhile: the page and its state do not wait.
+        threading.Thread(target=self._builder.start, name="build-start", daemon=True).start()
         try:
             self._uvicorn.run(sockets=[self.socket])
         finally:
