@@ -459,7 +459,8 @@ def test_busy_port_exits_2_with_the_message(tmp_path):
     holder.listen(1)
     try:
         proc = subprocess.run([sys.executable, "-m", "ruledmesh.cli", "design", "--port", str(port),
-                               "--no-browser"], capture_output=True, text=True, timeout=60,
+                               "--no-browser"], check=False, capture_output=True, text=True,
+                              timeout=60,
                               cwd=tmp_path)
     finally:
         holder.close()
@@ -485,3 +486,14 @@ def test_printed_url_holds_a_fresh_token(tmp_path):
         assert line.startswith("ruledmesh designer: http://127.0.0.1:") and "/?token=" in line
         tokens.append(line.split("?token=")[1].split()[0])
     assert tokens[0] != tokens[1] and min(len(t) for t in tokens) >= 40
+
+
+def test_without_the_web_extra_one_line_names_the_install(tmp_path):
+    # The import system is told the packages are absent (as in an environment without them).
+    code = ("import sys; sys.modules['starlette'] = None; sys.modules['uvicorn'] = None; "
+            "from ruledmesh.cli import main; sys.exit(main(['design', '--no-browser']))")
+    proc = subprocess.run([sys.executable, "-c", code], check=False, capture_output=True,
+                          text=True, timeout=60, cwd=tmp_path)
+    assert proc.returncode == 2 and proc.stdout == ""
+    assert proc.stderr == ('ruledmesh design: needs starlette and uvicorn; '
+                           'pip install "ruledmesh[web]"\n')

@@ -27,7 +27,7 @@ from typing import Any
 
 from ..errors import RuledMeshError
 
-__all__ = ["BuildWorker", "InProcessBuilder", "BuildTimeout", "Superseded", "MAX_BUILD_SECONDS"]
+__all__ = ["MAX_BUILD_SECONDS", "BuildTimeout", "BuildWorker", "InProcessBuilder", "Superseded"]
 
 # Wall-clock limit of one designer build (the CLI has none: it is the user's own job there).
 MAX_BUILD_SECONDS = 20.0

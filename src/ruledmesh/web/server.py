@@ -50,7 +50,7 @@ import secrets
 import socket
 import threading
 import time
-from collections.abc import Awaitable, Callable
+from collections.abc import Awaitable, Callable, MutableMapping
 from dataclasses import dataclass
 from importlib import resources
 from pathlib import Path
@@ -255,7 +255,7 @@ class _Guard:
             await self.app(scope, receive, send)
             return
 
-        async def secured(message: dict) -> None:
+        async def secured(message: MutableMapping[str, Any]) -> None:
             if message["type"] == "http.response.start":
                 message = {**message, "headers": [*message.get("headers", []),
                                                    *_SECURITY_HEADERS]}

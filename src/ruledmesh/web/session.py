@@ -33,8 +33,17 @@ from ..registry import Built
 from .builder import InProcessBuilder, Superseded
 from .toml_writer import dumps
 
-__all__ = ["Session", "DEFAULT_DESIGN", "fan_triangles", "fast_figures", "encode_message",
-           "set_path", "check_limits", "OverwriteRefused", "MAX_CONTROL_POINTS"]
+__all__ = [
+    "DEFAULT_DESIGN",
+    "MAX_CONTROL_POINTS",
+    "OverwriteRefused",
+    "Session",
+    "check_limits",
+    "encode_message",
+    "fan_triangles",
+    "fast_figures",
+    "set_path",
+]
 
 # Shown when the designer starts without a design file (paper Fig. 10, a skew surface).
 DEFAULT_DESIGN = """\
@@ -110,13 +119,14 @@ def check_limits(data: Mapping[str, Any], base_dir: Path) -> None:
     mesh = data.get("mesh")
     if isinstance(rulings, Mapping):
         count_points(rulings.get("lines"), "rulings.lines")
-        count = rulings.get("count")
-        rows = mesh.get("rows", 20) if isinstance(mesh, Mapping) else 20
-        if (_positive_int(count) and _positive_int(rows)
-                and count * (rows + 1) > MAX_GRID_POINTS):
-            raise DesignError(f"{count:,} generators x {rows + 1:,} rows = "
-                              f"{count * (rows + 1):,} grid points; the limit is "
-                              f"{MAX_GRID_POINTS:,}", "rulings.count")
+        count: Any = rulings.get("count")
+        rows: Any = mesh.get("rows", 20) if isinstance(mesh, Mapping) else 20
+        if _positive_int(count) and _positive_int(rows):
+            points = int(count) * (int(rows) + 1)
+            if points > MAX_GRID_POINTS:
+                raise DesignError(f"{count:,} generators x {int(rows) + 1:,} points each = "
+                                  f"{points:,} grid points; the limit is {MAX_GRID_POINTS:,}",
+                                  "rulings.count")
         if "file" in rulings and isinstance(rulings["file"], str):
             inside(base_dir, rulings["file"], "rulings.file", DesignError, must_exist=False)
 
@@ -314,9 +324,9 @@ def encode_message(header: Mapping[str, Any], arrays: Sequence[tuple[str, np.nda
     except ValueError:  # NaN or infinity somewhere (a figure of a degenerate mesh): as strings
         text = json.dumps(_clean({**header, "arrays": table}), default=_json_default,
                           allow_nan=False)
-    text = text.encode("utf-8")
-    text += b" " * ((-len(text)) % 4)
-    return np.uint32(len(text)).tobytes() + text + b"".join(chunks)
+    raw_text = text.encode("utf-8")
+    raw_text += b" " * ((-len(raw_text)) % 4)
+    return np.uint32(len(raw_text)).tobytes() + raw_text + b"".join(chunks)
 
 
 @dataclass
