@@ -497,3 +497,16 @@ def test_without_the_web_extra_one_line_names_the_install(tmp_path):
     assert proc.returncode == 2 and proc.stdout == ""
     assert proc.stderr == ('ruledmesh design: needs starlette and uvicorn; '
                            'pip install "ruledmesh[web]"\n')
+
+
+def test_a_linked_design_file_is_edited_where_it_lives(tmp_path):
+    real = tmp_path / "projects" / "real.toml"
+    real.parent.mkdir()
+    real.write_text(SMALL)
+    link = tmp_path / "link.toml"
+    link.symlink_to(real)
+    s = Session(link.read_text(), link)
+    assert s.path == real and s.base_dir == real.parent
+    s.edit([(["mesh", "rows"], 7)])
+    assert s.save() == real and "rows = 7" in real.read_text() and link.is_symlink()
+    assert s.export(".obj") == real.parent / "real.obj"

@@ -66,6 +66,7 @@ from .session import DEFAULT_DESIGN, OverwriteRefused, Session, encode_message
 
 try:
     import anyio
+    import anyio.to_thread
     import uvicorn
     from starlette.applications import Starlette
     from starlette.concurrency import run_in_threadpool
@@ -459,6 +460,22 @@ def _bind(host: str, port: int) -> socket.socket:
     return sock
 
 
+class _Uvicorn(uvicorn.Server):
+    """uvicorn's server, stopping the worker processes before waiting for open requests.
+
+    A figures request waits for its worker; stopping the workers first answers
+    such requests at once, so shutting down does not wait out the grace period.
+    """
+
+    def __init__(self, config: uvicorn.Config, before_shutdown: Callable[[], None]):
+        super().__init__(config)
+        self.before_shutdown = before_shutdown
+
+    async def shutdown(self, sockets: list[socket.socket] | None = None) -> None:
+        await anyio.to_thread.run_sync(self.before_shutdown)
+        await super().shutdown(sockets)
+
+
 class DesignerServer:
     """The designer's server for one :class:`Session`: bound at once, serving on demand.
 
@@ -490,6 +507,7 @@ class DesignerServer:
         self.server_address = self.socket.getsockname()
         self._figures: FigureWorker | None = None
         self._figures_lock = threading.Lock()
+        self._closing = False
         self._builder = BuildWorker(self.limits.build_seconds)
         session.set_builder(self._builder)
         api = _Api(self)
@@ -500,7 +518,7 @@ class DesignerServer:
         config = uvicorn.Config(self.app, http=protocol, ws="none", lifespan="off",
                                 log_level="error", access_log=False, server_header=False,
                                 timeout_keep_alive=KEEP_ALIVE, timeout_graceful_shutdown=3)
-        self._uvicorn = uvicorn.Server(config)
+        self._uvicorn = _Uvicorn(config, self._stop_workers)
         self._stopped = threading.Event()
 
     @property
@@ -518,6 +536,8 @@ class DesignerServer:
 
     def figures(self) -> FigureWorker:
         with self._figures_lock:
+            if self._closing:
+                raise Superseded("the designer is stopping")
             if self._figures is None:
                 self._figures = FigureWorker()
             return self._figures
@@ -536,14 +556,18 @@ class DesignerServer:
         self._uvicorn.should_exit = True
         self._stopped.wait(timeout)
 
-    def server_close(self) -> None:
-        """Close the socket and stop the worker processes."""
-        self.socket.close()
+    def _stop_workers(self) -> None:
         self._builder.close()
         with self._figures_lock:
+            self._closing = True
             if self._figures is not None:
                 self._figures.close()
                 self._figures = None
+
+    def server_close(self) -> None:
+        """Close the socket and stop the worker processes."""
+        self.socket.close()
+        self._stop_workers()
 
 
 def make_server(session: Session, host: str = DEFAULT_HOST, port: int = 0, *,

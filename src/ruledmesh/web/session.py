@@ -364,7 +364,8 @@ class Session:
     def __init__(self, text: str | None = None, path: str | Path | None = None,
                  base_dir: str | Path | None = None, undo_limit: int = UNDO_LIMIT,
                  builder: InProcessBuilder | None = None):
-        self.path = Path(path).absolute() if path is not None else None
+        # Resolved: a design file that is a link is edited where it really lives.
+        self.path = Path(path).resolve() if path is not None else None
         if base_dir is None:
             base_dir = self.path.parent if self.path is not None else Path(".")
         # Resolved once: a later chdir or a renamed link does not move the folder written to.
@@ -548,11 +549,11 @@ class Session:
 
     def _writable(self, name: str, overwrite: bool) -> Path:
         target = self.inside(name)
+        if target.is_dir():
+            raise ParameterError(f'"{target.name}" is a folder', "path")
         if target.exists() and not overwrite and target not in self._owned:
             raise OverwriteRefused(f'"{target.name}" exists in {self.base_dir} and was not '
                                    "opened in this designer; confirm to replace it", "path")
-        if target.is_dir():
-            raise ParameterError(f'"{target.name}" is a folder', "path")
         return target
 
     def save(self, path: str | None = None, overwrite: bool = False) -> Path:
