@@ -5,6 +5,7 @@ from __future__ import annotations
 import http.client
 import json
 import math
+import re
 import socket
 import threading
 import time
@@ -206,11 +207,14 @@ def server(tmp_path):
     srv.server_close()
 
 
-def request(srv, method, path, body=None, headers=None, conn=None):
+def request(srv, method, path, body=None, headers=None, conn=None, token=True):
+    """One request to the designer, with the server's token unless ``token`` is false."""
     own = conn is None
     if own:
         conn = http.client.HTTPConnection(*srv.server_address[:2], timeout=60)
     hdrs = {"Content-Type": "application/json"} if body is not None else {}
+    if token:
+        hdrs["Authorization"] = f"Bearer {srv.token}"
     hdrs.update(headers or {})
     conn.request(method, path, None if body is None else json.dumps(body), hdrs)
     resp = conn.getresponse()
@@ -242,6 +246,7 @@ def test_http_page_and_api(server, tmp_path):
     status, ctype, js = request(server, "GET", "/vendor/three-bundle.min.js")
     assert status == 200 and ctype.startswith("text/javascript") and len(js) > 100_000
     assert request(server, "GET", "/../../pyproject.toml")[0] == 404
+    assert request(server, "GET", "/api/state", token=False)[0] == 401
     status, _, data = request(server, "POST", "/api/edit", {"changes": [[["mesh", "rows"], 8]]})
     header, arrays = decode(data)
     assert status == 200 and header["design"]["mesh"]["rows"] == 8
@@ -277,10 +282,8 @@ def test_refuses_foreign_hosts_and_cross_site_posts(server):
     status, _, _ = request(server, "POST", "/api/edit", {"changes": []},
                            headers={"Origin": "http://evil.example"})
     assert status == 403
-    conn = http.client.HTTPConnection(*server.server_address[:2], timeout=10)
-    conn.request("POST", "/api/undo", "{}", {"Content-Type": "text/plain"})
-    assert conn.getresponse().status == 415
-    conn.close()
+    status, _, _ = request(server, "POST", "/api/undo", {}, headers={"Content-Type": "text/plain"})
+    assert status == 415
 
 
 def _rss_bytes() -> int:
@@ -334,7 +337,6 @@ def test_thousand_rapid_updates_without_memory_growth(tmp_path):
 # ---------------------------------------------------------------- command line
 def start_cli(*args: str):
     """``ruledmesh design ARGS --no-browser`` in its own process; returns (process, url)."""
-    import re
     import subprocess
     import sys
 
@@ -349,14 +351,15 @@ def start_cli(*args: str):
 
 
 def test_cli_serves_on_loopback_and_stops_on_sigterm(tmp_path):
-    from urllib.request import urlopen
+    from urllib.request import Request, urlopen
 
     design = tmp_path / "small.toml"
     design.write_text(SMALL)
     proc, url = start_cli(str(design))
     try:
-        assert url.startswith("http://127.0.0.1:")
-        header, _ = decode(urlopen(url + "api/state", timeout=30).read())
+        base, token = re.fullmatch(r"(http://127\.0\.0\.1:\d+/)\?token=([\w-]{40,})", url).groups()
+        req = Request(base + "api/state", headers={"Authorization": f"Bearer {token}"})
+        header, _ = decode(urlopen(req, timeout=30).read())
         assert header["path"] == str(design) and header["design"]["rulings"]["count"] == 9
     finally:
         proc.terminate()

@@ -7,6 +7,7 @@ when ``/usr/bin/chromium`` or the ``playwright`` package is missing.
 
 from __future__ import annotations
 
+import json
 import os
 import re
 import statistics
@@ -265,3 +266,142 @@ def test_update_latency_100_by_100(browser, tmp_path):
     assert faces > 5000
     # A generous bound so a loaded CI machine does not fail; docs/designer.md has the figure.
     assert total < 400
+
+
+# ---------------------------------------------------------------- token and files in the page
+def test_page_without_the_token_says_where_to_find_it(browser, designer):
+    pg = browser.new_page()
+    try:
+        pg.goto(designer.base_url)
+        pg.wait_for_selector("#error:not([hidden])")
+        assert "?token=" in pg.inner_text("#error")
+        assert designer.session.version == 0
+    finally:
+        pg.close()
+
+
+def test_save_asks_before_replacing_a_file_it_did_not_open(page, designer, tmp_path):
+    other = tmp_path / "other.toml"
+    other.write_text("# the user's own file\n")
+    page.fill("#save-path", "other.toml")
+    dialogs = []
+
+    def dismiss(dialog):
+        dialogs.append(dialog.message)
+        dialog.dismiss()
+
+    page.on("dialog", dismiss)
+    page.click("#save")
+    page.wait_for_selector("#error:not([hidden])")
+    assert "confirm" in page.inner_text("#error") and "other.toml" in dialogs[0]
+    assert other.read_text() == "# the user's own file\n"
+    page.remove_listener("dialog", dismiss)
+    page.once("dialog", lambda dialog: dialog.accept())
+    page.click("#save")
+    page.wait_for_function("document.querySelector('#status').textContent.startsWith('saved')")
+    rebuilt = build_design(parse_design(other.read_text(), other.name, tmp_path))
+    assert rebuilt.mesh.n_faces == designer.session.built.mesh.n_faces
+
+
+def test_download_sends_the_token(page, designer):
+    page.select_option("#export-format", ".obj")
+    with page.expect_download() as info:
+        page.click("#download")
+    download = info.value
+    assert download.suggested_filename == "browser.obj"
+    text = Path(download.path()).read_text()
+    assert sum(line.startswith("f ") for line in text.splitlines()) == \
+        designer.session.built.mesh.n_faces
+
+
+# ---------------------------------------------------------------- attacks from another page
+ATTACK_PAGE = """<!doctype html><html><body>
+<iframe name="f1"></iframe><iframe name="f2"></iframe><iframe name="f3"></iframe>
+<script>
+const target = %(target)s;
+const requests = %(requests)s;   // [path, body] pairs, each body a smuggled request
+let pending = 0;
+function done() { if (--pending === 0) document.title = 'done'; }
+requests.forEach(([path, body], k) => {
+  // 1. an auto-submitted HTML form (text/plain: the body is "name=value")
+  if (k < 3) {
+    const form = document.createElement('form');
+    form.method = 'POST'; form.action = target + path; form.enctype = 'text/plain';
+    form.target = 'f' + (k + 1);
+    const cut = body.lastIndexOf('=');
+    const input = document.createElement('input');
+    input.name = body.slice(0, cut); input.value = body.slice(cut + 1);
+    form.append(input);
+    document.body.append(form);
+    pending++;
+    document.getElementsByName('f' + (k + 1))[0].onload = done;
+    form.submit();
+  }
+  // 2. a no-cors text/plain fetch (no preflight) with the same body
+  pending++;
+  fetch(target + path, { method: 'POST', mode: 'no-cors', body,
+                         headers: { 'Content-Type': 'text/plain' } }).then(done, done);
+});
+</script></body></html>"""
+
+
+def smuggled_body(port: int, token: str, path: str, payload: dict) -> str:
+    """A complete API request (with the right token, as if stolen) carried in a body.
+
+    It ends in ``"x": "="}`` so that a form's ``name=value`` encoding reproduces it.
+    """
+    data = json.dumps({**payload, "x": "="})
+    return (f"POST {path} HTTP/1.1\r\nHost: 127.0.0.1:{port}\r\nAuthorization: Bearer {token}\r\n"
+            f"Content-Type: application/json\r\nContent-Length: {len(data)}\r\n\r\n{data}")
+
+
+def test_cross_origin_form_and_no_cors_fetch_change_nothing(browser, designer, tmp_path,
+                                                             tmp_path_factory):
+    import http.server
+
+    outside = tmp_path_factory.mktemp("outside")
+    port = designer.server_address[1]
+    token = designer.token
+    requests = [
+        ["/api/edit", smuggled_body(port, token, "/api/edit",
+                                    {"changes": [[["mesh", "rows"], 3]]})],
+        ["/api/save", smuggled_body(port, token, "/api/save",
+                                    {"path": str(outside / "evil.toml")})],
+        ["/api/export", smuggled_body(port, token, "/api/export",
+                                      {"format": ".obj", "path": str(outside / "evil.obj")})],
+        ["/api/save", smuggled_body(port, token, "/api/save", {"path": "browser.toml"})],
+        ["/api/edit", json.dumps({"changes": [[["mesh", "rows"], 3]]})],
+        ["/api/export", json.dumps({"format": ".obj"})],
+    ]
+    html = ATTACK_PAGE % {"target": json.dumps(f"http://127.0.0.1:{port}"),
+                          "requests": json.dumps(requests)}
+
+    class Attacker(http.server.BaseHTTPRequestHandler):
+        def do_GET(self):  # noqa: N802 - stdlib name
+            body = html.encode()
+            self.send_response(200)
+            self.send_header("Content-Type", "text/html")
+            self.send_header("Content-Length", str(len(body)))
+            self.end_headers()
+            self.wfile.write(body)
+
+        def log_message(self, *args):
+            pass
+
+    evil = http.server.ThreadingHTTPServer(("127.0.0.1", 0), Attacker)
+    threading.Thread(target=evil.serve_forever, daemon=True).start()
+    before = {p.name: p.read_bytes() for p in tmp_path.iterdir()}
+    pg = browser.new_page()
+    try:
+        pg.goto(f"http://127.0.0.1:{evil.server_address[1]}/")
+        pg.wait_for_function("document.title === 'done'", timeout=30_000)
+        # the forms reached the designer and were refused (what the frames show)
+        answers = [f.content() for f in pg.frames[1:]]
+        assert len(answers) == 3 and all("refused" in a for a in answers), answers
+    finally:
+        pg.close()
+        evil.shutdown()
+        evil.server_close()
+    assert designer.session.version == 0 and designer.session.design["mesh"]["rows"] == 12
+    assert {p.name: p.read_bytes() for p in tmp_path.iterdir()} == before
+    assert list(outside.iterdir()) == []

@@ -857,6 +857,14 @@ def from_lines(lines: Any, *, tol: Tolerances = DEFAULT) -> Rulings:
     return Rulings(a, b, u, surface, {"distribution": "lines", "warnings": []})
 
 
+def _is_number(text: str) -> bool:
+    try:
+        float(text)
+    except ValueError:
+        return False
+    return True
+
+
 def from_csv(path: str | os.PathLike, *, tol: Tolerances = DEFAULT) -> Rulings:
     """Rulings from a CSV file with rows ``x0,y0,z0,x1,y1,z1``.
 
@@ -888,8 +896,10 @@ def from_csv(path: str | os.PathLike, *, tol: Tolerances = DEFAULT) -> Rulings:
             if first:
                 first = False
                 continue  # header
-            raise DesignError(f"expected 6 numbers separated by commas, got {stripped!r}",
-                              f"line {number}", name) from None
+            # The cell's position, not its text: the message must not echo a file's content.
+            bad = next(k for k, c in enumerate(cells, start=1) if not _is_number(c))
+            raise DesignError(f"expected 6 numbers separated by commas; cell {bad} is not a "
+                              "number", f"line {number}", name) from None
         first = False
         if len(values) != 6:
             raise DesignError(f"expected 6 numbers (x0,y0,z0,x1,y1,z1), got {len(values)}",

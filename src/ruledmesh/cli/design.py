@@ -11,28 +11,47 @@ def add_parser(sub) -> None:
         help="interactive designer in the browser",
         description="Start the designer: a local web page with a 3-D view of the director "
                     "curves, generators and mesh, handles and sliders, live figures, undo/redo, "
-                    "save and export. Serves on 127.0.0.1 only unless --host is given.",
+                    "save and export. Serves on 127.0.0.1 only unless --host is given; the "
+                    "printed URL holds a per-run token that the page needs. Needs the "
+                    "'web' extra (pip install \"ruledmesh[web]\").",
         epilog="example: ruledmesh design examples/skew.toml --port 8765",
     )
     p.add_argument("design", nargs="?", help="design file (.toml); a skew surface if omitted "
-                   "(saved as <name>.toml in the working folder)")
+                   "(Save then picks a free <name>.toml in the working folder)")
     p.add_argument("--port", type=int, default=0, help="port (default: a free one)")
     p.add_argument("--host", default=None,
                    help="interface to bind (default 127.0.0.1; other interfaces expose the "
-                        "designer, which can write files, to the network)")
+                        "designer, which can write files in the design's folder, to anyone on "
+                        "the network who has the token)")
     p.add_argument("--no-browser", action="store_true", help="do not open a browser")
     p.set_defaults(run=run)
+
+
+def _missing_web() -> str | None:
+    """The one-line error when Starlette or uvicorn is not installed, else ``None``."""
+    import importlib.util
+
+    missing = [m for m in ("starlette", "uvicorn") if importlib.util.find_spec(m) is None]
+    if missing:
+        return (f"ruledmesh design: needs {' and '.join(missing)}; "
+                'pip install "ruledmesh[web]"')
+    return None
 
 
 def run(args) -> int:
     from pathlib import Path
 
     from ..errors import ParameterError
-    from ..web.server import DEFAULT_HOST, make_server
-    from ..web.session import Session
 
     if not 0 <= args.port <= 65535:
         raise ParameterError(f"expected a port in 0..65535, got {args.port}", "--port")
+    missing = _missing_web()
+    if missing:
+        print(missing, file=sys.stderr)
+        return 2
+    from ..web.server import DEFAULT_HOST, PortInUse, make_server
+    from ..web.session import Session
+
     text = path = None
     if args.design:
         path = Path(args.design)
@@ -42,30 +61,37 @@ def run(args) -> int:
             raise ParameterError(f"no such design file: {path}", "design") from None
     session = Session(text, path)
     host = args.host if args.host is not None else DEFAULT_HOST
-    server = make_server(session, host, args.port)
-    print(f"ruledmesh designer: {server.url}  (Ctrl+C to stop)", flush=True)
-    if args.host is not None and not server.loopback:
-        print(f"warning: serving on {host}: anyone who can reach it can edit and write files",
-              file=sys.stderr)
-    if not args.no_browser:
-        import webbrowser
-
-        webbrowser.open(server.url)
+    try:
+        server = make_server(session, host, args.port)
+    except PortInUse as exc:
+        print(f"ruledmesh design: {exc}", file=sys.stderr)
+        return 2
     import signal
 
-    def stop(signum, frame):  # SIGTERM: shut down like Ctrl+C (stops the figures process too)
+    def stop(signum, frame):  # SIGTERM: shut down like Ctrl+C (stops the worker processes too)
         raise KeyboardInterrupt
 
     try:
+        # Before the URL is printed: whoever reads it may stop us at once.
         previous = signal.signal(signal.SIGTERM, stop)
     except ValueError:  # not the main thread (e.g. called from a test): leave signals alone
         previous = None
     try:
-        server.serve_forever()
+        print(f"ruledmesh designer: {server.url}  (Ctrl+C to stop)", flush=True)
+        if not server.loopback:
+            print(f"warning: serving on {host}: anyone who can reach it and has the token in "
+                  "the URL above can edit the design and write files in its folder; the "
+                  "connection is not encrypted", file=sys.stderr)
+        if not args.no_browser:
+            import webbrowser
+
+            webbrowser.open(server.url)
+        server.serve_forever()  # uvicorn stops on SIGINT/SIGTERM, then re-raises the signal
     except KeyboardInterrupt:
-        print("ruledmesh designer: stopped", file=sys.stderr)
+        pass
     finally:
         server.server_close()
         if previous is not None:
             signal.signal(signal.SIGTERM, previous)
+    print("ruledmesh designer: stopped", file=sys.stderr)
     return 0

@@ -1,53 +1,147 @@
-"""The designer's HTTP server: static page plus a small JSON/binary API.
+"""The designer's HTTP server: the static page plus a small JSON/binary API.
 
-Standard library only (:class:`http.server.ThreadingHTTPServer`).  The API:
+A Starlette application served by uvicorn (the optional extra ``web``).  The
+HTTP parsing is h11's, which never reads a second request out of a first
+one's body; this module adds the designer's own rules.  The API:
 
 ==========================  ==================================================
 ``GET /api/state``          binary message: state, fast figures, mesh arrays
 ``POST /api/edit``          ``{"changes": [[path, value], ...], "coalesce"}``
 ``POST /api/design``        ``{"design": {...}}`` or ``{"toml": "..."}``
 ``POST /api/undo``, ``/api/redo``
-``POST /api/save``          ``{"path": optional}`` -> ``{"path"}``
-``POST /api/export``        ``{"format": ".obj", "path": optional}`` -> ``{"path"}``
+``POST /api/save``          ``{"path", "overwrite"}`` (both optional) -> ``{"path"}``
+``POST /api/export``        ``{"format": ".obj", "path", "overwrite"}`` -> ``{"path"}``
 ``GET /api/download?format=.glb``  the exported bytes as a download
 ``GET /api/figures?version=N``     binary message: closeness, coverage, panels
 ==========================  ==================================================
 
 Edits answer like ``GET /api/state`` (one round trip per change).  Errors
-answer ``{"error": message}`` with status 400 (bad edit) or 500 (a bug); the
-state is unchanged and the server keeps running.
+answer ``{"error": message}``: 400 a refused edit, 401/403 no or a wrong
+token, 403 a foreign ``Host`` or ``Origin``, 408 a request sent too slowly,
+409 a file that would be overwritten (``"exists": true``) or an edit
+superseded by a newer one (``"superseded": true``), 413 too large, 415 not
+JSON, 500 a bug.  The state is unchanged and the server keeps running.
 
-Safety: the server binds 127.0.0.1 unless another host is given explicitly;
-on a loopback address it also refuses requests whose ``Host`` header is not a
-loopback name (DNS rebinding) and POSTs that are not ``application/json`` or
-come from another origin (cross-site requests from other pages).
+Safety (see docs/designer.md, "Security"):
+
+- every ``/api/`` request carries ``Authorization: Bearer <token>``, a secret
+  made per run and printed in the page's URL (``?token=...``);
+- on a loopback address, requests whose ``Host`` is not a loopback name are
+  refused (DNS rebinding); an ``Origin`` other than the page's own is refused
+  even with the token; POSTs must be ``application/json``;
+- a refused request's connection is closed (``Connection: close``) so an
+  unread body is never looked at; bodies are limited to :data:`MAX_BODY`
+  bytes and every request must arrive within :data:`REQUEST_TIMEOUT` seconds;
+- builds run in a worker process with a time limit (:mod:`.builder`), off the
+  event loop, so a long build never holds up other requests.
+
+WebSockets (live updates across tabs) fit as a ``WebSocketRoute`` next to the
+API routes; :class:`_Guard` already refuses WebSocket connections, which will
+then need the token as a query parameter (browsers cannot set headers there).
 """
 
 from __future__ import annotations
 
+import errno
+import hmac
 import ipaddress
 import json
-import mimetypes
+import secrets
+import socket
 import threading
 import time
-from http import HTTPStatus
-from http.server import BaseHTTPRequestHandler, ThreadingHTTPServer
+from collections.abc import Awaitable, Callable, MutableMapping
+from dataclasses import dataclass
 from importlib import resources
 from pathlib import Path
 from typing import Any
-from urllib.parse import parse_qs, urlsplit
+from urllib.parse import urlsplit
 
 import numpy as np
 
-from ..errors import RuledMeshError
+from ..errors import ParameterError, RuledMeshError
+from .builder import MAX_BUILD_SECONDS, BuildWorker, Superseded
 from .figures import FigureWorker
-from .session import DEFAULT_DESIGN, Session, encode_message
+from .session import DEFAULT_DESIGN, OverwriteRefused, Session, encode_message
 
-__all__ = ["DesignerServer", "make_server", "DEFAULT_HOST", "MAX_BODY"]
+try:
+    import anyio
+    import anyio.to_thread
+    import uvicorn
+    from starlette.applications import Starlette
+    from starlette.concurrency import run_in_threadpool
+    from starlette.datastructures import Headers
+    from starlette.requests import Request
+    from starlette.responses import JSONResponse, Response
+    from starlette.routing import Mount, Route
+    from starlette.staticfiles import StaticFiles
+    from uvicorn.protocols.http.h11_impl import H11Protocol
+except ImportError as exc:  # pragma: no cover - checked by the CLI before importing this
+    raise ImportError(f"the designer needs Starlette and uvicorn ({exc.name}); "
+                      'pip install "ruledmesh[web]"', name=exc.name) from None
+
+__all__ = ["DEFAULT_HOST", "MAX_BODY", "REQUEST_TIMEOUT", "DesignerServer", "Limits",
+           "PortInUse", "make_server"]
 
 DEFAULT_HOST = "127.0.0.1"
-MAX_BODY = 16 * 1024 * 1024
+# A request body (an edit, a design's TOML): a hand-made design is a few kB; 1 MiB is room
+# for 2,000 control points per curve on several curves, and far from the 14.7 MB of an attack.
+MAX_BODY = 2**20
+# Seconds a client has to send one request's headers and body (slow or half-open
+# connections are closed after this), and to keep an idle keep-alive connection.
+REQUEST_TIMEOUT = 10.0
+KEEP_ALIVE = 5
+# A body over the limit but under this is read and dropped before the 413 answer (see _drain).
+DRAIN_LIMIT = 64 * 2**20
 _LOOPBACK_NAMES = {"localhost", "127.0.0.1", "::1", "[::1]"}
+_SECURITY_HEADERS = [
+    (b"cache-control", b"no-store"),
+    (b"x-content-type-options", b"nosniff"),
+    (b"referrer-policy", b"no-referrer"),  # the page's URL holds the token
+    (b"x-frame-options", b"DENY"),
+    (b"content-security-policy", b"frame-ancestors 'none'"),
+]
+
+
+@dataclass(frozen=True)
+class Limits:
+    """The designer server's limits (see docs/designer.md, "Security").
+
+    Attributes
+    ----------
+    body : int
+        Bytes of one request body.
+    request_timeout : float
+        Seconds to send one request's headers, and its body.
+    build_seconds : float
+        Wall-clock seconds of one build (the worker process is stopped after).
+    """
+
+    body: int = MAX_BODY
+    request_timeout: float = REQUEST_TIMEOUT
+    build_seconds: float = MAX_BUILD_SECONDS
+
+
+class PortInUse(RuledMeshError):
+    """The port asked for is taken by another program."""
+
+    def __init__(self, port: int):
+        super().__init__(f"port {port} is in use; choose another with --port or omit it")
+        self.port = port
+
+
+class _HttpError(Exception):
+    def __init__(self, status: int, message: str, close: bool = False, **extra: Any):
+        super().__init__(message)
+        self.status = status
+        self.close = close
+        self.extra = extra
+
+    def response(self) -> JSONResponse:
+        headers = {"connection": "close"} if self.close else {}
+        if self.status == 401:
+            headers["www-authenticate"] = "Bearer"
+        return JSONResponse({"error": str(self), **self.extra}, self.status, headers=headers)
 
 
 def _static_root() -> Path:
@@ -55,7 +149,7 @@ def _static_root() -> Path:
 
 
 def _is_loopback(host: str) -> bool:
-    if host in _LOOPBACK_NAMES:
+    if host.lower() in _LOOPBACK_NAMES:
         return True
     try:
         return ipaddress.ip_address(host.strip("[]")).is_loopback
@@ -63,274 +157,420 @@ def _is_loopback(host: str) -> bool:
         return False
 
 
-class DesignerServer(ThreadingHTTPServer):
-    """A :class:`ThreadingHTTPServer` holding one :class:`Session`.
+def _host_name(host: str) -> str:
+    """``name`` of a ``Host`` header ``name:port`` (IPv6 in brackets kept whole)."""
+    if host.startswith("["):
+        return host[:host.find("]") + 1] if "]" in host else host
+    return host.rsplit(":", 1)[0]
+
+
+# ---------------------------------------------------------------------- connection deadline
+class _DeadlineH11(H11Protocol):
+    """uvicorn's h11 protocol with a deadline for each request to arrive.
+
+    uvicorn closes idle keep-alive connections, but a connection that never
+    completes its request headers (half-open, or one byte every few seconds)
+    is kept forever.  Here every connection must deliver a request's headers
+    within :attr:`deadline` seconds of opening or of the previous answer.
+    """
+
+    deadline = REQUEST_TIMEOUT
+
+    def connection_made(self, transport) -> None:  # type: ignore[no-untyped-def]
+        self._timer: Any = None
+        self._timed_cycle: Any = None
+        super().connection_made(transport)
+        self._arm()
+
+    def _arm(self) -> None:
+        self._disarm()
+        self._timer = self.loop.call_later(self.deadline, self._expire)
+
+    def _disarm(self) -> None:
+        if self._timer is not None:
+            self._timer.cancel()
+            self._timer = None
+
+    def _expire(self) -> None:
+        if not self.transport.is_closing():
+            self.transport.close()
+
+    def handle_events(self) -> None:
+        super().handle_events()
+        if self.cycle is not None and self.cycle is not self._timed_cycle:
+            self._timed_cycle = self.cycle  # a request's headers arrived: its body has its own limit
+            self._disarm()
+
+    def on_response_complete(self) -> None:
+        self._arm()  # before the parent, which may start a pipelined request (and disarm)
+        super().on_response_complete()
+
+    def connection_lost(self, exc: Exception | None) -> None:
+        self._disarm()
+        super().connection_lost(exc)
+
+
+# ---------------------------------------------------------------------- checks
+class _Guard:
+    """ASGI middleware: security headers, ``Host``, ``Origin`` and token checks.
+
+    Refusals close the connection, so whatever the client sent after the
+    headers is never read.
+    """
+
+    def __init__(self, app: Callable[..., Awaitable[None]], token: str, loopback: bool):
+        self.app = app
+        self.token = token
+        self.loopback = loopback
+
+    def check(self, scope: dict, headers: Headers) -> _HttpError | None:
+        host = headers.get("host", "")
+        if self.loopback and not _is_loopback(_host_name(host)):
+            return _HttpError(403, f"refused: Host {host!r} is not this machine", close=True)
+        if not scope["path"].startswith("/api/"):
+            return None
+        origin = headers.get("origin")
+        if origin is not None:
+            parts = urlsplit(origin)
+            if f"{parts.scheme}://{parts.netloc}".lower() != f"http://{host}".lower():
+                return _HttpError(403, f"refused: request from {origin}", close=True)
+        auth = headers.get("authorization", "")
+        if not auth:
+            return _HttpError(401, "refused: no token; open the URL that ruledmesh design "
+                              "printed (it ends in ?token=...)", close=True)
+        scheme, _, given = auth.partition(" ")
+        if scheme.lower() != "bearer" or not hmac.compare_digest(
+                given.strip().encode(), self.token.encode()):
+            return _HttpError(403, "refused: wrong token", close=True)
+        if scope["method"] == "POST":
+            ctype = headers.get("content-type", "").split(";")[0].strip().lower()
+            if ctype != "application/json":
+                return _HttpError(415, "expected Content-Type: application/json", close=True)
+        return None
+
+    async def __call__(self, scope: dict, receive: Callable, send: Callable) -> None:
+        if scope["type"] == "websocket":  # none yet; when there are, they need the token too
+            await send({"type": "websocket.close", "code": 1008})
+            return
+        if scope["type"] != "http":
+            await self.app(scope, receive, send)
+            return
+
+        async def secured(message: MutableMapping[str, Any]) -> None:
+            if message["type"] == "http.response.start":
+                message = {**message, "headers": [*message.get("headers", []),
+                                                   *_SECURITY_HEADERS]}
+            await send(message)
+
+        problem = self.check(scope, Headers(scope=scope))
+        if problem is not None:
+            await problem.response()(scope, receive, secured)
+            return
+        await self.app(scope, receive, secured)
+
+
+# ---------------------------------------------------------------------- application
+class _Api:
+    """The endpoints; blocking work (builds, encoding, files) runs in worker threads."""
+
+    def __init__(self, server: DesignerServer):
+        self.server = server
+        self.session = server.session
+        self.limits = server.limits
+
+    async def _drain(self, request: Request, size: int) -> None:
+        """Read and drop a too-large body (up to :data:`DRAIN_LIMIT`), so the answer arrives.
+
+        Closing a connection with unread data makes the kernel reset it, and the
+        client would see a network error instead of the message with the limit.
+        """
+        if size > DRAIN_LIMIT:
+            return
+        with anyio.move_on_after(self.limits.request_timeout):
+            async for _ in request.stream():
+                pass
+
+    async def body(self, request: Request) -> dict:
+        """The JSON object of a POST, read with the size and time limits."""
+        declared = request.headers.get("content-length")
+        limit = self.limits.body
+        if declared is not None:
+            try:
+                size = int(declared)
+            except ValueError:
+                raise _HttpError(400, "bad Content-Length", close=True) from None
+            if size > limit:
+                await self._drain(request, size)
+                raise _HttpError(413, f"request too large: {size:,} bytes; the limit is "
+                                 f"{limit:,} bytes", close=True)
+        chunks, size = [], 0
+        try:
+            with anyio.fail_after(self.limits.request_timeout):
+                async for chunk in request.stream():
+                    size += len(chunk)
+                    if size > limit:
+                        raise _HttpError(413, f"request too large: more than {limit:,} bytes; "
+                                         f"the limit is {limit:,} bytes", close=True)
+                    chunks.append(chunk)
+        except TimeoutError:
+            raise _HttpError(408, f"request body not received within "
+                             f"{self.limits.request_timeout:g} s", close=True) from None
+        raw = b"".join(chunks) or b"{}"
+        try:
+            body = json.loads(raw.decode("utf-8"))
+        except (UnicodeDecodeError, json.JSONDecodeError) as exc:
+            raise _HttpError(400, f"invalid JSON: {exc}") from None
+        if not isinstance(body, dict):
+            raise _HttpError(400, "expected a JSON object")
+        return body
+
+    def state(self, started: float) -> Response:
+        body = self.session.payload()
+        ms = (time.perf_counter() - started) * 1000
+        # Server-Timing lets the page tell server time (build + encode) from its own.
+        return Response(body, media_type="application/octet-stream",
+                        headers={"Server-Timing": f"app;dur={ms:.1f}"})
+
+    async def dispatch(self, request: Request) -> Response:
+        started = time.perf_counter()
+        name = request.path_params["name"]
+        method = "get" if request.method == "HEAD" else request.method.lower()
+        fn = getattr(self, f"{method}_{name}", None)
+        try:
+            if fn is None:
+                raise _HttpError(404, f"no API {request.method} /api/{name}")
+            arg = await self.body(request) if method == "post" else dict(request.query_params)
+            return await run_in_threadpool(fn, arg, started)
+        except _HttpError as exc:
+            return exc.response()
+        except OverwriteRefused as exc:
+            return JSONResponse({"error": str(exc), "exists": True}, 409)
+        except Superseded as exc:
+            return JSONResponse({"error": str(exc), "superseded": True}, 409)
+        except RuledMeshError as exc:
+            return JSONResponse({"error": str(exc)}, 400)
+        except MemoryError:
+            return JSONResponse({"error": "out of memory; reduce the counts in the design"}, 400)
+        except Exception as exc:  # noqa: BLE001 - a bug must not stop the server
+            return JSONResponse({"error": f"internal error: {type(exc).__name__}: {exc}"}, 500)
+
+    # ------------------------------------------------------------ endpoints (worker threads)
+    def get_state(self, query: dict, started: float) -> Response:
+        return self.state(started)
+
+    def post_edit(self, body: dict, started: float) -> Response:
+        changes = body.get("changes")
+        if not isinstance(changes, list) or not all(
+                isinstance(c, list) and len(c) == 2 for c in changes):
+            raise _HttpError(400, "expected changes: [[path, value], ...]")
+        coalesce = body.get("coalesce")
+        self.session.edit([(p, v) for p, v in changes],
+                          coalesce=str(coalesce) if coalesce else None)
+        return self.state(started)
+
+    def post_design(self, body: dict, started: float) -> Response:
+        if "toml" in body:
+            if not isinstance(body["toml"], str):
+                raise _HttpError(400, "expected toml: a string")
+            self.session.load_text(body["toml"])
+        elif body.get("default") is True:
+            self.session.load_text(DEFAULT_DESIGN)
+        elif isinstance(body.get("design"), dict):
+            self.session.replace(body["design"])
+        else:
+            raise _HttpError(400, "expected design: {...} or toml: \"...\"")
+        return self.state(started)
+
+    def post_undo(self, body: dict, started: float) -> Response:
+        self.session.undo()
+        return self.state(started)
+
+    def post_redo(self, body: dict, started: float) -> Response:
+        self.session.redo()
+        return self.state(started)
+
+    @staticmethod
+    def _name(body: dict, key: str = "path") -> str | None:
+        value = body.get(key)
+        if value is None or value == "":
+            return None
+        if not isinstance(value, str):
+            raise ParameterError(f"expected a file name, got {type(value).__name__}", key)
+        return value
+
+    def post_save(self, body: dict, started: float) -> Response:
+        path = self.session.save(self._name(body), overwrite=body.get("overwrite") is True)
+        return JSONResponse({"path": str(path)})
+
+    def post_export(self, body: dict, started: float) -> Response:
+        fmt = body.get("format")
+        if not isinstance(fmt, str) or not fmt:
+            raise _HttpError(400, "expected format, e.g. \".obj\"")
+        path = self.session.export(fmt, self._name(body), overwrite=body.get("overwrite") is True)
+        return JSONResponse({"path": str(path)})
+
+    def get_download(self, query: dict, started: float) -> Response:
+        fmt = query.get("format") or ""
+        if not fmt:
+            raise _HttpError(400, "expected ?format=.obj")
+        data = self.session.export_bytes(fmt)
+        ext = fmt.lower() if fmt.startswith(".") else f".{fmt.lower()}"
+        stem = self.session.save_name().rsplit(".", 1)[0].replace("/", "_")
+        return Response(data, media_type="application/octet-stream",
+                        headers={"Content-Disposition": f'attachment; filename="{stem}{ext}"'})
+
+    def _stale(self, version: int) -> Response:
+        return Response(encode_message({"version": version, "stale": True}, []),
+                        media_type="application/octet-stream")
+
+    def get_figures(self, query: dict, started: float) -> Response:
+        session = self.session
+        try:
+            version = int(query.get("version", session.version))
+        except ValueError:
+            raise _HttpError(400, "expected version=<integer>") from None
+        current, data = session.snapshot()
+        if version != current:
+            return self._stale(version)
+        result = self.server.figures().request(version, data, session.source, session.base_dir)
+        if result is None:
+            return self._stale(version)
+        figures, per_face, error = result
+        arrays = [] if per_face is None else [("closeness", np.asarray(per_face, np.float32))]
+        return Response(encode_message({"version": version, "figures": figures, "error": error},
+                                       arrays), media_type="application/octet-stream")
+
+
+# ---------------------------------------------------------------------- server
+def _bind(host: str, port: int) -> socket.socket:
+    name = host.strip("[]")
+    family = socket.AF_INET6 if ":" in name else socket.AF_INET
+    # proto given explicitly: asyncio turns Nagle's algorithm off only for sockets whose proto
+    # is IPPROTO_TCP, and with it on every answer's body waits ~40 ms for a delayed ACK.
+    sock = socket.socket(family, socket.SOCK_STREAM, socket.IPPROTO_TCP)
+    try:
+        sock.setsockopt(socket.SOL_SOCKET, socket.SO_REUSEADDR, 1)
+        sock.bind((name, port))
+        sock.listen(256)
+    except OSError as exc:
+        sock.close()
+        if exc.errno == errno.EADDRINUSE:
+            raise PortInUse(port) from None
+        raise
+    return sock
+
+
+class _Uvicorn(uvicorn.Server):
+    """uvicorn's server, stopping the worker processes before waiting for open requests.
+
+    A figures request waits for its worker; stopping the workers first answers
+    such requests at once, so shutting down does not wait out the grace period.
+    """
+
+    def __init__(self, config: uvicorn.Config, before_shutdown: Callable[[], None]):
+        super().__init__(config)
+        self.before_shutdown = before_shutdown
+
+    async def shutdown(self, sockets: list[socket.socket] | None = None) -> None:
+        await anyio.to_thread.run_sync(self.before_shutdown)
+        await super().shutdown(sockets)
+
+
+class DesignerServer:
+    """The designer's server for one :class:`Session`: bound at once, serving on demand.
 
     Parameters
     ----------
     session : Session
+        Its builds move to a :class:`~ruledmesh.web.builder.BuildWorker` process.
     host : str
         Interface to bind (default loopback only).
     port : int
         0 picks a free port; see :attr:`url`.
+    token : str, optional
+        The secret of the API; a new random one by default.
+    limits : Limits, optional
+
+    Raises
+    ------
+    PortInUse
+        Another program listens on ``port``.
     """
 
-    daemon_threads = True
-    allow_reuse_address = True
-
-    def __init__(self, session: Session, host: str = DEFAULT_HOST, port: int = 0):
-        if ":" in host.strip("[]"):
-            self.address_family = __import__("socket").AF_INET6
-        super().__init__((host.strip("[]"), port), _Handler)
+    def __init__(self, session: Session, host: str = DEFAULT_HOST, port: int = 0, *,
+                 token: str | None = None, limits: Limits | None = None):
         self.session = session
-        self.loopback = _is_loopback(host)
-        self.static_root = _static_root()
+        self.limits = limits or Limits()
+        self.token = token or secrets.token_urlsafe(32)
+        self.loopback = _is_loopback(host.strip("[]"))
+        self.socket = _bind(host, port)
+        self.server_address = self.socket.getsockname()
         self._figures: FigureWorker | None = None
         self._figures_lock = threading.Lock()
-
-    def handle_error(self, request, client_address) -> None:
-        """A client that went away mid-answer is normal (page reloaded); others go to stderr."""
-        import sys
-
-        if isinstance(sys.exc_info()[1], (BrokenPipeError, ConnectionResetError)):
-            return
-        super().handle_error(request, client_address)
+        self._closing = False
+        self._builder = BuildWorker(self.limits.build_seconds)
+        session.set_builder(self._builder)
+        api = _Api(self)
+        routes = [Route("/api/{name:str}", api.dispatch, methods=["GET", "HEAD", "POST"]),
+                  Mount("/", StaticFiles(directory=_static_root(), html=True))]
+        self.app = _Guard(Starlette(routes=routes), self.token, self.loopback)
+        protocol = type("_Protocol", (_DeadlineH11,), {"deadline": self.limits.request_timeout})
+        config = uvicorn.Config(self.app, http=protocol, ws="none", lifespan="off",
+                                log_level="error", access_log=False, server_header=False,
+                                timeout_keep_alive=KEEP_ALIVE, timeout_graceful_shutdown=3)
+        self._uvicorn = _Uvicorn(config, self._stop_workers)
+        self._stopped = threading.Event()
 
     @property
-    def url(self) -> str:
-        """``http://host:port/`` of the page."""
+    def base_url(self) -> str:
+        """``http://host:port/`` of the page (without the token)."""
         host, port = self.server_address[:2]
         if ":" in host:
             host = f"[{host}]"
         return f"http://{host}:{port}/"
 
+    @property
+    def url(self) -> str:
+        """``http://host:port/?token=...``: the page's address, as printed and opened."""
+        return f"{self.base_url}?token={self.token}"
+
     def figures(self) -> FigureWorker:
         with self._figures_lock:
+            if self._closing:
+                raise Superseded("the designer is stopping")
             if self._figures is None:
                 self._figures = FigureWorker()
             return self._figures
 
-    def server_close(self) -> None:
-        super().server_close()
+    def serve_forever(self) -> None:
+        """Serve until :meth:`shutdown` (or SIGINT/SIGTERM in the main thread)."""
+        # The worker imports numpy and scipy meanwhile: the page and its state do not wait.
+        threading.Thread(target=self._builder.start, name="build-start", daemon=True).start()
+        try:
+            self._uvicorn.run(sockets=[self.socket])
+        finally:
+            self._stopped.set()
+
+    def shutdown(self, timeout: float = 10.0) -> None:
+        """Stop serving (from another thread) and wait for :meth:`serve_forever` to return."""
+        self._uvicorn.should_exit = True
+        self._stopped.wait(timeout)
+
+    def _stop_workers(self) -> None:
+        self._builder.close()
         with self._figures_lock:
+            self._closing = True
             if self._figures is not None:
                 self._figures.close()
                 self._figures = None
 
+    def server_close(self) -> None:
+        """Close the socket and stop the worker processes."""
+        self.socket.close()
+        self._stop_workers()
 
-def make_server(session: Session, host: str = DEFAULT_HOST, port: int = 0) -> DesignerServer:
+
+def make_server(session: Session, host: str = DEFAULT_HOST, port: int = 0, *,
+                token: str | None = None, limits: Limits | None = None) -> DesignerServer:
     """A :class:`DesignerServer` bound to ``host:port`` (not yet serving)."""
-    return DesignerServer(session, host, port)
-
-
-class _HttpError(Exception):
-    def __init__(self, status: int, message: str):
-        super().__init__(message)
-        self.status = status
-
-
-class _Handler(BaseHTTPRequestHandler):
-    server: DesignerServer
-    protocol_version = "HTTP/1.1"
-    # Headers and body go out in two writes; with Nagle's algorithm the second waits for the
-    # client's delayed ACK (~40 ms per request on Linux), a third of the 100 ms budget.
-    disable_nagle_algorithm = True
-    server_version = "ruledmesh-designer"
-
-    def log_message(self, format: str, *args: Any) -> None:  # noqa: A002 - stdlib signature
-        pass  # quiet: the CLI prints the URL; per-request logs would flood the terminal
-
-    # ------------------------------------------------------------ replies
-    def _send(self, status: int, body: bytes, ctype: str, extra: dict | None = None) -> None:
-        self.send_response(status)
-        self.send_header("Content-Type", ctype)
-        self.send_header("Content-Length", str(len(body)))
-        self.send_header("Cache-Control", "no-store")
-        self.send_header("X-Content-Type-Options", "nosniff")
-        for k, v in (extra or {}).items():
-            self.send_header(k, v)
-        self.end_headers()
-        if self.command != "HEAD":
-            self.wfile.write(body)
-
-    def _json(self, status: int, obj: Any) -> None:
-        self._send(status, json.dumps(obj).encode("utf-8"), "application/json")
-
-    def _error(self, status: int, message: str) -> None:
-        self._json(status, {"error": message})
-
-    # ------------------------------------------------------------ checks
-    def _check_host(self) -> None:
-        if not self.server.loopback:
-            return
-        host = self.headers.get("Host", "")
-        name = host.rsplit(":", 1)[0] if not host.endswith("]") else host
-        if name.lower() not in _LOOPBACK_NAMES and not _is_loopback(name):
-            raise _HttpError(HTTPStatus.FORBIDDEN, f"refused: Host {host!r} is not this machine")
-
-    def _body(self) -> dict:
-        ctype = self.headers.get("Content-Type", "").split(";")[0].strip().lower()
-        if ctype != "application/json":
-            raise _HttpError(HTTPStatus.UNSUPPORTED_MEDIA_TYPE, "expected application/json")
-        origin = self.headers.get("Origin")
-        if origin and self.server.loopback:
-            oh = urlsplit(origin).hostname or ""
-            if not _is_loopback(oh):
-                raise _HttpError(HTTPStatus.FORBIDDEN, f"refused: request from {origin}")
-        try:
-            length = int(self.headers.get("Content-Length", "0"))
-        except ValueError:
-            raise _HttpError(HTTPStatus.BAD_REQUEST, "bad Content-Length") from None
-        if length < 0 or length > MAX_BODY:
-            raise _HttpError(HTTPStatus.REQUEST_ENTITY_TOO_LARGE, "request too large")
-        raw = self.rfile.read(length) if length else b"{}"
-        try:
-            body = json.loads(raw.decode("utf-8"))
-        except (UnicodeDecodeError, json.JSONDecodeError) as exc:
-            raise _HttpError(HTTPStatus.BAD_REQUEST, f"invalid JSON: {exc}") from None
-        if not isinstance(body, dict):
-            raise _HttpError(HTTPStatus.BAD_REQUEST, "expected a JSON object")
-        return body
-
-    # ------------------------------------------------------------ dispatch
-    def _handle(self, method: str) -> None:
-        self._started = time.perf_counter()
-        try:
-            self._check_host()
-            url = urlsplit(self.path)
-            if url.path.startswith("/api/"):
-                name = url.path[5:]
-                fn = getattr(self, f"_{method}_{name}", None)
-                if fn is None:
-                    raise _HttpError(HTTPStatus.NOT_FOUND, f"no API {method.upper()} {url.path}")
-                if method == "post":
-                    fn(self._body())
-                else:
-                    fn(parse_qs(url.query))
-            elif method == "get":
-                self._static(url.path)
-            else:
-                raise _HttpError(HTTPStatus.NOT_FOUND, f"no such path {url.path}")
-        except _HttpError as exc:
-            self._error(exc.status, str(exc))
-        except RuledMeshError as exc:
-            self._error(HTTPStatus.BAD_REQUEST, str(exc))
-        except (BrokenPipeError, ConnectionResetError):
-            pass
-        except MemoryError:
-            self._error(HTTPStatus.BAD_REQUEST, "out of memory; reduce the counts in the design")
-        except Exception as exc:  # noqa: BLE001 - a bug must not stop the server
-            self._error(HTTPStatus.INTERNAL_SERVER_ERROR,
-                        f"internal error: {type(exc).__name__}: {exc}")
-
-    def do_GET(self) -> None:  # noqa: N802 - stdlib name
-        self._handle("get")
-
-    def do_HEAD(self) -> None:  # noqa: N802 - stdlib name
-        self._handle("get")
-
-    def do_POST(self) -> None:  # noqa: N802 - stdlib name
-        self._handle("post")
-
-    # ------------------------------------------------------------ static
-    def _static(self, path: str) -> None:
-        if path in ("", "/"):
-            path = "/index.html"
-        root = self.server.static_root.resolve()
-        target = (root / path.lstrip("/")).resolve()
-        if not target.is_relative_to(root) or not target.is_file():
-            raise _HttpError(HTTPStatus.NOT_FOUND, f"no such file {path}")
-        ctype = mimetypes.guess_type(target.name)[0] or "application/octet-stream"
-        if target.suffix == ".js":
-            ctype = "text/javascript"
-        self._send(HTTPStatus.OK, target.read_bytes(), f"{ctype}; charset=utf-8"
-                   if ctype.startswith("text/") else ctype)
-
-    # ------------------------------------------------------------ API
-    def _state(self) -> None:
-        body = self.server.session.payload()
-        ms = (time.perf_counter() - self._started) * 1000
-        # Server-Timing lets the page tell server time (build + encode) from its own.
-        self._send(HTTPStatus.OK, body, "application/octet-stream",
-                   {"Server-Timing": f"app;dur={ms:.1f}"})
-
-    def _get_state(self, query: dict) -> None:
-        self._state()
-
-    def _post_edit(self, body: dict) -> None:
-        changes = body.get("changes")
-        if not isinstance(changes, list) or not all(
-                isinstance(c, list) and len(c) == 2 for c in changes):
-            raise _HttpError(HTTPStatus.BAD_REQUEST, "expected changes: [[path, value], ...]")
-        coalesce = body.get("coalesce")
-        self.server.session.edit([(p, v) for p, v in changes],
-                                 coalesce=str(coalesce) if coalesce else None)
-        self._state()
-
-    def _post_design(self, body: dict) -> None:
-        if "toml" in body:
-            if not isinstance(body["toml"], str):
-                raise _HttpError(HTTPStatus.BAD_REQUEST, "expected toml: a string")
-            self.server.session.load_text(body["toml"])
-        elif body.get("default") is True:
-            self.server.session.load_text(DEFAULT_DESIGN)
-        elif isinstance(body.get("design"), dict):
-            self.server.session.replace(body["design"])
-        else:
-            raise _HttpError(HTTPStatus.BAD_REQUEST, "expected design: {...} or toml: \"...\"")
-        self._state()
-
-    def _post_undo(self, body: dict) -> None:
-        self.server.session.undo()
-        self._state()
-
-    def _post_redo(self, body: dict) -> None:
-        self.server.session.redo()
-        self._state()
-
-    def _post_save(self, body: dict) -> None:
-        path = self.server.session.save(body.get("path") or None)
-        self._json(HTTPStatus.OK, {"path": str(path)})
-
-    def _post_export(self, body: dict) -> None:
-        fmt = body.get("format")
-        if not isinstance(fmt, str) or not fmt:
-            raise _HttpError(HTTPStatus.BAD_REQUEST, "expected format, e.g. \".obj\"")
-        path = self.server.session.export(fmt, body.get("path") or None)
-        self._json(HTTPStatus.OK, {"path": str(path)})
-
-    def _get_download(self, query: dict) -> None:
-        fmt = (query.get("format") or [""])[0]
-        if not fmt:
-            raise _HttpError(HTTPStatus.BAD_REQUEST, "expected ?format=.obj")
-        session = self.server.session
-        data = session.export_bytes(fmt)
-        ext = fmt.lower() if fmt.startswith(".") else f".{fmt.lower()}"
-        stem = session.path.stem if session.path else str(session.design.get("name") or "design")
-        safe = "".join(c for c in stem if c.isalnum() or c in "-_.") or "design"
-        self._send(HTTPStatus.OK, data, "application/octet-stream",
-                   {"Content-Disposition": f'attachment; filename="{safe}{ext}"'})
-
-    def _stale(self, version: int) -> None:
-        self._send(HTTPStatus.OK, encode_message({"version": version, "stale": True}, []),
-                   "application/octet-stream")
-
-    def _get_figures(self, query: dict) -> None:
-        session = self.server.session
-        try:
-            version = int((query.get("version") or [session.version])[0])
-        except ValueError:
-            raise _HttpError(HTTPStatus.BAD_REQUEST, "expected version=<integer>") from None
-        current, data = session.snapshot()
-        if version != current:
-            self._stale(version)
-            return
-        result = self.server.figures().request(version, data, session.source, session.base_dir)
-        if result is None:
-            self._stale(version)
-            return
-        figures, per_face, error = result
-        arrays = [] if per_face is None else [("closeness", np.asarray(per_face, np.float32))]
-        self._send(HTTPStatus.OK, encode_message(
-            {"version": version, "figures": figures, "error": error}, arrays),
-            "application/octet-stream")
+    return DesignerServer(session, host, port, token=token, limits=limits)

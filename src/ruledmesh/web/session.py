@@ -6,6 +6,11 @@ builds it and only then makes it current, so the state always holds a design
 that builds; a bad edit raises (with the design file's dotted field path) and
 leaves the state as it was.  :meth:`Session.payload` encodes the mesh for the
 page as one binary message (see :func:`encode_message`).
+
+The session is also where the designer's file safety lives: it reads and
+writes only inside its folder (:meth:`Session.inside`), never replaces a file
+it did not load or write itself unless asked to (:class:`OverwriteRefused`),
+and refuses designs over the limits (:func:`check_limits`) before building.
 """
 
 from __future__ import annotations
@@ -25,10 +30,20 @@ from ..design import Design, build_design, parse_design
 from ..errors import DesignError, ExportError, ParameterError
 from ..mesh import FaceKind, Mesh
 from ..registry import Built
+from .builder import InProcessBuilder, Superseded
 from .toml_writer import dumps
 
-__all__ = ["Session", "DEFAULT_DESIGN", "fan_triangles", "fast_figures", "encode_message",
-           "set_path"]
+__all__ = [
+    "DEFAULT_DESIGN",
+    "MAX_CONTROL_POINTS",
+    "OverwriteRefused",
+    "Session",
+    "check_limits",
+    "encode_message",
+    "fan_triangles",
+    "fast_figures",
+    "set_path",
+]
 
 # Shown when the designer starts without a design file (paper Fig. 10, a skew surface).
 DEFAULT_DESIGN = """\
@@ -62,6 +77,93 @@ trim = true
 UNDO_LIMIT = 200
 # Points sampled along each director curve for display.
 CURVE_SAMPLES = 160
+# Control points of one curve (or points of one list of a catalogue surface): each one is a
+# handle in the page, and a design is edited by hand, so thousands mean a mistake or an attack.
+MAX_CONTROL_POINTS = 2_000
+
+
+class OverwriteRefused(ParameterError):
+    """Save or export would replace a file this session did not load or write itself."""
+
+
+def check_limits(data: Mapping[str, Any], base_dir: Path) -> None:
+    """Refuse, before any work, a design over the designer's limits or reading outside its folder.
+
+    Limits: :data:`MAX_CONTROL_POINTS` points per curve (and per point list of
+    a ``[surface]`` table); generators x (rows + 1) grid points at most the
+    mesher's own ``MAX_GRID_POINTS`` (the budget of ``ruledmesh build``);
+    ``rulings.file`` a name inside ``base_dir``.
+
+    Raises
+    ------
+    DesignError
+        Naming the field and the limit.
+    """
+    from ..pq import MAX_GRID_POINTS
+
+    def count_points(value: Any, field: str) -> None:
+        if isinstance(value, list) and len(value) > MAX_CONTROL_POINTS:
+            raise DesignError(f"expected at most {MAX_CONTROL_POINTS:,} points, got "
+                              f"{len(value):,}", field)
+
+    curves = data.get("curves")
+    if isinstance(curves, Mapping):
+        for name, spec in curves.items():
+            if isinstance(spec, Mapping):
+                count_points(spec.get("points"), f"curves.{name}.points")
+    surface = data.get("surface")
+    if isinstance(surface, Mapping):
+        for key, value in surface.items():
+            count_points(value, f"surface.{key}")
+    rulings = data.get("rulings")
+    mesh = data.get("mesh")
+    if isinstance(rulings, Mapping):
+        count_points(rulings.get("lines"), "rulings.lines")
+        count: Any = rulings.get("count")
+        rows: Any = mesh.get("rows", 20) if isinstance(mesh, Mapping) else 20
+        if _positive_int(count) and _positive_int(rows):
+            points = int(count) * (int(rows) + 1)
+            if points > MAX_GRID_POINTS:
+                raise DesignError(f"{count:,} generators x {int(rows) + 1:,} points each = "
+                                  f"{points:,} grid points; the limit is {MAX_GRID_POINTS:,}",
+                                  "rulings.count")
+        if "file" in rulings and isinstance(rulings["file"], str):
+            inside(base_dir, rulings["file"], "rulings.file", DesignError, must_exist=False)
+
+
+def _positive_int(value: Any) -> bool:
+    return isinstance(value, int) and not isinstance(value, bool) and value > 0
+
+
+def inside(base_dir: Path, name: str, field: str, err: type = ParameterError,
+           must_exist: bool = False) -> Path:
+    """``base_dir / name`` if it names a file inside ``base_dir``; else a one-line refusal.
+
+    Refused: absolute paths, ``~``, ``..`` parts, and names whose folder or
+    the file itself is a symbolic link leading out of ``base_dir``.  Sub-folders
+    that exist inside are fine.
+    """
+    base = Path(base_dir).resolve()
+    where = f"a file name inside the design's folder {base}"
+    if not isinstance(name, str) or not name.strip():
+        raise err(f"expected {where}, got {name!r}", field)
+    if "\0" in name:
+        raise err(f"expected {where}, got a name with a NUL character", field)
+    path = Path(name)
+    if name.startswith("~"):
+        raise err(f'expected {where}, got "{name}" (no "~" paths)', field)
+    if path.is_absolute() or name.startswith(("/", "\\")):
+        raise err(f'expected {where}, got the absolute path "{name}"', field)
+    if ".." in path.parts or ".." in name.replace("\\", "/").split("/"):
+        raise err(f'expected {where}, got "{name}" (no ".." parts)', field)
+    target = base / path
+    if not target.parent.resolve().is_relative_to(base):
+        raise err(f'expected {where}, got "{name}" (its folder is a link outside)', field)
+    if target.is_symlink() and not target.resolve().is_relative_to(base):
+        raise err(f'expected {where}, got "{name}" (a link to a file outside)', field)
+    if must_exist and not target.parent.is_dir():
+        raise err(f'no such folder "{target.parent.relative_to(base)}" in {base}', field)
+    return target.parent.resolve() / target.name
 
 
 def set_path(data: dict, path: Sequence[str | int], value: Any) -> None:
@@ -222,9 +324,9 @@ def encode_message(header: Mapping[str, Any], arrays: Sequence[tuple[str, np.nda
     except ValueError:  # NaN or infinity somewhere (a figure of a degenerate mesh): as strings
         text = json.dumps(_clean({**header, "arrays": table}), default=_json_default,
                           allow_nan=False)
-    text = text.encode("utf-8")
-    text += b" " * ((-len(text)) % 4)
-    return np.uint32(len(text)).tobytes() + text + b"".join(chunks)
+    raw_text = text.encode("utf-8")
+    raw_text += b" " * ((-len(raw_text)) % 4)
+    return np.uint32(len(raw_text)).tobytes() + raw_text + b"".join(chunks)
 
 
 @dataclass
@@ -249,28 +351,46 @@ class Session:
         design's folder, else the working folder).
     undo_limit : int
         Undo steps kept (older ones are dropped, so memory stays bounded).
+    builder : InProcessBuilder, optional
+        Builds the edits (the server passes a :class:`~ruledmesh.web.builder.BuildWorker`:
+        a separate process with a time limit); default: in the calling thread.
 
     Raises
     ------
     DesignError, GeometryError
-        When the starting design does not build.
+        When the starting design does not build or is over the limits.
     """
 
     def __init__(self, text: str | None = None, path: str | Path | None = None,
-                 base_dir: str | Path | None = None, undo_limit: int = UNDO_LIMIT):
-        self.path = Path(path) if path is not None else None
+                 base_dir: str | Path | None = None, undo_limit: int = UNDO_LIMIT,
+                 builder: InProcessBuilder | None = None):
+        # Resolved: a design file that is a link is edited where it really lives.
+        self.path = Path(path).resolve() if path is not None else None
         if base_dir is None:
             base_dir = self.path.parent if self.path is not None else Path(".")
-        self.base_dir = Path(base_dir)
+        # Resolved once: a later chdir or a renamed link does not move the folder written to.
+        self.base_dir = Path(base_dir).resolve()
         self.source = self.path.name if self.path is not None else "<designer>"
+        # Files this session loaded or wrote: the only ones replaced without asking.
+        self._owned: set[Path] = set()
+        if self.path is not None:
+            self.path = inside(self.base_dir, self.path.name, "path")
+            self._owned.add(self.path)
+        self._builder = builder or InProcessBuilder()
         design = parse_design(DEFAULT_DESIGN if text is None else text, self.source, self.base_dir)
         data = _plain(design.data)
+        check_limits(data, self.base_dir)
         self._lock = threading.RLock()
         self._current = _Snapshot(data, self._build(data), 0, dumps(data))
         self._undo: list[dict] = []
         self._redo: list[dict] = []
         self._coalesce: str | None = None
         self.undo_limit = int(undo_limit)
+
+    def set_builder(self, builder: InProcessBuilder) -> None:
+        """Build the next edits with ``builder`` (the server's worker process)."""
+        with self._lock:
+            self._builder = builder
 
     # ------------------------------------------------------------- state
     @property
@@ -304,12 +424,27 @@ class Session:
     def _build(self, data: dict) -> Built:
         return build_design(Design(data, self.source, self.base_dir))
 
+    def _commit(self, generation: int, push: bool, data: dict, built: Built,
+                text: str | None = None, coalesce: str | None = None) -> int:
+        """Make ``data`` current unless a newer edit arrived while it built (under the lock)."""
+        if self._builder.superseded(generation):
+            raise Superseded("superseded by a newer edit")
+        if push:
+            if coalesce is None or coalesce != self._coalesce:
+                self._undo.append(self._current.design)
+                del self._undo[:-self.undo_limit]
+            self._redo.clear()
+        self._coalesce = coalesce
+        self._make_current(data, built, text)
+        return self.version
+
     def _make_current(self, data: dict, built: Built, text: str | None = None) -> None:
         self._current = _Snapshot(data, built, self._current.version + 1,
                                   dumps(data) if text is None else text)
 
     # ------------------------------------------------------------- edits
-    def replace(self, data: Mapping[str, Any], coalesce: str | None = None) -> int:
+    def replace(self, data: Mapping[str, Any], coalesce: str | None = None,
+                generation: int | None = None) -> int:
         """Make ``data`` the current design if it builds; returns the new version.
 
         Parameters
@@ -319,28 +454,29 @@ class Session:
         coalesce : str, optional
             Consecutive edits with the same key (one handle drag, one slider
             gesture) make a single undo step.
+        generation : int, optional
+            Taken by :meth:`edit` when it read the design it changed.
 
         Raises
         ------
         DesignError, GeometryError, ParameterError
             The edit is refused and the state is unchanged.
+        Superseded
+            A newer edit arrived while this one was building; it wins.
         """
+        if generation is None:
+            generation = self._builder.generation()
         if not isinstance(data, Mapping):
             raise DesignError(f"expected a table, got {type(data).__name__}", "design")
         candidate = _plain(data)
+        check_limits(candidate, self.base_dir)
         # Parsing the TOML we would save checks the top level and that the design can be written.
         text = dumps(candidate)
         parse_design(text, self.source, self.base_dir)
-        # Edits are built one at a time, so they apply in the order they arrive.
+        # Built outside the lock: state requests (and newer edits) never wait for a build.
+        built = self._builder.build(generation, candidate, self.source, self.base_dir)
         with self._lock:
-            built = self._build(candidate)
-            if coalesce is None or coalesce != self._coalesce:
-                self._undo.append(self._current.design)
-                del self._undo[:-self.undo_limit]
-            self._coalesce = coalesce
-            self._redo.clear()
-            self._make_current(candidate, built, text)
-            return self.version
+            return self._commit(generation, True, candidate, built, text, coalesce)
 
     def edit(self, changes: Sequence[tuple[Sequence[str | int], Any]],
              coalesce: str | None = None) -> int:
@@ -350,70 +486,102 @@ class Session:
         "points", 2]``; ``value=None`` deletes the key.
         """
         with self._lock:
+            generation = self._builder.generation()
             data = self.design
-            for path, value in changes:
-                if not isinstance(path, (list, tuple)):
-                    raise DesignError(f"expected a list of keys, got {path!r}", "edit")
-                set_path(data, list(path), value)
-            return self.replace(data, coalesce)
+        for path, value in changes:
+            if not isinstance(path, (list, tuple)):
+                raise DesignError(f"expected a list of keys, got {path!r}", "edit")
+            set_path(data, list(path), value)
+        return self.replace(data, coalesce, generation)
 
     def load_text(self, text: str) -> int:
         """Replace the design by TOML ``text`` (one undo step)."""
         design = parse_design(text, self.source, self.base_dir)
         return self.replace(design.data)
 
+    def _step(self, back: bool) -> int:
+        name = "undo" if back else "redo"
+        with self._lock:
+            stack = self._undo if back else self._redo
+            if not stack:
+                raise ParameterError(f"nothing to {name}", name)
+            generation = self._builder.generation()
+            data = stack[-1]
+        built = self._builder.build(generation, data, self.source, self.base_dir)
+        with self._lock:
+            if self._builder.superseded(generation):
+                raise Superseded("superseded by a newer edit")
+            stack.pop()
+            (self._redo if back else self._undo).append(self._current.design)
+            return self._commit(generation, False, data, built)
+
     def undo(self) -> int:
         """Go back one edit; raises :class:`ParameterError` when there is none."""
-        with self._lock:
-            if not self._undo:
-                raise ParameterError("nothing to undo", "undo")
-            data = self._undo[-1]
-            built = self._build(data)
-            self._undo.pop()
-            self._redo.append(self._current.design)
-            self._coalesce = None
-            self._make_current(data, built)
-            return self.version
+        return self._step(True)
 
     def redo(self) -> int:
         """Repeat the last undone edit; raises :class:`ParameterError` when there is none."""
-        with self._lock:
-            if not self._redo:
-                raise ParameterError("nothing to redo", "redo")
-            data = self._redo[-1]
-            built = self._build(data)
-            self._redo.pop()
-            self._undo.append(self._current.design)
-            self._coalesce = None
-            self._make_current(data, built)
-            return self.version
+        return self._step(False)
 
     # ------------------------------------------------------------- files
     def toml(self) -> str:
         """The current design as TOML text."""
         return self._current.toml
 
-    def _target(self, path: str | Path | None, suffix: str) -> Path:
-        if path:
-            target = Path(path).expanduser()
-            return target if target.is_absolute() else self.base_dir / target
+    def inside(self, name: str, field: str = "path") -> Path:
+        """The path of file ``name`` in the design's folder; refuses names leading outside."""
+        return inside(self.base_dir, name, field, must_exist=True)
+
+    def _stem(self) -> str:
         stem = self.path.stem if self.path is not None else str(
             self._current.design.get("name") or "design")
-        return self.base_dir / f"{stem}{suffix}"
+        return "".join(c for c in stem if c.isalnum() or c in "-_.").strip(".") or "design"
 
-    def save(self, path: str | Path | None = None) -> Path:
+    def save_name(self) -> str:
+        """The name :meth:`save` writes without a path: the design file, else a free name."""
+        if self.path is not None:
+            return str(self.path.relative_to(self.base_dir))
+        stem = self._stem()
+        name, k = f"{stem}.toml", 2
+        while (self.base_dir / name).exists() or (self.base_dir / name).is_symlink():
+            name, k = f"{stem}-{k}.toml", k + 1
+        return name
+
+    def _writable(self, name: str, overwrite: bool) -> Path:
+        target = self.inside(name)
+        if target.is_dir():
+            raise ParameterError(f'"{target.name}" is a folder', "path")
+        if target.exists() and not overwrite and target not in self._owned:
+            raise OverwriteRefused(f'"{target.name}" exists in {self.base_dir} and was not '
+                                   "opened in this designer; confirm to replace it", "path")
+        return target
+
+    def save(self, path: str | None = None, overwrite: bool = False) -> Path:
         """Write the current design as TOML (atomically); returns the path written.
 
-        Without ``path``: the file the design came from, else
-        ``<name>.toml`` in the base folder.  A relative ``path`` is relative to
-        the base folder.
+        Parameters
+        ----------
+        path : str, optional
+            A file name inside the design's folder; default :meth:`save_name`.
+        overwrite : bool
+            Replace an existing file this session did not load or write.
+
+        Raises
+        ------
+        ParameterError
+            A name outside the folder or not ending in ``.toml``.
+        OverwriteRefused
+            The file exists, is not the session's own, and ``overwrite`` is false.
         """
         from ..io import write_atomic
 
-        target = self._target(path or self.path, ".toml")
-        if target.suffix.lower() != ".toml":
-            raise ParameterError(f'expected a ".toml" file name, got "{target.name}"', "path")
+        name = path or self.save_name()
+        if not str(name).lower().endswith(".toml"):
+            raise ParameterError(f'expected a ".toml" file name, got "{Path(str(name)).name}"',
+                                 "path")
+        target = self._writable(str(name), overwrite)
         write_atomic(target, self.toml().encode("utf-8"))
+        self._owned.add(target)
         if self.path is None:
             self.path = target
         return target
@@ -439,17 +607,24 @@ class Session:
             raise ExportError(f"{ext} export needs an optional package that is not installed "
                               f"({exc.name or exc}); see the install extras") from None
 
-    def export(self, ext: str, path: str | Path | None = None) -> Path:
-        """Write the current mesh as ``ext`` (atomically); returns the path written."""
+    def export(self, ext: str, path: str | None = None, overwrite: bool = False) -> Path:
+        """Write the current mesh as ``ext`` (atomically) inside the design's folder.
+
+        ``path`` defaults to ``<design name><ext>``; the rules of :meth:`save`
+        about folders and overwriting apply.  Returns the path written.
+        """
         from ..io import write_atomic
 
         ext = ext.lower() if ext.startswith(".") else f".{ext.lower()}"
+        name = str(path) if path else f"{self._stem()}{ext}"
+        if not name.lower().endswith(ext):
+            raise ParameterError(f'expected a file name ending in "{ext}", got '
+                                 f'"{Path(name).name}"', "path")
+        target = self._writable(name, overwrite)
         data = self.export_bytes(ext)
-        target = self._target(path, ext)
-        if target.suffix.lower() != ext:
-            raise ParameterError(f'expected a file name ending in "{ext}", got "{target.name}"',
-                                 "path")
-        return write_atomic(target, data)
+        write_atomic(target, data)
+        self._owned.add(target)
+        return target
 
     # ------------------------------------------------------------- page
     def describe(self) -> dict[str, Any]:
@@ -465,6 +640,8 @@ class Session:
             "design": self._current.design,
             "toml": self.toml(),
             "path": str(self.path) if self.path else None,
+            "folder": str(self.base_dir),
+            "save_name": self.save_name(),
             "can_undo": self.can_undo,
             "can_redo": self.can_redo,
             "choices": {

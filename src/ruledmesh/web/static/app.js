@@ -22,10 +22,14 @@ function decode(buffer) {
   return { header, arrays };
 }
 
-async function api(method, name, body) {
-  const init = { method };
+// The per-run secret from the page's address (http://127.0.0.1:PORT/?token=...): every API
+// call sends it, so other pages and programs on this machine cannot drive the designer.
+const TOKEN = new URLSearchParams(location.search).get('token') || '';
+
+async function request(method, name, body) {
+  const init = { method, headers: { Authorization: `Bearer ${TOKEN}` } };
   if (body !== undefined) {
-    init.headers = { 'Content-Type': 'application/json' };
+    init.headers['Content-Type'] = 'application/json';
     init.body = JSON.stringify(body);
   }
   let response;
@@ -35,16 +39,39 @@ async function api(method, name, body) {
     throw new Error('the designer server does not answer (was it stopped?)');
   }
   const ctype = response.headers.get('Content-Type') || '';
-  if (ctype.startsWith('application/json')) {
+  if (!response.ok && ctype.startsWith('application/json')) {
     const data = await response.json();
-    if (!response.ok || data.error) throw new Error(data.error || response.statusText);
-    return data;
+    const err = new Error(data.error || response.statusText);
+    err.status = response.status;
+    err.data = data;
+    throw err;
   }
   if (!response.ok) throw new Error(`${response.status} ${response.statusText}`);
+  return response;
+}
+
+async function api(method, name, body) {
+  const response = await request(method, name, body);
+  if ((response.headers.get('Content-Type') || '').startsWith('application/json')) {
+    return response.json();
+  }
   const msg = decode(await response.arrayBuffer());
   const timing = /dur=([0-9.]+)/.exec(response.headers.get('Server-Timing') || '');
   msg.serverMs = timing ? parseFloat(timing[1]) : null;
   return msg;
+}
+
+// Save and export never replace a file the designer did not open or write itself unless the
+// user agrees: the server answers 409 with {exists: true}, we ask, and send overwrite: true.
+async function writeFile(name, body) {
+  try {
+    return await api('POST', name, body);
+  } catch (err) {
+    if (err.status === 409 && err.data?.exists && window.confirm(`${err.message}.\n\nReplace it?`)) {
+      return api('POST', name, { ...body, overwrite: true });
+    }
+    throw err;
+  }
 }
 
 // ------------------------------------------------------------------ status
@@ -593,7 +620,8 @@ async function send(name, body) {
     status(`updated in ${ms.toFixed(0)} ms (server ${msg.serverMs?.toFixed(0)} ms)`);
     return true;
   } catch (err) {
-    showError(err.message);
+    // Superseded: another tab's newer edit won; show the design as it is now, not an error.
+    if (err.data?.superseded) status('edit superseded by a newer one'); else showError(err.message);
     activeInput = null;
     forceSync = true;  // even the field just typed in shows the server's value again
     await refresh();  // show the design as the server has it (the edit was refused)
@@ -619,8 +647,9 @@ function applyState(msg) {
   $('file').textContent = h.path || '(unsaved design)';
   $('undo').disabled = !h.can_undo;
   $('redo').disabled = !h.can_redo;
+  $('folder').textContent = h.folder;
   if (!$('save-path').value || document.activeElement !== $('save-path')) {
-    $('save-path').value = h.path || `${h.design.name || 'design'}.toml`;
+    $('save-path').value = h.save_name;  // the design file, or a free name in the folder
   }
   const fmtSel = $('export-format');
   if (fmtSel.options.length !== h.choices.formats.length) {
@@ -641,7 +670,26 @@ function applyState(msg) {
 }
 
 function updateDownload() {
-  $('download').href = `/api/download?format=${encodeURIComponent($('export-format').value)}`;
+  $('download').dataset.format = $('export-format').value;
+}
+
+// Downloads go through fetch (a plain link cannot send the token) and a temporary blob URL.
+async function download(event) {
+  event.preventDefault();
+  const fmt = $('export-format').value;
+  try {
+    const response = await request('GET', `download?format=${encodeURIComponent(fmt)}`);
+    const name = /filename="([^"]+)"/.exec(response.headers.get('Content-Disposition') || '');
+    const url = URL.createObjectURL(await response.blob());
+    const a = document.createElement('a');
+    a.href = url;
+    a.download = name ? name[1] : `design${fmt}`;
+    document.body.append(a);
+    a.click();
+    a.remove();
+    setTimeout(() => URL.revokeObjectURL(url), 10_000);
+    showError('');
+  } catch (err) { showError(err.message); }
 }
 
 // ------------------------------------------------------------------ handle dragging
@@ -750,9 +798,10 @@ for (const box of document.querySelectorAll('[data-layer]')) {
     render();
   });
 }
+$('download').addEventListener('click', download);
 $('save').addEventListener('click', async () => {
   try {
-    const r = await api('POST', 'save', { path: $('save-path').value.trim() });
+    const r = await writeFile('save', { path: $('save-path').value.trim() });
     showError('');
     status(`saved ${r.path}`);
     await refresh();
@@ -760,7 +809,7 @@ $('save').addEventListener('click', async () => {
 });
 $('export').addEventListener('click', async () => {
   try {
-    const r = await api('POST', 'export', { format: $('export-format').value });
+    const r = await writeFile('export', { format: $('export-format').value });
     showError('');
     status(`wrote ${r.path}`);
     window.designer.lastExport = r.path;
@@ -798,4 +847,6 @@ window.designer = {
 };
 
 resize();
-refresh();
+if (!TOKEN) showError('this address has no token: open the one that ruledmesh design printed ' +
+                      '(it ends in ?token=...)');
+else refresh();

@@ -1,0 +1,227 @@
+"""Designer builds in a worker process: a hard time limit and supersession by newer edits.
+
+A build runs in Python code that cannot be interrupted from another thread, so
+the only honest time limit is a process that can be terminated.  The server
+sends each candidate design to one long-lived worker process (started with
+``spawn``: a threaded server is never forked) and waits for the built result
+off the event loop.  The worker is killed and restarted when
+
+- the build takes longer than the limit (the edit is refused with the figure),
+- a newer edit arrives while an older one is still building after a short
+  grace period (the older one is superseded: its result would be discarded
+  anyway, and finishing it would only delay the newer one).
+
+Every edit takes a *generation* number from :meth:`BuildWorker.generation`
+when it reads the design it changes; a build whose generation is older than
+the newest one handed out is superseded, whether it is still waiting, running
+or already finished, so only the newest edit's result can become current.
+"""
+
+from __future__ import annotations
+
+import multiprocessing as mp
+import threading
+import time
+from pathlib import Path
+from typing import Any
+
+from ..errors import RuledMeshError
+
+__all__ = ["MAX_BUILD_SECONDS", "BuildTimeout", "BuildWorker", "InProcessBuilder", "Superseded"]
+
+# Wall-clock limit of one designer build (the CLI has none: it is the user's own job there).
+MAX_BUILD_SECONDS = 20.0
+# A superseded build younger than this is left to finish (and its result dropped): a fresh
+# worker process needs about a second to import numpy and scipy, most builds take milliseconds.
+SUPERSEDE_GRACE = 0.3
+# Seconds a fresh worker process may take to import its modules.
+STARTUP_SECONDS = 120.0
+
+
+class Superseded(RuledMeshError):
+    """A newer edit arrived while this one was waiting or building; it was dropped."""
+
+
+class BuildTimeout(RuledMeshError):
+    """A build took longer than the designer's limit and was stopped."""
+
+
+def _worker_main(conn) -> None:  # pragma: no cover - runs in the child process
+    from ..design import Design, build_design, parse_design
+    from ..registry import load_plugins
+    from .session import DEFAULT_DESIGN
+
+    load_plugins()
+    build_design(parse_design(DEFAULT_DESIGN))  # imports the mesher's modules (lazy elsewhere)
+    conn.send(("ready", None))  # the time limit counts from here
+    while True:
+        try:
+            job = conn.recv()
+        except (EOFError, OSError):
+            return
+        if job is None:
+            return
+        data, source, base_dir = job
+        try:
+            reply: tuple[str, Any] = ("ok", build_design(Design(data, source, Path(base_dir))))
+        except RuledMeshError as exc:
+            reply = ("error", exc)
+        except MemoryError:
+            reply = ("memory", None)
+        except Exception as exc:  # noqa: BLE001 - reported to the page, never a dead worker
+            reply = ("bug", f"{type(exc).__name__}: {exc}")
+        try:
+            conn.send(reply)
+        except Exception:  # noqa: BLE001 - an unpicklable error: say so instead of hanging
+            try:
+                conn.send(("bug", f"cannot return the result: {reply[0]}"))
+            except OSError:
+                return
+
+
+class InProcessBuilder:
+    """Builds in the calling thread (no time limit): a :class:`Session` used as a library.
+
+    Generations work as in :class:`BuildWorker`, so concurrent edits from
+    several threads still let only the newest one become current.
+    """
+
+    def __init__(self) -> None:
+        self._state = threading.Lock()
+        self._issued = 0
+
+    def generation(self) -> int:
+        """A new generation number, newer than every one before (one per edit)."""
+        with self._state:
+            self._issued += 1
+            return self._issued
+
+    def superseded(self, generation: int) -> bool:
+        """Whether a newer generation has been handed out (a newer edit arrived)."""
+        with self._state:
+            return self._issued > generation
+
+    def build(self, generation: int, data: dict, source: str, base_dir: str | Path) -> Any:
+        """Build design ``data`` here and now; returns the :class:`~ruledmesh.registry.Built`."""
+        from ..design import Design, build_design
+
+        return build_design(Design(data, source, Path(base_dir)))
+
+    def close(self) -> None:
+        """Nothing to stop."""
+
+
+class BuildWorker(InProcessBuilder):
+    """Builds designs in a separate process with a time limit.
+
+    Parameters
+    ----------
+    timeout : float
+        Seconds a build may take before it is stopped (:class:`BuildTimeout`).
+    """
+
+    def __init__(self, timeout: float = MAX_BUILD_SECONDS):
+        super().__init__()
+        self.timeout = float(timeout)
+        self._ctx = mp.get_context("spawn")
+        self._run_lock = threading.Lock()  # one job in the process at a time
+        self._proc: Any = None
+        self._conn: Any = None
+        self._closed = False
+
+    # ---------------------------------------------------------------- process
+    def _start(self) -> None:
+        parent, child = self._ctx.Pipe()
+        proc = self._ctx.Process(target=_worker_main, args=(child,), daemon=True,
+                                 name="ruledmesh-build")
+        proc.start()
+        child.close()
+        self._proc, self._conn = proc, parent
+        # Importing numpy and scipy takes a second or more on a busy machine: not build time.
+        try:
+            deadline = time.monotonic() + STARTUP_SECONDS
+            while not parent.poll(0.05):
+                if self._closed or time.monotonic() > deadline or not proc.is_alive():
+                    raise EOFError
+            if parent.recv()[0] != "ready":
+                raise EOFError
+        except (EOFError, OSError):
+            self._stop()
+            raise RuledMeshError("the build process did not start") from None
+
+    def _stop(self) -> None:
+        if self._proc is not None:
+            self._proc.kill()
+            self._proc.join(timeout=5)
+            self._conn.close()
+        self._proc = self._conn = None
+
+    def start(self) -> None:
+        """Start the worker process now (so the first edit does not wait for it)."""
+        with self._run_lock:
+            if self._proc is None and not self._closed:
+                try:
+                    self._start()
+                except RuledMeshError:
+                    pass  # the first build tries again and reports it
+
+    # ---------------------------------------------------------------- builds
+    def build(self, generation: int, data: dict, source: str, base_dir: str | Path) -> Any:
+        """Build design ``data`` in the worker; returns the :class:`~ruledmesh.registry.Built`.
+
+        Raises
+        ------
+        Superseded
+            A newer generation asked to build meanwhile.
+        BuildTimeout
+            The build took longer than :attr:`timeout`; the worker was restarted.
+        RuledMeshError
+            The design does not build (the same error as in the process itself).
+        """
+        if self.superseded(generation):
+            raise Superseded("superseded by a newer edit")
+        with self._run_lock:
+            if self._closed:
+                raise Superseded("the designer is stopping")
+            if self.superseded(generation):
+                raise Superseded("superseded by a newer edit")
+            if self._proc is None or not self._proc.is_alive():
+                self._stop()
+                self._start()
+            return self._wait(generation, (data, source, str(base_dir)))
+
+    def _wait(self, generation: int, job: tuple) -> Any:
+        started = time.monotonic()
+        try:
+            self._conn.send(job)
+            while not self._conn.poll(0.02):
+                elapsed = time.monotonic() - started
+                if elapsed > self.timeout:
+                    self._stop()
+                    raise BuildTimeout(f"the build took longer than {self.timeout:g} s and was "
+                                       "stopped; reduce the generator count or the rows")
+                if self._closed or (elapsed > SUPERSEDE_GRACE and self.superseded(generation)):
+                    self._stop()
+                    raise Superseded("superseded by a newer edit")
+                if not self._proc.is_alive():
+                    raise EOFError
+            kind, value = self._conn.recv()
+        except (EOFError, OSError):
+            self._stop()
+            raise RuledMeshError("the build process stopped unexpectedly (out of memory?); "
+                                 "reduce the counts in the design") from None
+        if self.superseded(generation):
+            raise Superseded("superseded by a newer edit")
+        if kind == "ok":
+            return value
+        if kind == "error":
+            raise value
+        if kind == "memory":
+            raise MemoryError
+        raise RuntimeError(value)
+
+    def close(self) -> None:
+        """Stop the worker process (a running build is abandoned)."""
+        self._closed = True
+        with self._run_lock:
+            self._stop()

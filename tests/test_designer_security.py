@@ -1,0 +1,512 @@
+"""The designer under attack on loopback: token, origin, smuggling, paths, limits, sockets.
+
+Every test runs a real server (Starlette on uvicorn, the build worker process)
+on 127.0.0.1 and talks to it with raw sockets or ``http.client``; the user's
+design file must stay untouched and nothing may be written outside its folder.
+"""
+
+from __future__ import annotations
+
+import http.client
+import json
+import os
+import socket
+import subprocess
+import sys
+import threading
+import time
+from pathlib import Path
+
+import pytest
+
+from ruledmesh.web.server import MAX_BODY, Limits, make_server
+from ruledmesh.web.session import MAX_CONTROL_POINTS, Session
+
+SMALL = """\
+name = "small"
+
+[curves.c1]
+type = "bspline"
+degree = 3
+points = [[0, 0, 0], [3, 1, 0], [6, -1, 0], [10, 0, 0]]
+
+[curves.c2]
+type = "polyline"
+points = [[0, 2, 4], [3, 4, 5], [6, 3, 3], [10, 3, 4]]
+
+[rulings]
+between = ["c1", "c2"]
+distribution = "parameter"
+count = 9
+
+[mesh]
+method = "pq"
+rows = 6
+"""
+
+
+def tree(folder: Path) -> dict[str, bytes]:
+    """Every file under ``folder`` with its bytes (links as their target)."""
+    out = {}
+    for p in sorted(folder.rglob("*")):
+        if p.is_symlink():
+            out[str(p.relative_to(folder))] = b"-> " + os.readlink(p).encode()
+        elif p.is_file():
+            out[str(p.relative_to(folder))] = p.read_bytes()
+    return out
+
+
+class Designer:
+    """A running designer over ``folder/user.toml`` and an ``outside`` folder next to it."""
+
+    def __init__(self, root: Path, limits: Limits | None = None, design: str | None = SMALL):
+        self.folder = root / "work"
+        self.outside = root / "outside"
+        self.folder.mkdir()
+        self.outside.mkdir()
+        (self.outside / "secret.txt").write_text("root:x:0:0:SECRET-LINE\n")
+        self.path = self.folder / "user.toml"
+        if design is not None:
+            self.path.write_text(design)
+            session = Session(design, self.path)
+        else:
+            session = Session(base_dir=self.folder)
+        self.server = make_server(session, port=0, limits=limits)
+        self.host, self.port = self.server.server_address[:2]
+        self.token = self.server.token
+        self.thread = threading.Thread(target=self.server.serve_forever, daemon=True)
+        self.thread.start()
+        self.before = {"work": tree(self.folder), "outside": tree(self.outside)}
+
+    @property
+    def session(self) -> Session:
+        return self.server.session
+
+    def close(self) -> None:
+        self.server.shutdown()
+        self.server.server_close()
+
+    def request(self, method: str, path: str, body=None, headers=None, token: bool | str = True,
+                timeout: float = 60):
+        conn = http.client.HTTPConnection(self.host, self.port, timeout=timeout)
+        hdrs = {"Content-Type": "application/json"} if body is not None else {}
+        if token:
+            hdrs["Authorization"] = f"Bearer {self.token if token is True else token}"
+        hdrs.update(headers or {})
+        data = body if isinstance(body, (bytes, str)) or body is None else json.dumps(body)
+        conn.request(method, path, data, hdrs)
+        resp = conn.getresponse()
+        raw = resp.read()
+        conn.close()
+        try:
+            return resp.status, json.loads(raw)
+        except (UnicodeDecodeError, json.JSONDecodeError):
+            return resp.status, raw
+
+    def raw(self, data: bytes, wait: float = 3.0) -> bytes:
+        """Send ``data`` on one connection; everything read until the server closes it."""
+        with socket.create_connection((self.host, self.port), timeout=wait) as s:
+            s.sendall(data)
+            out = b""
+            try:
+                while chunk := s.recv(65536):
+                    out += chunk
+            except TimeoutError:
+                pass
+        return out
+
+    def untouched(self) -> None:
+        """The design file, its folder and the outside folder are as they were."""
+        assert tree(self.outside) == self.before["outside"]
+        assert tree(self.folder) == self.before["work"]
+
+
+@pytest.fixture
+def designer(tmp_path):
+    d = Designer(tmp_path)
+    yield d
+    d.close()
+
+
+API = [("GET", "/api/state", None), ("GET", "/api/figures?version=0", None),
+       ("GET", "/api/download?format=.obj", None),
+       ("POST", "/api/edit", {"changes": [[["mesh", "rows"], 13]]}),
+       ("POST", "/api/design", {"toml": SMALL.replace("rows = 6", "rows = 13")}),
+       ("POST", "/api/undo", {}), ("POST", "/api/save", {"path": "evil.toml"}),
+       ("POST", "/api/export", {"format": ".obj", "path": "evil.obj"})]
+
+
+# ---------------------------------------------------------------- token, Host, Origin
+@pytest.mark.parametrize(("method", "path", "body"), API)
+def test_api_needs_the_token(designer, method, path, body):
+    version = designer.session.version
+    status, reply = designer.request(method, path, body, token=False)
+    assert status == 401 and "token" in reply["error"]
+    status, reply = designer.request(method, path, body, token="not-the-token")
+    assert status == 403 and reply["error"] == "refused: wrong token"
+    status, _ = designer.request(method, path, body, headers={"Authorization": designer.token})
+    assert status == 403  # the bare token without "Bearer" is not accepted either
+    assert designer.session.version == version
+    designer.untouched()
+
+
+def test_static_page_without_token_but_not_from_a_foreign_host(designer):
+    status, page = designer.request("GET", "/", token=False)
+    assert status == 200 and b"app.js" in page
+    status, reply = designer.request("GET", "/", token=False, headers={"Host": "evil.example"})
+    assert status == 403 and "Host" in reply["error"]
+    status, _ = designer.request("GET", "/api/state", headers={"Host": f"evil.example:{designer.port}"})
+    assert status == 403
+
+
+@pytest.mark.parametrize("origin", ["http://evil.example", "http://127.0.0.1:1",
+                                    "http://localhost:{port}", "https://127.0.0.1:{port}", "null"])
+def test_foreign_origin_refused_even_with_the_token(designer, origin):
+    origin = origin.format(port=designer.port)
+    for method, path, body in API:
+        status, reply = designer.request(method, path, body, headers={"Origin": origin})
+        assert status == 403 and origin in reply["error"], (path, reply)
+    assert designer.session.version == 0
+    designer.untouched()
+    # the page's own origin is fine
+    status, _ = designer.request("GET", "/api/state",
+                                 headers={"Origin": f"http://127.0.0.1:{designer.port}"})
+    assert status == 200
+
+
+def test_post_must_be_json(designer):
+    status, reply = designer.request("POST", "/api/undo", "{}", headers={"Content-Type": "text/plain"})
+    assert status == 415 and "application/json" in reply["error"]
+
+
+# ---------------------------------------------------------------- smuggling
+def smuggled(designer, rows: int) -> bytes:
+    """A complete, valid (token and all) HTTP request that would change rows and write files."""
+    body = json.dumps({"changes": [[["mesh", "rows"], rows]]}).encode()
+    inner = (f"POST /api/edit HTTP/1.1\r\nHost: 127.0.0.1:{designer.port}\r\n"
+             f"Authorization: Bearer {designer.token}\r\nContent-Type: application/json\r\n"
+             f"Content-Length: {len(body)}\r\n\r\n").encode() + body
+    save = json.dumps({"path": "smuggled.toml"}).encode()
+    inner += (f"POST /api/save HTTP/1.1\r\nHost: 127.0.0.1:{designer.port}\r\n"
+              f"Authorization: Bearer {designer.token}\r\nContent-Type: application/json\r\n"
+              "Connection: close\r\n"
+              f"Content-Length: {len(save)}\r\n\r\n").encode() + save
+    return inner
+
+
+def outer(designer, headers: str, body: bytes, length: int | None = None) -> bytes:
+    n = len(body) if length is None else length
+    return (f"POST /api/edit HTTP/1.1\r\nHost: 127.0.0.1:{designer.port}\r\n{headers}"
+            f"Content-Length: {n}\r\n\r\n").encode() + body
+
+
+def test_pipelining_works_so_the_smuggling_test_can_fail(designer):
+    # Control: the same bytes after an accepted request ARE executed (two answers, rows 13).
+    data = (f"GET /api/state HTTP/1.1\r\nHost: 127.0.0.1:{designer.port}\r\n"
+            f"Authorization: Bearer {designer.token}\r\n\r\n").encode() + smuggled(designer, 13)
+    out = designer.raw(data, wait=8.0)
+    assert out.count(b"HTTP/1.1 200") == 3
+    assert designer.session.design["mesh"]["rows"] == 13
+    assert (designer.folder / "smuggled.toml").exists()
+
+
+@pytest.mark.parametrize("refusal", ["no token", "wrong token", "text/plain", "foreign origin",
+                                     "too large", "bad JSON"])
+def test_refused_post_body_is_never_a_second_request(designer, refusal):
+    inner = smuggled(designer, 13)
+    auth = f"Authorization: Bearer {designer.token}\r\n"
+    json_ct = "Content-Type: application/json\r\n"
+    headers, length = {
+        "no token": (json_ct, None),
+        "wrong token": ("Authorization: Bearer nope\r\n" + json_ct, None),
+        "text/plain": (auth + "Content-Type: text/plain\r\n", None),
+        "foreign origin": (auth + json_ct + "Origin: http://evil.example\r\n", None),
+        "too large": (auth + json_ct, MAX_BODY + 1),
+        "bad JSON": (auth + json_ct + "Connection: close\r\n", None),
+    }[refusal]
+    if length is not None:  # the smuggled request at the start of a body over the limit
+        inner += b" " * (length - len(inner))
+    out = designer.raw(outer(designer, headers, inner, length), wait=8.0)
+    assert out.startswith(b"HTTP/1.1 4"), out[:200]
+    assert out.count(b"HTTP/1.1 ") == 1, out      # one answer: the body was not parsed
+    assert designer.session.design["mesh"]["rows"] == 6 and designer.session.version == 0
+    designer.untouched()
+
+
+def test_chunked_body_over_the_limit_is_refused(designer):
+    chunk = b"x" * 65536
+    head = (f"POST /api/edit HTTP/1.1\r\nHost: 127.0.0.1:{designer.port}\r\n"
+            f"Authorization: Bearer {designer.token}\r\nContent-Type: application/json\r\n"
+            "Transfer-Encoding: chunked\r\n\r\n").encode()
+    # Just over the limit and without the final chunk: the server has read everything sent
+    # when it answers, so closing the connection does not reset it before we read the answer.
+    body = b"".join(b"%x\r\n%s\r\n" % (len(chunk), chunk) for _ in range(MAX_BODY // len(chunk) + 1))
+    out = designer.raw(head + body, wait=8.0)
+    assert out.startswith(b"HTTP/1.1 413") and f"{MAX_BODY:,}".encode() in out
+    assert designer.session.version == 0
+
+
+# ---------------------------------------------------------------- half-open connections
+def test_hundreds_of_half_open_connections(tmp_path):
+    import resource
+
+    soft, hard = resource.getrlimit(resource.RLIMIT_NOFILE)
+    if soft < 2048:
+        resource.setrlimit(resource.RLIMIT_NOFILE, (min(4096, hard), hard))
+    d = Designer(tmp_path, limits=Limits(request_timeout=2.0))
+    socks = []
+    try:
+        for k in range(300):
+            s = socket.create_connection((d.host, d.port), timeout=10)
+            # half a request: some send nothing, some part of the headers
+            if k % 2:
+                s.sendall(f"POST /api/edit HTTP/1.1\r\nHost: 127.0.0.1:{d.port}\r\nX-".encode())
+            socks.append(s)
+        t0 = time.monotonic()
+        status, _ = d.request("GET", "/api/state", timeout=10)
+        answered = time.monotonic() - t0
+        assert status == 200 and answered < 2.0, answered
+        # a slow client sending a byte now and then does not keep its connection either
+        slow = socket.create_connection((d.host, d.port), timeout=10)
+        for ch in b"GET /api/state HTTP/1.1\r\n":
+            try:
+                slow.sendall(bytes([ch]))
+            except OSError:
+                break
+            time.sleep(0.25)
+        deadline = time.monotonic() + 10
+        for s in [*socks, slow]:
+            s.settimeout(max(deadline - time.monotonic(), 0.1))
+            try:
+                assert s.recv(1024) == b""  # closed by the server, without an answer
+            except ConnectionResetError:
+                pass
+        freed = time.monotonic() - t0
+        print(f"300 half-open connections: a normal request answered in {answered * 1000:.0f} ms, "
+              f"all freed after {freed:.1f} s (deadline 2 s)")
+        assert freed < 9
+        assert d.request("GET", "/api/state")[0] == 200
+    finally:
+        for s in socks:
+            s.close()
+        d.close()
+
+
+# ---------------------------------------------------------------- paths
+BAD_PATHS = ["/tmp/evil.toml", "{outside}/evil.toml", "../outside/evil.toml", "~/evil.toml",
+             "sub/../../outside/evil.toml", "link/evil.toml", "linked.toml", "nosuchdir/evil.toml",
+             "..\\outside\\evil.toml"]
+
+
+@pytest.mark.parametrize("endpoint", ["save", "export"])
+def test_writes_outside_the_folder_are_refused(designer, endpoint):
+    (designer.folder / "link").symlink_to(designer.outside, target_is_directory=True)
+    (designer.folder / "linked.toml").symlink_to(designer.outside / "secret.txt")
+    (designer.folder / "linked.obj").symlink_to(designer.outside / "secret.txt")
+    designer.before = {"work": tree(designer.folder), "outside": tree(designer.outside)}
+    for bad in BAD_PATHS:
+        bad = bad.format(outside=designer.outside)
+        if endpoint == "export":
+            bad = bad.replace(".toml", ".obj")
+            body = {"format": ".obj", "path": bad}
+        else:
+            body = {"path": bad}
+        status, reply = designer.request("POST", f"/api/{endpoint}", body)
+        assert status == 400, (bad, reply)
+        assert "\n" not in reply["error"] and ("inside the design's folder" in reply["error"]
+                                               or "no such folder" in reply["error"]), reply
+    assert not Path("/tmp/evil.toml").exists() and not (Path.home() / "evil.toml").exists()
+    designer.untouched()
+
+
+def test_save_without_the_flag_never_replaces_a_file_it_did_not_open(designer):
+    other = designer.folder / "mine.toml"
+    other.write_text("# the user's own file\n")
+    obj = designer.folder / "user.obj"
+    obj.write_text("# the user's own mesh\n")
+    designer.before = {"work": tree(designer.folder), "outside": tree(designer.outside)}
+    for endpoint, body in (("save", {"path": "mine.toml"}), ("export", {"format": ".obj"})):
+        status, reply = designer.request("POST", f"/api/{endpoint}", body)
+        assert status == 409 and reply["exists"] is True and "confirm" in reply["error"]
+    designer.untouched()
+    # the design file the session was started with is its own: saved without asking
+    designer.request("POST", "/api/edit", {"changes": [[["mesh", "rows"], 7]]})
+    status, reply = designer.request("POST", "/api/save", {})
+    assert status == 200 and Path(reply["path"]) == designer.path
+    assert "rows = 7" in designer.path.read_text()
+    # with the flag (the page asked the user), the other file is replaced
+    status, reply = designer.request("POST", "/api/save", {"path": "mine.toml", "overwrite": True})
+    assert status == 200 and "rows = 7" in other.read_text()
+    # and from then on it is the session's own
+    assert designer.request("POST", "/api/save", {"path": "mine.toml"})[0] == 200
+
+
+def test_without_a_design_file_save_picks_a_free_name(tmp_path):
+    d = Designer(tmp_path, design=None)
+    try:
+        user = d.folder / "skew.toml"
+        user.write_text("# the user's skew design\n")
+        (d.folder / "skew-2.toml").write_text("# another\n")
+        status, reply = d.request("POST", "/api/save", {})
+        assert status == 200 and Path(reply["path"]) == d.folder / "skew-3.toml"
+        assert user.read_text() == "# the user's skew design\n"
+        # the next Save writes the same file again
+        assert Path(d.request("POST", "/api/save", {})[1]["path"]) == d.folder / "skew-3.toml"
+    finally:
+        d.close()
+
+
+def test_referenced_files_stay_inside_and_errors_never_echo_content(designer):
+    (designer.folder / "notes.csv").write_text("header\nSECRET-LINE,1,2,3,4,5\n")
+    (designer.folder / "passwd.csv").symlink_to(designer.outside / "secret.txt")
+    for name, why in (("/etc/passwd", "absolute"), (str(designer.outside / "secret.txt"), "absolute"),
+                      ("../outside/secret.txt", ".."), ("~/.bashrc", "~"),
+                      ("passwd.csv", "link"), ("notes.csv", "cell 1 is not a number")):
+        design = SMALL.replace('between = ["c1", "c2"]\ndistribution = "parameter"\ncount = 9',
+                               f'file = "{name}"')
+        status, reply = designer.request("POST", "/api/design", {"toml": design})
+        assert status == 400 and "\n" not in reply["error"], reply
+        assert why in reply["error"], reply
+        assert "SECRET" not in reply["error"] and "root:" not in reply["error"], reply
+    assert designer.session.version == 0
+
+
+# ---------------------------------------------------------------- limits
+def test_huge_edit_refused_with_the_figure(designer):
+    points = [[k * 1e-3, 1.0, 0.5] for k in range(700_000)]
+    body = json.dumps({"changes": [[["curves", "c1", "points"], points]]})
+    t0 = time.monotonic()
+    status, reply = designer.request("POST", "/api/edit", body)
+    assert status == 413 and f"{len(body):,} bytes" in reply["error"]
+    assert f"{MAX_BODY:,}" in reply["error"] and time.monotonic() - t0 < 5
+    # under the byte limit but over the control points of one curve
+    many = [[k * 1e-3, 1.0, 0.5] for k in range(MAX_CONTROL_POINTS + 1)]
+    status, reply = designer.request("POST", "/api/edit",
+                                     {"changes": [[["curves", "c2", "points"], many]]})
+    assert status == 400 and f"at most {MAX_CONTROL_POINTS:,} points" in reply["error"]
+    assert "curves.c2.points" in reply["error"]
+    # grid points: the budget of the command line's mesher
+    from ruledmesh.pq import MAX_GRID_POINTS
+
+    status, reply = designer.request("POST", "/api/edit", {"changes": [
+        [["rulings", "count"], 60_000], [["mesh", "rows"], 1_000]]})
+    assert status == 400 and f"{MAX_GRID_POINTS:,}" in reply["error"], reply
+    assert designer.session.version == 0
+    designer.untouched()
+
+
+def slow_edit(rows: int = 50, count: int = 20_000) -> dict:
+    return {"changes": [[["rulings", "count"], count], [["mesh", "rows"], rows]]}
+
+
+def test_long_build_is_stopped_and_never_blocks_state_requests(tmp_path):
+    d = Designer(tmp_path, limits=Limits(build_seconds=1.5))
+    try:
+        d.request("POST", "/api/edit", {"changes": [[["mesh", "rows"], 7]]})  # worker warm
+        result = {}
+        t0 = time.monotonic()
+        worker = threading.Thread(target=lambda: result.setdefault(
+            "slow", d.request("POST", "/api/edit", slow_edit())))
+        worker.start()
+        time.sleep(0.3)
+        waits = []
+        while worker.is_alive():
+            t = time.monotonic()
+            assert d.request("GET", "/api/state", timeout=10)[0] == 200
+            waits.append(time.monotonic() - t)
+            time.sleep(0.05)
+        took = time.monotonic() - t0
+        status, reply = result["slow"]
+        print(f"build stopped after {took:.1f} s (limit 1.5 s); {len(waits)} state requests "
+              f"meanwhile, slowest {max(waits) * 1000:.0f} ms")
+        assert status == 400 and "longer than 1.5 s" in reply["error"]
+        assert took < 6 and max(waits) < 1.0
+        assert d.session.design["rulings"]["count"] == 9
+        # the restarted worker builds the next edit
+        assert d.request("POST", "/api/edit", {"changes": [[["mesh", "rows"], 8]]})[0] == 200
+    finally:
+        d.close()
+
+
+def test_newer_edit_supersedes_a_running_one(designer):
+    designer.request("POST", "/api/edit", {"changes": [[["mesh", "rows"], 7]]})  # worker warm
+    result = {}
+    slow = threading.Thread(target=lambda: result.setdefault(
+        "slow", designer.request("POST", "/api/edit", slow_edit())))
+    slow.start()
+    time.sleep(0.8)
+    t0 = time.monotonic()
+    status, _ = designer.request("POST", "/api/edit", {"changes": [[["mesh", "rows"], 9]]})
+    took = time.monotonic() - t0
+    slow.join(30)
+    assert status == 200
+    assert result["slow"][0] == 409 and result["slow"][1]["superseded"] is True
+    design = designer.session.design
+    assert design["mesh"]["rows"] == 9 and design["rulings"]["count"] == 9
+    print(f"newer edit answered {took:.1f} s after it was sent (worker restarted)")
+    assert took < 10
+
+
+# ---------------------------------------------------------------- command line
+def test_busy_port_exits_2_with_the_message(tmp_path):
+    holder = socket.socket(socket.AF_INET, socket.SOCK_STREAM)
+    try:
+        holder.bind(("127.0.0.1", 8765))
+        port = 8765
+    except OSError:  # taken by someone else: still a busy port, take a free one to hold
+        holder.bind(("127.0.0.1", 0))
+        port = holder.getsockname()[1]
+    holder.listen(1)
+    try:
+        proc = subprocess.run([sys.executable, "-m", "ruledmesh.cli", "design", "--port", str(port),
+                               "--no-browser"], check=False, capture_output=True, text=True,
+                              timeout=60,
+                              cwd=tmp_path)
+    finally:
+        holder.close()
+    assert proc.returncode == 2
+    assert proc.stderr == (f"ruledmesh design: port {port} is in use; choose another with --port "
+                           "or omit it\n")
+    assert proc.stdout == "" and list(tmp_path.iterdir()) == []
+
+
+def test_printed_url_holds_a_fresh_token(tmp_path):
+    design = tmp_path / "small.toml"
+    design.write_text(SMALL)
+    tokens = []
+    for _ in range(2):
+        proc = subprocess.Popen([sys.executable, "-m", "ruledmesh.cli", "design", str(design),
+                                 "--no-browser"], stdout=subprocess.PIPE, stderr=subprocess.PIPE,
+                                text=True)
+        try:
+            line = proc.stdout.readline()
+        finally:
+            proc.terminate()
+            assert proc.wait(timeout=30) == 0
+        assert line.startswith("ruledmesh designer: http://127.0.0.1:") and "/?token=" in line
+        tokens.append(line.split("?token=")[1].split()[0])
+    assert tokens[0] != tokens[1] and min(len(t) for t in tokens) >= 40
+
+
+def test_without_the_web_extra_one_line_names_the_install(tmp_path):
+    # The import system is told the packages are absent (as in an environment without them).
+    code = ("import sys; sys.modules['starlette'] = None; sys.modules['uvicorn'] = None; "
+            "from ruledmesh.cli import main; sys.exit(main(['design', '--no-browser']))")
+    proc = subprocess.run([sys.executable, "-c", code], check=False, capture_output=True,
+                          text=True, timeout=60, cwd=tmp_path)
+    assert proc.returncode == 2 and proc.stdout == ""
+    assert proc.stderr == ('ruledmesh design: needs starlette and uvicorn; '
+                           'pip install "ruledmesh[web]"\n')
+
+
+def test_a_linked_design_file_is_edited_where_it_lives(tmp_path):
+    real = tmp_path / "projects" / "real.toml"
+    real.parent.mkdir()
+    real.write_text(SMALL)
+    link = tmp_path / "link.toml"
+    link.symlink_to(real)
+    s = Session(link.read_text(), link)
+    assert s.path == real and s.base_dir == real.parent
+    s.edit([(["mesh", "rows"], 7)])
+    assert s.save() == real and "rows = 7" in real.read_text() and link.is_symlink()
+    assert s.export(".obj") == real.parent / "real.obj"
