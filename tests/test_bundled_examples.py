@@ -80,8 +80,8 @@ def _help_examples() -> list[list[str]]:
             found = re.search(r"ruledmesh (\S.*?)(\s{2,}|\s+\(|$)", line)
             if found and "<" not in found.group(1):
                 commands.append(found.group(1).split())
-    # The designer serves until stopped; test_designer covers it.
-    return [c for c in commands if c[0] != "design"]
+    # The designer and the Hops server serve until stopped; their own tests cover them.
+    return [c for c in commands if c[0] not in ("design", "hops")]
 
 
 @pytest.fixture(scope="module")
