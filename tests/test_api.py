@@ -121,3 +121,22 @@ def test_python_m_ruledmesh_is_the_cli(tmp_path):
     run = subprocess.run([sys.executable, "-m", "ruledmesh", "build", "nothing.toml", "-o", "x.obj"],
                          check=False, capture_output=True, text=True, cwd=tmp_path, timeout=60)
     assert run.returncode == 2 and "Traceback" not in run.stderr and not (tmp_path / "x.obj").exists()
+
+
+def test_jupyter_view_is_wellformed_html_with_one_path_per_face(skew):
+    import xml.etree.ElementTree as ET
+
+    from ruledmesh.notebook import MAX_DRAWN_FACES
+
+    view = ET.fromstring(skew._repr_html_())  # well-formed: parses as XML
+    svg = view.find("{http://www.w3.org/2000/svg}svg")
+    paths = svg.findall("{http://www.w3.org/2000/svg}path")
+    assert len(paths) == skew.n_faces
+    assert f"{skew.count_kinds()['quad']} quad" in "".join(view.itertext())
+    phi = np.linspace(0, 2, 201)
+    a = np.stack([np.cos(phi) - np.sin(phi), np.sin(phi) + np.cos(phi), -np.ones(201)], 1)
+    b = np.stack([np.cos(phi) + np.sin(phi), np.sin(phi) - np.cos(phi), np.ones(201)], 1)
+    big = ruledmesh.pq_mesh(a, b, rows=250)
+    assert big.n_faces > MAX_DRAWN_FACES
+    assert "<svg" not in big._repr_html_() and "not drawn" in big._repr_html_()
+
