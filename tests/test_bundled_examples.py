@@ -85,13 +85,35 @@ def _help_examples() -> list[list[str]]:
 
 
 @pytest.fixture(scope="module")
-def wheel_install(tmp_path_factory):
+def source_copy(tmp_path_factory):
+    """The files a package build reads, copied (the build writes into its source folder)."""
+    src = tmp_path_factory.mktemp("source")
+    for name in ("pyproject.toml", "README.md", "LICENSE"):
+        shutil.copy(ROOT / name, src / name)
+    shutil.copytree(ROOT / "src", src / "src", ignore=shutil.ignore_patterns("__pycache__", "*.egg-info"))
+    return src
+
+
+def test_sdist_holds_real_example_files(source_copy, tmp_path):
+    import tarfile
+
+    code = ("import sys; from setuptools import build_meta; "
+            "print(build_meta.build_sdist(sys.argv[1]))")
+    run = subprocess.run([sys.executable, "-c", code, str(tmp_path)], check=False,
+                         capture_output=True, text=True, cwd=source_copy, timeout=300)
+    assert run.returncode == 0, run.stderr[-2000:]
+    with tarfile.open(tmp_path / run.stdout.strip().splitlines()[-1]) as tar:
+        members = {Path(m.name).name: m for m in tar.getmembers()
+                   if "/src/ruledmesh/examples/" in m.name}
+    assert set(members) == {p.name for p in bundled.folder().iterdir()}
+    assert all(m.isfile() for m in members.values())
+
+
+@pytest.fixture(scope="module")
+def wheel_install(tmp_path_factory, source_copy):
     """ruledmesh built as a wheel from a copy of the sources and installed into a folder."""
     tmp = tmp_path_factory.mktemp("wheel")
-    src = tmp / "src"
-    for name in ("pyproject.toml", "README.md", "LICENSE"):
-        shutil.copy(ROOT / name, src / name if src.exists() else (src.mkdir() or src / name))
-    shutil.copytree(ROOT / "src", src / "src", ignore=shutil.ignore_patterns("__pycache__", "*.egg-info"))
+    src = source_copy
     run = subprocess.run([sys.executable, "-m", "pip", "wheel", "-q", "--no-deps",
                           "--no-build-isolation", "-w", str(tmp / "dist"), str(src)],
                          check=False, capture_output=True, text=True, timeout=300)
