@@ -85,6 +85,21 @@ def test_fabricate_from_a_design(tmp_path, skew):
     assert (tmp_path / "fab" / "summary.json").is_file()
 
 
+@pytest.mark.parametrize("first", ["import ruledmesh.fabricate.output",
+                                   "from ruledmesh.fabricate.output import fabricate",
+                                   "import ruledmesh.fabricate"])
+def test_fabricate_stays_the_function_after_importing_the_subpackage(first):
+    # Regression: importing ruledmesh.fabricate.output replaced ruledmesh.fabricate (the
+    # function) with the subpackage, and ruledmesh.fabricate(...) raised "module not callable".
+    code = (f"{first}\nimport ruledmesh, ruledmesh.fabricate.unroll\n"
+            "from ruledmesh.fabricate import unroll\n"
+            "assert callable(ruledmesh.fabricate) and ruledmesh.fabricate is ruledmesh.api.fabricate\n"
+            "assert callable(unroll)\n")
+    run = subprocess.run([sys.executable, "-c", code], check=False, capture_output=True,
+                         text=True, timeout=60)
+    assert run.returncode == 0, run.stderr
+
+
 def test_pq_and_hybrid_mesh_at_the_top_level():
     phi = np.linspace(0, 2, 13)
     a = np.stack([np.cos(phi) - np.sin(phi), np.sin(phi) + np.cos(phi), -np.ones(13)], 1)

@@ -310,6 +310,8 @@ def test_ruledmesh_hops_command_serves_and_stops(tmp_path):
                                      {"Content-Type": "application/json", KEY_HEADER: key})
         result = json.load(urllib.request.urlopen(req, timeout=120))
         assert result["errors"] == [] and _decode_mesh(_values(result)["Mesh"][0]).Faces.QuadCount
+        proc.stdout.readline()  # "Ctrl+C to stop"
+        assert proc.stdout.readline().startswith("ruled_pq: ok (")
     finally:
         proc.terminate()
         try:
@@ -332,10 +334,13 @@ def test_component_picture_is_drawn_from_the_metadata(server, tmp_path):
     assert out.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n" and out.stat().st_size > 10_000
 
 
+def _containers(inner):
+    return st.lists(inner, max_size=4) | st.dictionaries(st.text(max_size=8), inner, max_size=4)
+
+
 _JSON = st.recursive(st.none() | st.booleans() | st.integers(-10**12, 10**12)
-                     | st.floats(allow_nan=True) | st.text(max_size=20),
-                     lambda inner: st.lists(inner, max_size=4)
-                     | st.dictionaries(st.text(max_size=8), inner, max_size=4), max_leaves=12)
+                     | st.floats(allow_nan=True) | st.text(max_size=20), _containers,
+                     max_leaves=12)
 
 
 @settings(max_examples=40, deadline=None, suppress_health_check=[HealthCheck.function_scoped_fixture])

@@ -33,6 +33,11 @@ from __future__ import annotations
 import importlib
 from typing import Any
 
+# ``ruledmesh.fabricate`` names both a subpackage and the function from .api. The import system
+# sets a package attribute only when it first loads a submodule, so importing the subpackage
+# here, before the function is bound, keeps a later ``import ruledmesh.fabricate.output`` from
+# replacing the function with the module (it is cheap: no scipy).
+from . import fabricate as _fabricate_package  # noqa: F401
 from ._version import __version__
 from .api import analyze, build, build_full, fabricate, load, save
 from .errors import (

@@ -43,6 +43,7 @@ def run(args) -> int:
     else:
         print(f"API key: {server.key}  (Hops settings > API Key; sent as {KEY_HEADER})", flush=True)
     print("Ctrl+C to stop", flush=True)
+    server.log = lambda line: print(line, flush=True)
     if not server.loopback:
         print(f"warning: serving on {args.host}: reachable from the network", file=sys.stderr)
     try:

@@ -24,6 +24,8 @@ import ipaddress
 import json
 import secrets
 import threading
+import time
+from collections.abc import Callable
 from http.server import BaseHTTPRequestHandler, ThreadingHTTPServer
 from typing import Any
 from urllib.parse import urlsplit
@@ -53,6 +55,7 @@ class HopsServer(ThreadingHTTPServer):
         self.key = key
         self.components = dict(COMPONENTS if components is None else components)
         self.solve_lock = threading.Lock()  # one design at a time: bounded memory
+        self.log: Callable[[str], None] | None = None  # one line per solve, if set
         host, port = str(self.server_address[0]), int(self.server_address[1])
         self.loopback = ipaddress.ip_address(host).is_loopback
         shown = f"[{host}]" if ":" in str(host) else host
@@ -101,7 +104,7 @@ class _Handler(BaseHTTPRequestHandler):
     sys_version = ""
 
     def log_message(self, format: str, *args: Any) -> None:
-        pass  # the command line prints one line per solve instead
+        pass  # the command line prints one line per solve instead (HopsServer.log)
 
     def _send(self, status: int, body: Any) -> None:
         data = json.dumps(body).encode("utf-8")
@@ -181,7 +184,13 @@ class _Handler(BaseHTTPRequestHandler):
         if component is None:
             self._send(404, _errors(f"no component {route or '(no pointer)'}; GET / lists them"))
             return
-        self._send(*self._solve(component, payload))
+        start = time.perf_counter()
+        status, body = self._solve(component, payload)
+        self._send(status, body)
+        if self.server.log is not None:
+            errors = body.get("errors") or []
+            outcome = f"error: {errors[0]}" if errors else "ok"
+            self.server.log(f"{component.name}: {outcome} ({time.perf_counter() - start:.2f} s)")
 
     def _solve(self, component: Component, payload: dict[str, Any]) -> tuple[int, Any]:
         try:
