@@ -163,12 +163,19 @@ def encode_mesh(mesh: Mesh) -> tuple[dict[str, Any], np.ndarray]:
     face_of : (G,) int64
         The ``mesh`` face of each Rhino mesh face.
     """
-    from ..io.rhino import rhino_mesh
-
     r3 = rhino3dm()
     faces, face_of = face_kinds(mesh)
     used, local = np.unique(faces, return_inverse=True)
-    rmesh = rhino_mesh(r3, mesh.vertices[used], local.reshape(-1, 4))
+    rmesh = r3.Mesh()
+    # rhino3dm has no bulk setter: one call per vertex and face, as in the 3DM export.
+    for x, y, z in mesh.vertices[used].tolist():
+        rmesh.Vertices.AddPoint3d(x, y, z)  # double precision (Add() is float32)
+    for a, b, c, d in local.reshape(-1, 4).tolist():
+        if c == d:
+            rmesh.Faces.AddFace(a, b, c)
+        else:
+            rmesh.Faces.AddFace(a, b, c, d)
+    rmesh.Normals.ComputeNormals()
     rmesh.SetUserString("ruledmesh.face_of", ",".join(map(str, face_of.tolist())))
     return rmesh.Encode(), face_of
 

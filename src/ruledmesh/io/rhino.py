@@ -70,21 +70,6 @@ def rhino_faces(mesh: Mesh) -> tuple[np.ndarray, np.ndarray]:
     return faces[order], face_of[order]
 
 
-def rhino_mesh(r3, vertices: np.ndarray, faces: np.ndarray):
-    """A rhino3dm Mesh of ``vertices`` (V, 3) and ``faces`` (G, 4) in :func:`rhino_faces` form."""
-    rmesh = r3.Mesh()
-    # rhino3dm has no bulk setter: one call per vertex and face.
-    for x, y, z in vertices.tolist():
-        rmesh.Vertices.AddPoint3d(x, y, z)  # double precision (Add() is float32)
-    for a, b, c, d in faces.tolist():
-        if c == d:
-            rmesh.Faces.AddFace(a, b, c)
-        else:
-            rmesh.Faces.AddFace(a, b, c, d)
-    rmesh.Normals.ComputeNormals()
-    return rmesh
-
-
 def dumpb(mesh: Mesh) -> bytes:
     """The .3dm bytes of ``mesh``.
 
@@ -109,7 +94,15 @@ def dumpb(mesh: Mesh) -> bytes:
         sel = mesh.face_kind[face_of] == kind
         used, local = np.unique(faces[sel], return_inverse=True)
         local = local.reshape(-1, 4)
-        rmesh = rhino_mesh(r3, mesh.vertices[used], local)
+        rmesh = r3.Mesh()
+        for x, y, z in mesh.vertices[used].tolist():
+            rmesh.Vertices.AddPoint3d(x, y, z)  # double precision (Add() is float32)
+        for a, b, c, d in local.tolist():
+            if c == d:
+                rmesh.Faces.AddFace(a, b, c)
+            else:
+                rmesh.Faces.AddFace(a, b, c, d)
+        rmesh.Normals.ComputeNormals()
         rmesh.SetUserString("ruledmesh.face_of", ",".join(map(str, face_of[sel].tolist())))
         attrs = r3.ObjectAttributes()
         attrs.LayerIndex = index
