@@ -71,8 +71,14 @@ def parse_design(text: str, source: str = "<design>", base_dir: str | os.PathLik
 
 
 def load_design(path: str | os.PathLike) -> Design:
-    """Read and parse the design file at ``path``."""
-    path = Path(path)
+    """Read and parse the design file at ``path``.
+
+    A relative ``examples/NAME.toml`` that does not exist here is the bundled
+    example of that name (:func:`ruledmesh.bundled.resolve`).
+    """
+    from .bundled import resolve
+
+    path = resolve(path)
     try:
         text = path.read_text(encoding="utf-8")
     except FileNotFoundError:

@@ -372,6 +372,12 @@ class Mesh:
                        face_indices=idx[keep], face_kind=self.face_kind[ok_face],
                        members=self.members[mem_ok], member_id=self.member_id[mem_ok])
 
+    def _repr_html_(self) -> str:
+        """The Jupyter view: counts and a small picture (:func:`ruledmesh.notebook.mesh_html`)."""
+        from .notebook import mesh_html
+
+        return mesh_html(self)
+
     def __repr__(self) -> str:
         kinds = ", ".join(f"{k}={c}" for k, c in self.count_kinds().items())
         return f"Mesh(vertices={self.n_vertices}, faces={self.n_faces} [{kinds}], members={len(self.members)})"
