@@ -19,7 +19,8 @@ __all__ = ["MAX_DRAWN_FACES", "mesh_html", "mesh_svg"]
 
 MAX_DRAWN_FACES = 20_000
 _COLOURS = {FaceKind.QUAD: "#c8cdd7", FaceKind.BORDER: "#f0b450", FaceKind.FILL: "#5aa5f0",
-            FaceKind.SPLIT: "#e65050", FaceKind.TRIANGLE: "#73cd73", FaceKind.POLYGON: "#b48cd7"}
+            FaceKind.SPLIT: "#e65050", FaceKind.TRIANGLE: "#73cd73", FaceKind.POLYGON: "#b48cd7",
+            FaceKind.STRIP: "#72b7b2"}
 
 
 def _project(vertices: np.ndarray) -> np.ndarray:

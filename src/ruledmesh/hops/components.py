@@ -64,12 +64,10 @@ def _input_name(exc: DesignError) -> DesignError:
 
 
 def _quad_share(mesh) -> float:
-    from ..analysis.faces import face_normals
-    from ..mesh import FaceKind
+    """Share of the area in faces with four corners (whatever their kind)."""
+    from ..analysis.faces import area_shares
 
-    _, areas = face_normals(mesh)
-    total = float(areas.sum())
-    return float(areas[mesh.face_kind == FaceKind.QUAD].sum() / total) if total > 0 else 0.0
+    return area_shares(mesh)["quads"] if mesh.n_faces else 0.0
 
 
 def solve_design(design: Mapping[str, Any], notes: list[str], tolerance: float | None = None

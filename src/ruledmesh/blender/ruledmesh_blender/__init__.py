@@ -40,9 +40,9 @@ bl_info = {
 
 # Metres per design unit.
 UNIT_METRES = {"m": 1.0, "cm": 0.01, "mm": 0.001, "in": 0.0254, "ft": 0.3048}
-KIND_NAMES = ("quad", "border", "fill", "split", "triangle", "polygon")
+KIND_NAMES = ("quad", "border", "fill", "split", "triangle", "polygon", "strip")
 KIND_COLOURS = ((0.78, 0.80, 0.84), (0.94, 0.71, 0.31), (0.35, 0.65, 0.94),
-                (0.90, 0.31, 0.31), (0.45, 0.80, 0.45), (0.71, 0.55, 0.84))
+                (0.90, 0.31, 0.31), (0.45, 0.80, 0.45), (0.71, 0.55, 0.84), (0.45, 0.72, 0.70))
 _UNIT_ITEMS = [("AUTO", "From the design", "the design's units key (metres when not stated)")] + [
     (u.upper(), u, f"coordinates in {u}") for u in UNIT_METRES]
 
