@@ -35,11 +35,12 @@ def _join(parts: list[Run]):
     POLE = np.concatenate([r.pole for r in parts])
     CG = np.concatenate([r.centre_gen for r in parts])
     order = np.lexsort((T, G))
-    same = (G[order][1:] == G[order][:-1]) & (T[order][1:] == T[order][:-1]) \
+    same = (G[order][1:] == G[order][:-1]) & (np.abs(T[order][1:] - T[order][:-1]) <= ON_BORDER) \
         & ~FAR[order][1:] & ~FAR[order][:-1]
     if same.any():
-        # Runs that meet on a generator share its division exactly (matched), so
-        # equal parameters mean the same point: keep the first of each group.
+        # Runs that meet on a generator share its division (matched, or both
+        # reaching a director curve), so parameters equal to rounding mean the
+        # same point: keep the first of each group.
         first = np.maximum.accumulate(np.where(np.r_[True, ~same], np.arange(len(order)), 0))
         remap = np.arange(len(V))
         remap[order] = order[first]

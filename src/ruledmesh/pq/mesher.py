@@ -126,7 +126,9 @@ def _build_segment(plan: _Plan, lo: int, hi: int, primary: int, div: Division,
         outward = 1 if shared == lo else -1
         dist = (bad - primary) * outward
         dist = dist[dist > 0]
-        reach = int(dist.min()) if dist.size else m
+        if dist.size == 0:
+            return [run]
+        reach = int(dist.min())
         if reach < 3:
             return _even(plan, lo + 1, hi, div.rows) if shared == lo else _even(plan, lo, hi - 1, div.rows)
         k = primary + outward * reach
@@ -382,7 +384,7 @@ def _build_all(plan: _Plan, segs: list[_Segment], p: int, middle: bool, div: Div
     budget = [max(4, m // 4)]
     built: dict[int, list[Run]] = {}
     s = segs[home]
-    pr = (p - s.lo) if not middle else (s.hi - s.lo) // 2
+    pr = (p - s.lo) if not middle else _well_twisted(plan, s.lo, s.hi)
     built[home] = _build_segment(plan, s.lo, s.hi, pr, div, budget)
     for step in (1, -1):
         k = home + step
@@ -399,7 +401,8 @@ def _build_all(plan: _Plan, segs: list[_Segment], p: int, middle: bool, div: Div
                 # Rows started on a torsal generator (K = 0 there) bunch and fan out:
                 # each segment takes its own division from its middle; the two meet
                 # on the torsal generator in a zipper.
-                built[k] = _build_segment(plan, s.lo, s.hi, (s.hi - s.lo) // 2, div, budget)
+                built[k] = _build_segment(plan, s.lo, s.hi, _well_twisted(plan, s.lo, s.hi), div,
+                                          budget)
             else:
                 t = _boundary_t(built[k - step], src)
                 sub = Division(div.rows, div.option, "auto", div.max_extend, t if t.size else None)
@@ -407,6 +410,29 @@ def _build_all(plan: _Plan, segs: list[_Segment], p: int, middle: bool, div: Div
                                           shared=src if crease else None)
             k += step
     return [r for k in sorted(built) for r in built[k]]
+
+
+def _well_twisted(plan: _Plan, lo: int, hi: int) -> int:
+    """Run-local primary for "middle": near the middle, away from nearly torsal generators.
+
+    The hop is ill-conditioned where consecutive generators are nearly
+    coplanar (K near 0): rows started there bunch.  The primary is the
+    generator whose smaller neighbouring twist volume, weighted towards the
+    middle of the run, is largest.  Affine maps scale every volume by the same
+    factor, so the choice commutes with them.
+    """
+    m = hi - lo + 1
+    if m < 3:
+        return m // 2
+    a, d = plan.a[lo:hi + 1], plan.d[lo:hi + 1]
+    vol = np.abs(np.einsum("ij,ij->i", np.cross(d[:-1], d[1:]), a[1:] - a[:-1]))
+    inner = np.arange(1, m - 1)
+    worst = np.minimum(vol[inner - 1], vol[inner])
+    centre = 1.0 - np.abs(inner - (m - 1) / 2) / m
+    score = worst * centre
+    # Ties within rounding go to the middle, so the choice does not flip with scale.
+    best = score >= score.max() * (1.0 - 1e-9)
+    return int(inner[best][np.argmin(np.abs(inner[best] - (m - 1) / 2))])
 
 
 def _boundary_t(runs: list[Run], g: int) -> np.ndarray:

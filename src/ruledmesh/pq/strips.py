@@ -19,10 +19,9 @@ __all__ = ["ON_BORDER", "Gaps", "chains", "group_starts", "strip_paths", "zipper
 
 # Parameters this close to 0 or 1 are on the patch border (rounding of t).
 ON_BORDER = 1e-12
-# A vertex nearer the director curve than this share of the strip width (and
-# this share of the diagonal) is taken as the border point of its generator.
-SNAP_WIDTH = 0.06
-SNAP_GAP = 5e-4
+# A vertex nearer a director curve than this share of the step to the next
+# vertex on its generator is taken as the border point of its generator.
+SNAP_STEP = 0.06
 
 
 def group_starts(keys: np.ndarray) -> np.ndarray:
@@ -30,16 +29,21 @@ def group_starts(keys: np.ndarray) -> np.ndarray:
     return np.r_[True, keys[1:] != keys[:-1]] if keys.size else np.zeros(0, bool)
 
 
-def _snap(rail: np.ndarray, scale: float) -> np.ndarray:
-    """(m,) distance along each generator within which a vertex stands in for the director point.
-
-    A fraction of the strip width next to it (below it the tooth between two
-    director points and the vertex would be a splinter), capped by what the
-    border may move (``SNAP_GAP`` of the diagonal).
-    """
-    step = np.linalg.norm(np.diff(rail, axis=0), axis=1)
-    w = np.minimum(np.r_[step, np.inf], np.r_[np.inf, step]) if len(step) else np.zeros(len(rail))
-    return np.minimum(SNAP_WIDTH * w, SNAP_GAP * scale)
+def _near_border(gi: np.ndarray, ti: np.ndarray, m: int, upper: bool) -> np.ndarray:
+    """(m,) bool: the generator's vertex nearest a director curve is within ``SNAP_STEP`` of
+    the step to the next vertex along the generator."""
+    t = 1.0 - ti if upper else ti
+    order = np.lexsort((t, gi))
+    g, t = gi[order], t[order]
+    first = group_starts(g)
+    out = np.zeros(m, bool)
+    idx = np.flatnonzero(first)
+    nxt = idx + 1
+    ok = (nxt < len(g)) & (g[np.minimum(nxt, len(g) - 1)] == g[idx])
+    idx, nxt = idx[ok], nxt[ok]
+    near = t[idx] < SNAP_STEP * (t[nxt] - t[idx])
+    out[g[idx][near]] = True
+    return out
 
 
 def chains(V, T, G, good_v, a, d, m, scale):
@@ -60,15 +64,12 @@ def chains(V, T, G, good_v, a, d, m, scale):
     has1 = np.zeros(m, bool)
     has0[gi[ti <= eps]] = True
     has1[gi[ti >= 1 - eps]] = True
-    # A vertex this close to the director curve is the border point of its
-    # generator itself: a director point beside it would leave a splinter.
-    glen = np.linalg.norm(d, axis=1)
-    lo_t = np.full(m, np.inf)
-    hi_t = np.full(m, -np.inf)
-    np.minimum.at(lo_t, gi, ti)
-    np.maximum.at(hi_t, gi, ti)
-    has0 |= lo_t * glen < _snap(a, scale)
-    has1 |= (1.0 - hi_t) * glen < _snap(a + d, scale)
+    # A vertex this close to the director curve, against the step to the next
+    # vertex on its generator, is the border point of its generator itself: a
+    # director point beside it would leave a splinter.  (Parameters along a
+    # generator: the decision commutes with affine maps.)
+    has0 |= _near_border(gi, ti, m, upper=False)
+    has1 |= _near_border(gi, ti, m, upper=True)
     new0, new1 = np.flatnonzero(~has0), np.flatnonzero(~has1)
     base = len(V)
     V = np.concatenate([V, a[new0], a[new1] + d[new1]])

@@ -1,0 +1,195 @@
+"""Buildability of §4.3 meshes: area in quads, splinters, strip quads, tolerance mode.
+
+The exact invariants (planarity, convexity, vertices on generators, a disc) must hold on every
+surface; the quality figures are held to what the mesher reaches on each regression surface, so
+that a change that brings back triangles or splinters fails here.  The goals the mesher does not
+reach yet are listed in docs/mesh-quality.md.
+"""
+
+from pathlib import Path
+
+import numpy as np
+import pytest
+from hypothesis import HealthCheck, given, settings, strategies as st
+
+from ruledmesh.analysis.faces import (area_shares, convexity, degenerate_faces, face_min_angles,
+                                      planarity)
+from ruledmesh.design import build_design, parse_design
+from ruledmesh.mesh import FaceKind
+from ruledmesh.pq import pq_mesh
+
+EXAMPLES = Path(__file__).resolve().parents[1] / "examples"
+
+
+def _design(c1, c2, count, rows, extra=""):
+    return (f'[curves.c1]\ntype = "bspline"\ndegree = 3\npoints = {np.round(c1, 6).tolist()}\n'
+            f'[curves.c2]\ntype = "bspline"\ndegree = 3\npoints = {np.round(c2, 6).tolist()}\n'
+            f'[rulings]\nbetween = ["c1", "c2"]\ncount = {count}\n'
+            f"[mesh]\nrows = {rows}\n{extra}")
+
+
+def _segment_distance(p, a, b):
+    d = b - a
+    s = np.clip(np.einsum("pgi,gi->pg", p[:, None, :] - a[None], d) / np.einsum("gi,gi->g", d, d),
+                0.0, 1.0)
+    return np.linalg.norm(p[:, None, :] - (a[None] + s[..., None] * d[None]), axis=2)
+
+
+def check_exact(built, ptol=1e-12):
+    mesh = built.mesh
+    assert np.all(np.isfinite(mesh.vertices))
+    assert planarity(mesh).max() <= ptol
+    assert convexity(mesh).all()
+    assert not degenerate_faces(mesh).any()
+    assert mesh.euler_characteristic() == 1
+    r = built.rulings
+    on = _segment_distance(mesh.vertices, np.asarray(r.a), np.asarray(r.b)).min(axis=1)
+    assert on.max() <= 1e-9 * mesh.diagonal()
+    patch = built.reference.area()
+    assert abs(float(np.sum(_areas(mesh))) / patch - 1.0) < 0.02
+
+
+def _areas(mesh):
+    from ruledmesh.analysis.faces import face_areas
+
+    return face_areas(mesh)
+
+
+curves = st.lists(st.floats(-2.0, 2.0), min_size=10, max_size=10)
+
+
+@settings(max_examples=20, deadline=None, suppress_health_check=[HealthCheck.too_slow])
+@given(y1=curves, y2=curves, count=st.integers(40, 60), rows=st.integers(10, 30))
+def test_random_director_curves_exact_and_mostly_quads(y1, y2, count, rows):
+    """Two random cubic B-splines at designer sizes: exact, a disc on the generators, covering
+    the patch, and most of the area in quads, or a warning that says how much is not and why
+    (two nearly equal curves make a nearly developable surface)."""
+    x = np.linspace(0.0, 10.0, 5)
+    c1 = np.c_[x, y1[:5], 0.5 * np.asarray(y1[5:])]
+    c2 = np.c_[x, y2[:5], 4.0 + 0.5 * np.asarray(y2[5:])]
+    built = build_design(parse_design(_design(c1, c2, count, rows)))
+    check_exact(built)
+    share = area_shares(built.mesh)["quads"]
+    said = [w for w in built.mesh.info["warnings"] if "of the area is not in quads" in w]
+    assert share >= 0.7 or said
+    if share < 0.7:
+        assert f"{1 - share:.0%}" in said[0]
+
+
+@settings(max_examples=10, deadline=None, suppress_health_check=[HealthCheck.too_slow])
+@given(lift=st.floats(1e-7, 1e-3), count=st.integers(20, 50), rows=st.integers(6, 24))
+def test_tolerance_mode_respects_the_tolerance_on_a_nearly_developable_surface(lift, count, rows):
+    """A cylinder with one control point lifted: every face within 1e-3, nearly all quads."""
+    c1 = np.array([[0, 0, 0], [3, 2, 0], [6, -1, 0], [10, 0, 0]], float)
+    c2 = c1 + [0, 0, 4]
+    c2[1, 1] += lift
+    text = _design(c1, c2, count, rows, "planarity_tolerance = 1e-3\n")
+    built = build_design(parse_design(text))
+    mesh = built.mesh
+    assert planarity(mesh).max() <= 1e-3
+    assert convexity(mesh).all() and mesh.euler_characteristic() == 1
+    assert area_shares(mesh)["quads"] >= 0.9
+
+
+def test_exact_mode_says_where_a_nearly_developable_surface_has_no_quads():
+    c1 = np.array([[0, 0, 0], [3, 2, 0], [6, -1, 0], [10, 0, 0]], float)
+    c2 = c1 + [0, 0, 4]
+    c2[1, 1] += 1e-3
+    built = build_design(parse_design(_design(c1, c2, 41, 20)))
+    check_exact(built)
+    warnings = " ".join(built.mesh.info["warnings"])
+    assert "of the area is not in quads" in warnings and "planarity_tolerance" in warnings
+
+
+def test_coplanar_generators_carry_exact_strip_quads():
+    """A general cylinder (a curve and its translate): every strip is coplanar, all strip quads."""
+    t = np.linspace(0, 1, 25)
+    a = np.c_[10 * t, 2 * np.sin(3 * t), np.zeros_like(t)]
+    mesh = pq_mesh(a, a + [0.3, 0.2, 5.0], rows=12)
+    assert set(mesh.count_kinds()) == {"strip"}
+    assert planarity(mesh).max() <= 1e-12 and convexity(mesh).all()
+
+
+# ---------------------------------------------------------------- regressions
+# (file, at most this share of the area outside quads, at least this smallest face angle)
+REGRESSIONS = [
+    ("skew.toml", 0.08, 2.0),                    # was 19 %, 0.19 deg (two crease bands)
+    ("fig10-skew-surface.toml", 0.11, 0.02),     # was 20 %, 0.03 deg
+    ("right-conoid-arc.toml", 0.21, 0.005),      # was 30 %
+    ("conoidal-director-plane.toml", 0.18, 0.03),  # was 33 %
+    ("three-directrices.toml", 0.14, None),      # was 20 %
+    ("parameter-distribution.toml", 0.13, 0.1),  # was 18 %
+]
+
+
+@pytest.mark.parametrize("name,share,angle", REGRESSIONS)
+def test_example_quality_does_not_regress(name, share, angle):
+    from ruledmesh.design import build_file
+
+    built = build_file(EXAMPLES / name)
+    check_exact(built)
+    mesh = built.mesh
+    assert 1.0 - area_shares(mesh)["quads"] <= share
+    if angle is not None:
+        assert face_min_angles(mesh).min() >= angle
+
+
+def test_two_bspline_director_curves_51_by_30():
+    """The issue's first surface: 55 % of the area was in triangles; generators are added
+    where the rows need them and the share falls under a quarter."""
+    c1 = [[0.0, 1.34, -1.68], [2.5, -1.44, -0.62], [5.0, 1.66, -0.92], [7.5, -2.19, 0.96],
+          [10.0, 1.63, -1.61]]
+    c2 = [[0.0, -0.52, 4.67], [2.5, -2.47, 3.40], [5.0, -1.19, 5.13], [7.5, -0.39, 4.77],
+          [10.0, -1.97, 3.66]]
+    text = (f'[curves.c1]\ntype = "bspline"\ndegree = 3\npoints = {c1}\n'
+            f'[curves.c2]\ntype = "bspline"\ndegree = 4\npoints = {c2}\n'
+            '[rulings]\nbetween = ["c1", "c2"]\ncount = 51\n[mesh]\nrows = 30\n')
+    built = build_design(parse_design(text))
+    check_exact(built)
+    assert 1.0 - area_shares(built.mesh)["quads"] <= 0.22
+    assert built.rulings.info["inserted"] > 0
+    assert any("generators of the smooth surface added" in w for w in built.mesh.info["warnings"])
+    given = build_design(parse_design(text.replace("rows = 30", "rows = 30\nrefine = false")))
+    assert len(given.rulings.a) == 51
+    assert area_shares(given.mesh)["quads"] < area_shares(built.mesh)["quads"]
+
+
+def test_border_quads_end_at_the_director_points():
+    from ruledmesh.design import build_file
+
+    mesh = build_file(EXAMPLES / "skew.toml").mesh
+    t = mesh.vertex_data["t"]
+    border = np.flatnonzero((mesh.face_kind == FaceKind.BORDER) & (mesh.valences == 4))
+    assert border.size
+    corners = mesh.face_indices[mesh.face_offsets[border][:, None] + np.arange(4)]
+    on_curve = (t[corners] <= 1e-12) | (t[corners] >= 1 - 1e-12)
+    assert np.all(on_curve.any(axis=1))
+
+
+def test_analysis_reports_area_shares_and_splinters():
+    from ruledmesh.analysis.report import analyze
+    from ruledmesh.design import build_file
+
+    mesh = build_file(EXAMPLES / "skew.toml").mesh
+    q = analyze(mesh)["quality"]
+    shares = q["area_share"]
+    assert abs(sum(shares["by_kind"].values()) - 1.0) < 1e-12
+    assert abs(shares["quads"] + shares["triangles"] + shares["polygons"] - 1.0) < 1e-12
+    assert q["faces_below_3deg"] == int(np.count_nonzero(face_min_angles(mesh) < 3))
+    assert q["degenerate_faces"] == 0
+
+
+def test_pluecker_conoid_closeness_finds_the_right_sheet():
+    """The nearest-point search used to stop on the other sheet of a self-intersecting surface
+    (1.9e-3 reported where the vertices lie on the surface to 1e-16)."""
+    from ruledmesh.analysis.report import analyze
+
+    theta = np.radians(np.linspace(0, 180, 25))
+    pts = np.c_[3 * np.cos(theta), 3 * np.sin(theta), 1.5 * np.sin(2 * theta)]
+    text = ('[curves.rim]\ntype = "bspline"\ninterpolate = true\n'
+            f"points = {np.round(pts, 9).tolist()}\n"
+            '[rulings]\nconoid = { curve = "rim", directrix = [[0, 0, -2], [0, 0, 2]], '
+            "director_plane = [0, 0, 1] }\ncount = 61\n[mesh]\nrows = 20\n")
+    built = build_design(parse_design(text))
+    report = analyze(built.mesh, built.reference)
+    assert report["closeness"]["vertices_max"] <= 1e-10
