@@ -1,0 +1,772 @@
+"""Mesh quality of ruledmesh builds, measured from the OBJ files the CLI writes.
+
+Usage::
+
+    python benchmarks/quality.py                    # every surface of benchmarks/quality/
+    python benchmarks/quality.py --large            # ... and the 300 x 300 ones
+    python benchmarks/quality.py my.toml --json q.json
+    python benchmarks/quality.py --only corner --keep out/
+
+Each design is built with ``python -m ruledmesh.cli build DESIGN -o X.obj`` in a
+subprocess; the OBJ is read back with the reader below and measured with the
+code below, independently of ``ruledmesh.analysis``.  Only the *input* comes
+from ruledmesh: the design's generators and a dense sampling of its smooth
+ruled surface (``ruledmesh.design`` / ``ruledmesh.rulings``), which are what
+the mesh is measured against.
+
+Figures per surface (lengths relative to the diagonal of the smooth patch's
+bounding box):
+
+* faces by size (3, 4, 5+), area share of triangles and of non-quads;
+* smallest corner angle over all faces (degrees), faces with an angle < 3 deg;
+* planarity of quads: distance between the two diagonal lines divided by the
+  mean diagonal length (the paper's measure); of 5+-gons: largest distance to
+  the least-squares plane divided by the polygon's diameter;
+* bow-ties: quads whose diagonals do not cross strictly inside both, and
+  non-convex 5+-gons;
+* degenerate faces: area <= 1e-9 x (longest edge)^2;
+* distance of the vertices to the nearest *design* generator line, and to the
+  nearest generator of the smooth surface (which admits generators the mesher
+  inserted); the overshoot of vertices beyond the patch ``0 <= t <= 1``;
+* for quadric line sets, the distance of the vertices to the quadric;
+* coverage: mesh area / area of the smooth patch (a dense bilinear
+  tessellation from a much finer generator sampling);
+* gap: the largest distance from a point of the smooth patch to the mesh
+  (exact point-triangle distances), with the surface parameters (u, t) of the
+  worst point.
+
+A design may carry a ``# quality: ...`` comment line with flags: ``general``
+(a general skew surface: the issue's triangle-share bound applies),
+``near-developable``, ``large`` (only with ``--large``), ``quadric``.
+``[mesh] planarity_tolerance`` marks a tolerance-mode design.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import os
+import subprocess
+import sys
+import tempfile
+import time
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+import tomllib
+from scipy.spatial import cKDTree
+
+ROOT = Path(__file__).resolve().parents[1]
+SURFACES = Path(__file__).resolve().parent / "quality"
+EXTRA = (ROOT / "examples" / "skew.toml", ROOT / "examples" / "fig10-skew-surface.toml")
+
+SPLINTER_DEG = 3.0          # a face with a smaller corner angle is a splinter
+DEGENERATE = 1e-9           # area <= DEGENERATE * longest_edge**2 (as ruledmesh fabricate)
+CROSS_MARGIN = 1e-9         # diagonals must cross inside (margin, 1 - margin) of both
+REF_GENERATORS = 1601       # generators of the dense reference sampling
+REF_ROWS = 96               # divisions of each reference generator
+GAP_U = 400                 # reference generators used as gap sample lines
+EXIT_DESIGN_ERROR = 2
+
+
+# --------------------------------------------------------------------------
+# surfaces
+# --------------------------------------------------------------------------
+
+@dataclass(frozen=True)
+class Surface:
+    """A design file to measure.
+
+    Attributes
+    ----------
+    name : str
+        File stem.
+    path : Path
+    description : str
+        The file's first comment line.
+    flags : frozenset of str
+        From the ``# quality:`` line (``general``, ``near-developable``,
+        ``large``, ``quadric``); ``tolerance`` is added for designs with
+        ``[mesh] planarity_tolerance``.
+    tolerance : float or None
+        ``[mesh] planarity_tolerance`` of the design, if any.
+    """
+
+    name: str
+    path: Path
+    description: str = ""
+    flags: frozenset = field(default_factory=frozenset)
+    tolerance: float | None = None
+
+
+def read_surface(path: str | os.PathLike) -> Surface:
+    """The :class:`Surface` of a design file (description, flags, tolerance)."""
+    path = Path(path)
+    text = path.read_text(encoding="utf-8")
+    lines = text.splitlines()
+    description = lines[0].lstrip("# ").strip() if lines and lines[0].startswith("#") else ""
+    flags: set[str] = set()
+    for line in lines:
+        if line.startswith("# quality:"):
+            flags.update(line.split(":", 1)[1].split())
+    try:
+        mesh = tomllib.loads(text).get("mesh", {})
+    except tomllib.TOMLDecodeError:
+        mesh = {}
+    tol = mesh.get("planarity_tolerance") if isinstance(mesh, dict) else None
+    if isinstance(tol, (int, float)) and not isinstance(tol, bool):
+        flags.add("tolerance")
+        tol = float(tol)
+    else:
+        tol = None
+    return Surface(path.stem, path, description, frozenset(flags), tol)
+
+
+def default_surfaces(large: bool = False) -> list[Surface]:
+    """The designs of ``benchmarks/quality/`` and the two bundled skew examples."""
+    out = [read_surface(p) for p in sorted(SURFACES.glob("*.toml"))]
+    out += [read_surface(p) for p in EXTRA]
+    out = [s if s.path.parent == SURFACES else _as_general(s) for s in out]
+    return [s for s in out if large or "large" not in s.flags]
+
+
+def _as_general(s: Surface) -> Surface:
+    return Surface(s.name, s.path, s.description, s.flags | {"general"}, s.tolerance)
+
+
+# --------------------------------------------------------------------------
+# building and reading
+# --------------------------------------------------------------------------
+
+@dataclass
+class BuildResult:
+    """Outcome of one ``ruledmesh build``: exit code, wall time, messages."""
+
+    returncode: int
+    seconds: float
+    stdout: str
+    stderr: str
+    obj: Path
+
+
+def build(design: Path, obj: Path, timeout: float = 900.0) -> BuildResult:
+    """Run ``python -m ruledmesh.cli build design -o obj`` and time it."""
+    env = dict(os.environ)
+    src = str(ROOT / "src")
+    env["PYTHONPATH"] = src + (os.pathsep + env["PYTHONPATH"] if env.get("PYTHONPATH") else "")
+    t0 = time.perf_counter()
+    proc = subprocess.run([sys.executable, "-m", "ruledmesh.cli", "build", str(design), "-o",
+                           str(obj)], capture_output=True, text=True, timeout=timeout, env=env,
+                          check=False)
+    return BuildResult(proc.returncode, time.perf_counter() - t0, proc.stdout, proc.stderr, obj)
+
+
+@dataclass
+class ObjMesh:
+    """A polygon mesh read from OBJ.
+
+    Attributes
+    ----------
+    vertices : (n, 3) float64
+    faces : dict int -> (f_k, k) int64
+        Faces grouped by size, 0-based vertex indices in boundary order.
+    groups : dict int -> (f_k,) object
+        The ``g`` group name each face was written under (``""`` for none).
+    """
+
+    vertices: np.ndarray
+    faces: dict[int, np.ndarray]
+    groups: dict[int, np.ndarray]
+
+
+def read_obj(path: str | os.PathLike) -> ObjMesh:
+    """Read ``v``, ``f`` and ``g`` statements of an OBJ file (``v/vt/vn`` forms, negative indices)."""
+    text = Path(path).read_text(encoding="utf-8")
+    vlines: list[str] = []
+    flines: list[list[str]] = []
+    fgroup: list[str] = []
+    group = ""
+    for line in text.splitlines():
+        tag = line[:2]
+        if tag == "v ":
+            vlines.append(line[2:])
+        elif tag == "f ":
+            flines.append(line[2:].split())
+            fgroup.append(group)
+        elif tag == "g ":
+            group = line[2:].strip()
+    verts = np.array(" ".join(vlines).split(), dtype=np.float64).reshape(-1, 3)
+    faces: dict[int, np.ndarray] = {}
+    groups: dict[int, np.ndarray] = {}
+    sizes = np.array([len(f) for f in flines], dtype=np.int64)
+    garr = np.array(fgroup, dtype=object)
+    for k in np.unique(sizes):
+        sel = np.flatnonzero(sizes == k)
+        toks = [t.split("/", 1)[0] for i in sel for t in flines[i]]
+        idx = np.array(toks, dtype=np.int64).reshape(-1, int(k))
+        faces[int(k)] = np.where(idx > 0, idx - 1, len(verts) + idx)
+        groups[int(k)] = garr[sel]
+    return ObjMesh(verts, faces, groups)
+
+
+# --------------------------------------------------------------------------
+# per-face measures (vectorised per face size)
+# --------------------------------------------------------------------------
+
+def _norm(x: np.ndarray) -> np.ndarray:
+    return np.sqrt(np.einsum("...i,...i->...", x, x))
+
+
+@dataclass
+class FaceMeasures:
+    """Measures of the faces of one size ``k``.
+
+    Attributes
+    ----------
+    area : (f,) float64
+        Norm of the vector area (exact for planar faces).
+    min_angle : (f,) float64
+        Smallest corner angle of each face, degrees (reflex corners count as
+        ``360 - angle``).
+    planarity : (f,) float64
+        Quads: distance between the diagonal lines / mean diagonal length;
+        triangles: 0; 5+-gons: largest distance to the least-squares plane /
+        diameter.
+    convex : (f,) bool
+        Quads: the diagonals cross strictly inside both; 5+-gons: every corner
+        turns the same way about the face normal; triangles: not degenerate.
+    degenerate : (f,) bool
+        ``area <= DEGENERATE * longest_edge ** 2``.
+    """
+
+    area: np.ndarray
+    min_angle: np.ndarray
+    planarity: np.ndarray
+    convex: np.ndarray
+    degenerate: np.ndarray
+
+
+def quad_diagonals(q: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Closest points of the diagonal lines 0-2 and 1-3 of quads.
+
+    Parameters
+    ----------
+    q : (f, 4, 3) float64
+        Corners, preferably in coordinates local to each face.
+
+    Returns
+    -------
+    s, t : (f,) float64
+        Parameters of the closest points on 0->2 and on 1->3 (``nan`` for
+        parallel diagonals).
+    planarity : (f,) float64
+        Distance between the diagonal lines / mean diagonal length.
+    """
+    d1 = q[:, 2] - q[:, 0]
+    d2 = q[:, 3] - q[:, 1]
+    w = q[:, 0] - q[:, 1]
+    n = np.cross(d1, d2)
+    nn = _norm(n)
+    l1, l2 = _norm(d1), _norm(d2)
+    par = nn <= 1e-14 * l1 * l2
+    with np.errstate(invalid="ignore", divide="ignore"):
+        gap = np.where(par, _norm(np.cross(w, d1)) / np.where(l1 > 0, l1, 1.0),
+                       np.abs(np.einsum("ij,ij->i", w, n)) / np.where(par, 1.0, nn))
+        # Closest points: p0 + s d1 = p1 + t d2 (least squares).
+        a, b, c = l1 * l1, np.einsum("ij,ij->i", d1, d2), l2 * l2
+        d, e = np.einsum("ij,ij->i", d1, w), np.einsum("ij,ij->i", d2, w)
+        den = np.where(par, np.nan, a * c - b * b)
+        s = (b * e - c * d) / den
+        t = (a * e - b * d) / den
+        plan = gap / np.maximum(0.5 * (l1 + l2), 1e-300)
+    return s, t, plan
+
+
+def face_measures(poly: np.ndarray) -> FaceMeasures:
+    """:class:`FaceMeasures` of polygons of one size.
+
+    Parameters
+    ----------
+    poly : (f, k, 3) float64
+        Corners in boundary order.
+    """
+    f, k = poly.shape[:2]
+    q = poly - poly.mean(axis=1, keepdims=True)       # local coordinates: no cancellation far out
+    nxt, prv = np.roll(q, -1, axis=1), np.roll(q, 1, axis=1)
+    vec = 0.5 * np.cross(q, nxt).sum(axis=1)
+    area = _norm(vec)
+    normal = vec / np.maximum(area, 1e-300)[:, None]
+    e_out, e_in = nxt - q, prv - q
+    cr = np.cross(e_out, e_in)
+    ang = np.degrees(np.arctan2(_norm(cr), np.einsum("fki,fki->fk", e_out, e_in)))
+    turn = np.einsum("fki,fi->fk", cr, normal)
+    # A corner turning against the face normal is reflex.
+    ang = np.where(turn < 0, 360.0 - ang, ang)
+    edge = _norm(e_out)
+    degenerate = area <= DEGENERATE * edge.max(axis=1) ** 2
+    if k == 3:
+        planarity = np.zeros(f)
+        convex = ~degenerate
+    elif k == 4:
+        s, t, planarity = quad_diagonals(q)
+        m = CROSS_MARGIN
+        with np.errstate(invalid="ignore"):
+            convex = (s > m) & (s < 1 - m) & (t > m) & (t < 1 - m)
+    else:
+        _, _, vt = np.linalg.svd(q)
+        dist = np.abs(np.einsum("fki,fi->fk", q, vt[:, 2]))
+        diam = _norm(q[:, :, None, :] - q[:, None, :, :]).max(axis=(1, 2))
+        planarity = dist.max(axis=1) / np.maximum(diam, 1e-300)
+        convex = np.all(turn > 0, axis=1) & ~degenerate
+    return FaceMeasures(area, ang.min(axis=1), planarity, convex, degenerate)
+
+
+# --------------------------------------------------------------------------
+# the input: generators and the smooth patch (from ruledmesh, the input side)
+# --------------------------------------------------------------------------
+
+@dataclass
+class Reference:
+    """What a mesh of a ruled design is measured against.
+
+    Attributes
+    ----------
+    a, b : (m, 3) float64
+        The design's generators (t = 0 and t = 1 ends).
+    grid : (N, T + 1, 3) float64
+        Dense sampling of the smooth patch: ``N`` generators, ``T + 1``
+        points from t = 0 to t = 1 on each.
+    grid_u : (N,) float64
+        Surface parameter of each dense generator.
+    surface : object or None
+        ``ruledmesh.rulings.RuledSurface`` (``a(u)``, ``b(u)``, rails with
+        ``deriv``) for the nearest-generator search; None for explicit lines.
+    from_lines : bool
+        The generators were given as lines (the design's own set is exact).
+    """
+
+    a: np.ndarray
+    b: np.ndarray
+    grid: np.ndarray
+    grid_u: np.ndarray
+    surface: Any
+    from_lines: bool
+
+    @property
+    def diagonal(self) -> float:
+        """Diagonal of the bounding box of the smooth patch."""
+        pts = self.grid.reshape(-1, 3)
+        return float(_norm(pts.max(axis=0) - pts.min(axis=0)))
+
+    def area(self) -> float:
+        """Area of the dense bilinear tessellation (two triangles per cell)."""
+        g = self.grid - self.grid.reshape(-1, 3).mean(axis=0)
+        p00, p10, p01, p11 = g[:-1, :-1], g[1:, :-1], g[:-1, 1:], g[1:, 1:]
+        return float(0.5 * (_norm(np.cross(p10 - p00, p11 - p00)).sum()
+                            + _norm(np.cross(p11 - p00, p01 - p00)).sum()))
+
+
+def reference_of(design: Path, n_ref: int = REF_GENERATORS, rows: int = REF_ROWS) -> Reference | None:
+    """The generators and dense smooth patch of a ruled design; None for catalogue designs.
+
+    The dense patch re-samples the design's rulings with ``n_ref`` generators
+    (``between`` two curves and ``conoid``); for three directrices and explicit
+    lines it evaluates the rulings' smooth surface at ``n_ref`` parameters.
+    Designs with ``[[transform]]`` tables are not supported (None).
+    """
+    from ruledmesh.curves import curve_from_spec
+    from ruledmesh.design import load_design
+    from ruledmesh.rulings import rulings_from_spec
+
+    d = load_design(design)
+    data = d.data
+    if "rulings" not in data or data.get("transform"):
+        return None
+    curves = {name: curve_from_spec(spec, f"curves.{name}")
+              for name, spec in data.get("curves", {}).items()}
+    spec = dict(data["rulings"])
+    rulings = rulings_from_spec(spec, curves, base_dir=d.base_dir)
+    lines = "lines" in spec or "file" in spec
+    resample = "conoid" in spec or len(spec.get("between", ())) == 2
+    t = np.linspace(0.0, 1.0, rows + 1)
+    if resample:
+        dense = rulings_from_spec({**spec, "count": n_ref}, curves, base_dir=d.base_dir)
+        ga, gb, gu = dense.a, dense.b, dense.u
+    else:
+        surf = rulings.surface
+        gu = np.unique(np.concatenate([np.linspace(rulings.u[0], rulings.u[-1], n_ref), rulings.u]))
+        ga, gb = surf.a(gu), surf.b(gu)
+    grid = ga[:, None, :] + t[None, :, None] * (gb - ga)[:, None, :]
+    return Reference(np.asarray(rulings.a), np.asarray(rulings.b), grid, np.asarray(gu),
+                     rulings.surface, lines)
+
+
+def line_distance(p: np.ndarray, a: np.ndarray, b: np.ndarray, chunk: int = 4096) -> np.ndarray:
+    """(n,) distance of each point ``p`` (n, 3) to the nearest of the lines ``a_i b_i`` (m, 3)."""
+    d = b - a
+    dd = np.einsum("ij,ij->i", d, d)
+    out = np.empty(len(p))
+    for s in range(0, len(p), chunk):
+        w = p[s:s + chunk, None, :] - a[None, :, :]            # (c, m, 3)
+        tt = np.einsum("cmi,mi->cm", w, d) / dd
+        r = w - tt[..., None] * d
+        out[s:s + chunk] = np.sqrt(np.einsum("cmi,cmi->cm", r, r).min(axis=1))
+    return out
+
+
+def surface_generator_distance(p: np.ndarray, ref: Reference, iters: int = 100
+                               ) -> tuple[np.ndarray, np.ndarray]:
+    """Distance of points to the nearest generator of the smooth surface, and its t.
+
+    Starts from the nearest dense patch point and runs Gauss-Newton on the
+    generator parameter ``u`` for ``min_u |p - A(u) - t*(u) (B(u) - A(u))|``
+    (``t*`` the foot on the line), which converges quadratically for points on
+    the surface (more slowly near the ends of the patch, hence up to ``iters`` steps).
+
+    Returns
+    -------
+    dist : (n,) float64
+    t : (n,) float64
+        Line parameter of the foot (0 on c1, 1 on c2).
+    """
+    surf = ref.surface
+    T = ref.grid.shape[1]
+    _, idx = cKDTree(ref.grid.reshape(-1, 3)).query(p)
+    u = ref.grid_u[idx // T].astype(float)
+    lo, hi = float(ref.grid_u[0]), float(ref.grid_u[-1])
+    for _ in range(iters):
+        a, b = surf.a(u), surf.b(u)
+        da, db = surf.rail_a.deriv(u), surf.rail_b.deriv(u)
+        d = b - a
+        w = p - a
+        t = np.einsum("ij,ij->i", w, d) / np.einsum("ij,ij->i", d, d)
+        r = w - t[:, None] * d
+        jac = -(da + t[:, None] * (db - da))                     # dr/du with t held (envelope)
+        jj = np.einsum("ij,ij->i", jac, jac)
+        step = -np.einsum("ij,ij->i", r, jac) / np.where(jj > 0, jj, 1.0)
+        u_new = np.clip(u + step, lo, hi)
+        done = np.all(np.abs(u_new - u) <= 1e-15)
+        u = u_new
+        if done:
+            break
+    a, b = surf.a(u), surf.b(u)
+    d = b - a
+    t = np.einsum("ij,ij->i", p - a, d) / np.einsum("ij,ij->i", d, d)
+    return _norm(p - a - t[:, None] * d), t
+
+
+def quadric_distance(p: np.ndarray, ref: Reference) -> np.ndarray:
+    """Distance estimate |Q| / |grad Q| of points to the quadric through the reference patch.
+
+    The quadric is the least-squares null vector of the 10 monomials on the
+    dense patch points (centred and scaled), so it is the design's quadric
+    when the generators lie on one.
+    """
+    pts = ref.grid.reshape(-1, 3)
+    c = pts.mean(axis=0)
+    s = float(np.abs(pts - c).max())
+
+    def mono(x: np.ndarray) -> np.ndarray:
+        X, Y, Z = x.T
+        one = np.ones_like(X)
+        return np.stack([X * X, Y * Y, Z * Z, X * Y, X * Z, Y * Z, X, Y, Z, one], axis=1)
+
+    _, _, vt = np.linalg.svd(mono((pts - c) / s), full_matrices=False)
+    q = vt[-1]
+    x = (p - c) / s
+    X, Y, Z = x.T
+    val = mono(x) @ q
+    grad = np.stack([2 * q[0] * X + q[3] * Y + q[4] * Z + q[6],
+                     2 * q[1] * Y + q[3] * X + q[5] * Z + q[7],
+                     2 * q[2] * Z + q[4] * X + q[5] * Y + q[8]], axis=1)
+    return s * np.abs(val) / np.maximum(_norm(grad), 1e-300)
+
+
+# --------------------------------------------------------------------------
+# distance from the smooth patch to the mesh
+# --------------------------------------------------------------------------
+
+def point_triangle_distance(p: np.ndarray, a: np.ndarray, b: np.ndarray, c: np.ndarray) -> np.ndarray:
+    """(n,) exact distance from points ``p`` to triangles ``abc`` (all (n, 3), paired row by row).
+
+    The closest point is found by the Voronoi regions of the vertices, edges
+    and face (Ericson, *Real-Time Collision Detection*, 5.1.5), vectorised.
+    """
+    ab, ac, ap = b - a, c - a, p - a
+    d1, d2 = np.einsum("ij,ij->i", ab, ap), np.einsum("ij,ij->i", ac, ap)
+    bp = p - b
+    d3, d4 = np.einsum("ij,ij->i", ab, bp), np.einsum("ij,ij->i", ac, bp)
+    cp = p - c
+    d5, d6 = np.einsum("ij,ij->i", ab, cp), np.einsum("ij,ij->i", ac, cp)
+    va = d3 * d6 - d5 * d4
+    vb = d5 * d2 - d1 * d6
+    vc = d1 * d4 - d3 * d2
+    with np.errstate(invalid="ignore", divide="ignore"):
+        den = va + vb + vc
+        v = np.where(den != 0, vb / den, 0.0)
+        w = np.where(den != 0, vc / den, 0.0)
+        q = a + v[:, None] * ab + w[:, None] * ac                  # inside the face
+        # Edges (clamped projections); the face point is used only when inside.
+        t_ab = np.clip(d1 / np.einsum("ij,ij->i", ab, ab), 0, 1)
+        t_ac = np.clip(d2 / np.einsum("ij,ij->i", ac, ac), 0, 1)
+        bc = c - b
+        t_bc = np.clip(np.einsum("ij,ij->i", bc, bp) / np.einsum("ij,ij->i", bc, bc), 0, 1)
+    inside = (va >= 0) & (vb >= 0) & (vc >= 0) & (den > 0)
+    cands = [np.where(inside, _norm(p - q), np.inf)]
+    for base, e, tt in ((a, ab, t_ab), (a, ac, t_ac), (b, bc, t_bc)):
+        tt = np.nan_to_num(tt, nan=0.0)
+        cands.append(_norm(p - base - tt[:, None] * e))
+    return np.min(np.stack(cands), axis=0)
+
+
+def _triangles(mesh: ObjMesh) -> np.ndarray:
+    """(n, 3, 3) fan triangles of every face."""
+    tris = [mesh.vertices[f[:, [0, j, j + 1]]] for k, f in mesh.faces.items() for j in range(1, k - 1)]
+    return np.concatenate(tris) if tris else np.zeros((0, 3, 3))
+
+
+def distance_to_mesh(p: np.ndarray, tris: np.ndarray) -> np.ndarray:
+    """(n,) exact distance from points to the nearest of the triangles (n_t, 3, 3).
+
+    An upper bound from the triangles with the nearest centroids, then every
+    triangle whose bounding sphere reaches within that bound, by classes of
+    triangle size (so a few long slivers do not widen every query).
+    """
+    if len(tris) == 0:
+        return np.full(len(p), np.inf)
+    cen = tris.mean(axis=1)
+    rad = _norm(tris - cen[:, None, :]).max(axis=1)
+    tree = cKDTree(cen)
+    kk = min(4, len(tris))
+    _, near = tree.query(p, k=kk)
+    near = near.reshape(len(p), kk)
+    ub = np.full(len(p), np.inf)
+    for j in range(kk):
+        tr = tris[near[:, j]]
+        ub = np.minimum(ub, point_triangle_distance(p, tr[:, 0], tr[:, 1], tr[:, 2]))
+    best = ub.copy()
+    cls = np.floor(np.log2(np.maximum(rad, 1e-300) / max(rad.min(), 1e-300))).astype(np.int64)
+    for c in np.unique(cls):
+        ids = np.flatnonzero(cls == c)
+        res = cKDTree(cen[ids]).query_ball_point(p, ub * (1 + 1e-9) + rad[ids].max())
+        counts = np.fromiter((len(r) for r in res), dtype=np.int64, count=len(p))
+        if counts.sum() == 0:
+            continue
+        pi = np.repeat(np.arange(len(p)), counts)
+        ti = ids[np.concatenate([np.asarray(r, dtype=np.int64) for r in res if r])]
+        tr = tris[ti]
+        dist = point_triangle_distance(p[pi], tr[:, 0], tr[:, 1], tr[:, 2])
+        np.minimum.at(best, pi, dist)
+    return best
+
+
+def patch_samples(ref: Reference, n_u: int = GAP_U) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Points of the smooth patch where the gap is measured, with their (u, t).
+
+    ``n_u`` dense generators sampled along their length, plus every dense
+    generator's two end points (the borders on c1 and c2, where gaps open).
+    """
+    N, T = ref.grid.shape[:2]
+    t = np.linspace(0.0, 1.0, T)
+    iu = np.unique(np.linspace(0, N - 1, min(n_u, N)).round().astype(np.int64))
+    inner = ref.grid[iu].reshape(-1, 3)
+    uu = np.repeat(ref.grid_u[iu], T)
+    tt = np.tile(t, len(iu))
+    ends = np.concatenate([ref.grid[:, 0], ref.grid[:, -1]])
+    return (np.concatenate([inner, ends]), np.concatenate([uu, ref.grid_u, ref.grid_u]),
+            np.concatenate([tt, np.zeros(N), np.ones(N)]))
+
+
+# --------------------------------------------------------------------------
+# one surface
+# --------------------------------------------------------------------------
+
+def measure(mesh: ObjMesh, ref: Reference | None, quadric: bool = False) -> dict[str, Any]:
+    """The quality figures of a mesh (see the module docstring); JSON-ready."""
+    per = {k: face_measures(mesh.vertices[f]) for k, f in mesh.faces.items() if len(f)}
+    counts = {k: len(f) for k, f in mesh.faces.items()}
+    area = {k: float(m.area.sum()) for k, m in per.items()}
+    total = sum(area.values())
+    out: dict[str, Any] = {
+        "faces": sum(counts.values()),
+        "triangles": counts.get(3, 0),
+        "quads": counts.get(4, 0),
+        "polygons_5plus": sum(n for k, n in counts.items() if k >= 5),
+        "vertices": len(np.unique(np.concatenate([f.ravel() for f in mesh.faces.values()])))
+        if mesh.faces else 0,
+        "area": total,
+        "triangle_area_share": area.get(3, 0.0) / total if total > 0 else float("nan"),
+        "nonquad_area_share": (total - area.get(4, 0.0)) / total if total > 0 else float("nan"),
+    }
+    if not per:
+        return out
+    allm = [m for m in per.values()]
+    min_angle = np.concatenate([m.min_angle for m in allm])
+    out["min_angle_deg"] = float(min_angle.min())
+    out["faces_below_3deg"] = int(np.count_nonzero(min_angle < SPLINTER_DEG))
+    out["triangles_below_3deg"] = int(np.count_nonzero(per[3].min_angle < SPLINTER_DEG)) if 3 in per else 0
+    out["max_planarity_quads"] = float(per[4].planarity.max()) if 4 in per else 0.0
+    poly = [m.planarity for k, m in per.items() if k >= 5]
+    out["max_planarity_polygons"] = float(np.concatenate(poly).max()) if poly else 0.0
+    out["max_planarity"] = max(out["max_planarity_quads"], out["max_planarity_polygons"])
+    out["bowties"] = int(np.count_nonzero(~per[4].convex)) if 4 in per else 0
+    out["nonconvex_polygons"] = int(sum(np.count_nonzero(~m.convex) for k, m in per.items() if k >= 5))
+    out["degenerate_faces"] = int(sum(np.count_nonzero(m.degenerate) for m in allm))
+    groups = {}
+    for k, g in mesh.groups.items():
+        names, n = np.unique(g.astype(str), return_counts=True)
+        for name, c in zip(names.tolist(), n.tolist()):
+            groups[f"{k}:{name or '-'}"] = c
+    out["groups"] = groups
+    verts = mesh.vertices[np.unique(np.concatenate([f.ravel() for f in mesh.faces.values()]))]
+    out["max_abs_coordinate"] = float(np.abs(verts).max())
+    if ref is not None:
+        out.update(_against_reference(mesh, verts, total, ref, quadric))
+    return out
+
+
+def _against_reference(mesh: ObjMesh, verts: np.ndarray, total: float, ref: Reference,
+                       quadric: bool) -> dict[str, Any]:
+    diag = ref.diagonal
+    out: dict[str, Any] = {"diagonal": diag}
+    out["patch_area"] = ref.area()
+    out["coverage"] = total / out["patch_area"]
+    gd = line_distance(verts, ref.a, ref.b) / diag
+    out["max_design_generator_distance"] = float(gd.max())
+    if ref.surface is not None and not ref.from_lines:
+        sd, t = surface_generator_distance(verts, ref)
+        sd = np.minimum(sd / diag, gd)                         # design generators are generators
+        out["max_generator_distance"] = float(sd.max())
+        out["vertices_off_design_generators"] = int(np.count_nonzero(gd > 1e-9))
+        glen = _norm(ref.grid[:, -1] - ref.grid[:, 0]).mean()
+        out["max_overshoot"] = float(max(0.0, -t.min(), t.max() - 1.0) * glen / diag)
+    else:
+        out["max_generator_distance"] = out["max_design_generator_distance"]
+    if quadric:
+        out["max_quadric_distance"] = float(quadric_distance(verts, ref).max() / diag)
+    pts, uu, tt = patch_samples(ref)
+    gap = distance_to_mesh(pts, _triangles(mesh)) / diag
+    worst = int(np.argmax(gap))
+    out["max_gap"] = float(gap[worst])
+    out["max_gap_at"] = {"u": float(uu[worst]), "t": float(tt[worst])}
+    return out
+
+
+def run_surface(s: Surface, workdir: Path) -> dict[str, Any]:
+    """Build one design through the CLI and measure it; a failed build is reported, not raised."""
+    obj = workdir / f"{s.name}.obj"
+    res = build(s.path, obj)
+    row: dict[str, Any] = {"surface": s.name, "path": str(s.path), "description": s.description,
+                           "flags": sorted(s.flags), "tolerance": s.tolerance,
+                           "build_seconds": round(res.seconds, 3), "returncode": res.returncode,
+                           "warnings": [ln[len("warning: "):] for ln in res.stderr.splitlines()
+                                        if ln.startswith("warning: ")]}
+    if res.returncode != 0 or not obj.exists():
+        err = [ln for ln in res.stderr.strip().splitlines() if ln.strip()]
+        row["status"] = "design-error" if res.returncode == EXIT_DESIGN_ERROR else "build-failed"
+        row["error"] = err[-1] if err else f"exit {res.returncode}"
+        return row
+    row["status"] = "ok"
+    t0 = time.perf_counter()
+    ref = reference_of(s.path)
+    row.update(measure(read_obj(obj), ref, quadric="quadric" in s.flags))
+    row["measure_seconds"] = round(time.perf_counter() - t0, 3)
+    return row
+
+
+# --------------------------------------------------------------------------
+# report
+# --------------------------------------------------------------------------
+
+COLUMNS = (
+    ("surface", "surface", "{}"),
+    ("build s", "build_seconds", "{:.1f}"),
+    ("F3/F4/F5+", None, None),
+    ("tri area", "triangle_area_share", "{:.1%}"),
+    ("non-quad area", "nonquad_area_share", "{:.1%}"),
+    ("min angle", "min_angle_deg", "{:.3g}"),
+    ("< 3 deg", "faces_below_3deg", "{}"),
+    ("planarity", "max_planarity", "{:.1e}"),
+    ("bow-ties", "bowties", "{}"),
+    ("degen.", "degenerate_faces", "{}"),
+    ("on gen.", "max_generator_distance", "{:.1e}"),
+    ("coverage", "coverage", "{:.4f}"),
+    ("gap", "max_gap", "{:.1e}"),
+)
+
+
+def _cell(row: dict, key: str | None, fmt: str | None) -> str:
+    if key is None:
+        return f"{row.get('triangles', '')}/{row.get('quads', '')}/{row.get('polygons_5plus', '')}"
+    value = row.get(key)
+    if value is None:
+        return "-"
+    try:
+        return fmt.format(value) if fmt else str(value)
+    except (TypeError, ValueError):
+        return str(value)
+
+
+def markdown(rows: list[dict]) -> str:
+    """The rows as a markdown table; failed builds as one line with the error."""
+    head = "| " + " | ".join(c[0] for c in COLUMNS) + " |"
+    sep = "|" + "|".join("---" for _ in COLUMNS) + "|"
+    lines = [head, sep]
+    for row in rows:
+        if row.get("status") != "ok":
+            msg = str(row.get("error", "")).replace("|", "\\|")
+            lines.append(f"| {row['surface']} | {row['build_seconds']:.1f} | **{row['status']}**: "
+                         f"{msg} |" + " |" * (len(COLUMNS) - 3))
+        else:
+            lines.append("| " + " | ".join(_cell(row, k, f) for _, k, f in COLUMNS) + " |")
+    return "\n".join(lines)
+
+
+def main(argv: list[str] | None = None) -> int:
+    """Command line: build and measure the surfaces, print a table, optionally write JSON."""
+    p = argparse.ArgumentParser(description=__doc__.split("\n\n", 1)[0])
+    p.add_argument("designs", nargs="*", help="more design files to measure")
+    p.add_argument("--large", action="store_true", help="include the 300 x 300 surfaces")
+    p.add_argument("--only", action="append", default=[],
+                   help="measure only surfaces whose name contains this (repeatable)")
+    p.add_argument("--no-defaults", action="store_true",
+                   help="measure only the designs given on the command line")
+    p.add_argument("--json", metavar="FILE", help="write the figures as JSON")
+    p.add_argument("--keep", metavar="DIR", help="keep the OBJ files in DIR")
+    args = p.parse_args(argv)
+    surfaces = [] if args.no_defaults else default_surfaces(args.large)
+    if args.only:
+        surfaces = [s for s in surfaces if any(o in s.name for o in args.only)]
+    surfaces += [_as_general(read_surface(d)) for d in args.designs]
+    rows = []
+    with tempfile.TemporaryDirectory() as tmp:
+        work = Path(args.keep) if args.keep else Path(tmp)
+        work.mkdir(parents=True, exist_ok=True)
+        t0 = time.perf_counter()
+        for s in surfaces:
+            row = run_surface(s, work)
+            rows.append(row)
+            print(f"{s.name}: {row['status']} ({row['build_seconds']:.1f} s build, "
+                  f"{row.get('measure_seconds', 0):.1f} s measure)", file=sys.stderr)
+        total = time.perf_counter() - t0
+    print(markdown(rows))
+    print(f"\n{len(rows)} surfaces in {total:.0f} s")
+    if args.json:
+        doc = {"surfaces": rows, "seconds": round(total, 1),
+               "thresholds": {"splinter_deg": SPLINTER_DEG, "degenerate": DEGENERATE,
+                              "cross_margin": CROSS_MARGIN}}
+        Path(args.json).write_text(json.dumps(doc, indent=2, allow_nan=False, default=_jsonable)
+                                   + "\n", encoding="utf-8")
+    return 0
+
+
+def _jsonable(x: Any) -> Any:
+    if isinstance(x, (np.integer, np.floating)):
+        return x.item()
+    raise TypeError(f"not JSON serialisable: {type(x).__name__}")
+
+
+if __name__ == "__main__":
+    sys.exit(main())
