@@ -21,7 +21,9 @@ bounding box):
 * smallest corner angle over all faces (degrees), faces with an angle < 3 deg;
 * planarity of quads: distance between the two diagonal lines divided by the
   mean diagonal length (the paper's measure); of 5+-gons: largest distance to
-  the least-squares plane divided by the polygon's diameter;
+  the least-squares plane divided by the polygon's diameter; and the part of
+  it beyond what rounding the coordinates to float64 can explain (far from
+  the origin, half an ulp of 2.6e6 already bends a 1 m quad by ~1e-10);
 * bow-ties: quads whose diagonals do not cross strictly inside both, and
   non-convex 5+-gons;
 * degenerate faces: area <= 1e-9 x (longest edge)^2;
@@ -50,6 +52,7 @@ import subprocess
 import sys
 import tempfile
 import time
+from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
@@ -65,6 +68,9 @@ EXTRA = (ROOT / "examples" / "skew.toml", ROOT / "examples" / "fig10-skew-surfac
 SPLINTER_DEG = 3.0          # a face with a smaller corner angle is a splinter
 DEGENERATE = 1e-9           # area <= DEGENERATE * longest_edge**2 (as ruledmesh fabricate)
 CROSS_MARGIN = 1e-9         # diagonals must cross inside (margin, 1 - margin) of both
+# Planarity a face can get from writing its coordinates to float64 alone, per unit of
+# (largest |coordinate| / face size): four corners each off by up to half an ulp.
+ROUNDING = 4 * np.finfo(np.float64).eps
 REF_GENERATORS = 1601       # generators of the dense reference sampling
 REF_ROWS = 96               # divisions of each reference generator
 GAP_U = 400                 # reference generators used as gap sample lines
@@ -239,6 +245,9 @@ class FaceMeasures:
         turns the same way about the face normal; triangles: not degenerate.
     degenerate : (f,) bool
         ``area <= DEGENERATE * longest_edge ** 2``.
+    size : (f,) float64
+        The length the planarity is relative to: mean diagonal (quads),
+        diameter (5+-gons), longest edge (triangles).
     """
 
     area: np.ndarray
@@ -246,6 +255,7 @@ class FaceMeasures:
     planarity: np.ndarray
     convex: np.ndarray
     degenerate: np.ndarray
+    size: np.ndarray
 
 
 def quad_diagonals(q: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
@@ -309,8 +319,10 @@ def face_measures(poly: np.ndarray) -> FaceMeasures:
     if k == 3:
         planarity = np.zeros(f)
         convex = ~degenerate
+        size = edge.max(axis=1)
     elif k == 4:
         s, t, planarity = quad_diagonals(q)
+        size = 0.5 * (_norm(q[:, 2] - q[:, 0]) + _norm(q[:, 3] - q[:, 1]))
         m = CROSS_MARGIN
         with np.errstate(invalid="ignore"):
             convex = (s > m) & (s < 1 - m) & (t > m) & (t < 1 - m)
@@ -320,7 +332,8 @@ def face_measures(poly: np.ndarray) -> FaceMeasures:
         diam = _norm(q[:, :, None, :] - q[:, None, :, :]).max(axis=(1, 2))
         planarity = dist.max(axis=1) / np.maximum(diam, 1e-300)
         convex = np.all(turn > 0, axis=1) & ~degenerate
-    return FaceMeasures(area, ang.min(axis=1), planarity, convex, degenerate)
+        size = diam
+    return FaceMeasures(area, ang.min(axis=1), planarity, convex, degenerate, size)
 
 
 # --------------------------------------------------------------------------
@@ -394,10 +407,13 @@ def reference_of(design: Path, n_ref: int = REF_GENERATORS, rows: int = REF_ROWS
     if resample:
         dense = rulings_from_spec({**spec, "count": n_ref}, curves, base_dir=d.base_dir)
         ga, gb, gu = dense.a, dense.b, dense.u
-    else:
+    elif rulings.surface is not None:
         surf = rulings.surface
         gu = np.unique(np.concatenate([np.linspace(rulings.u[0], rulings.u[-1], n_ref), rulings.u]))
         ga, gb = surf.a(gu), surf.b(gu)
+    else:                                   # no smooth surface: the generators' own strips
+        gu = np.asarray(rulings.u)
+        ga, gb = np.asarray(rulings.a), np.asarray(rulings.b)
     grid = ga[:, None, :] + t[None, :, None] * (gb - ga)[:, None, :]
     return Reference(np.asarray(rulings.a), np.asarray(rulings.b), grid, np.asarray(gu),
                      rulings.surface, lines)
@@ -527,15 +543,41 @@ def _triangles(mesh: ObjMesh) -> np.ndarray:
     return np.concatenate(tris) if tris else np.zeros((0, 3, 3))
 
 
+def _bisect_large(tris: np.ndarray, target: float, max_rounds: int = 24) -> np.ndarray:
+    """Split triangles at the midpoint of their longest edge until each radius <= ``target``.
+
+    The pieces cover exactly the same points, so distances are unchanged; the
+    search below only gets tighter bounding spheres.
+    """
+    for _ in range(max_rounds):
+        cen = tris.mean(axis=1)
+        big = _norm(tris - cen[:, None, :]).max(axis=1) > target
+        if not big.any():
+            break
+        t = tris[big]
+        e = _norm(t[:, [1, 2, 0]] - t)                        # edge i: corner i -> i + 1
+        k = e.argmax(axis=1)
+        rows = np.arange(len(t))
+        p0, p1, p2 = t[rows, k], t[rows, (k + 1) % 3], t[rows, (k + 2) % 3]
+        mid = 0.5 * (p0 + p1)
+        halves = np.concatenate([np.stack([p0, mid, p2], 1), np.stack([mid, p1, p2], 1)])
+        tris = np.concatenate([tris[~big], halves])
+    return tris
+
+
 def distance_to_mesh(p: np.ndarray, tris: np.ndarray) -> np.ndarray:
     """(n,) exact distance from points to the nearest of the triangles (n_t, 3, 3).
 
-    An upper bound from the triangles with the nearest centroids, then every
-    triangle whose bounding sphere reaches within that bound, by classes of
-    triangle size (so a few long slivers do not widen every query).
+    Large triangles are first bisected (same point set) to a few times the
+    median size; then an upper bound from the triangles with the nearest
+    centroids, then every triangle whose bounding sphere reaches within that
+    bound, by classes of triangle size (so a few long slivers do not widen
+    every query).
     """
     if len(tris) == 0:
         return np.full(len(p), np.inf)
+    rad0 = _norm(tris - tris.mean(axis=1)[:, None, :]).max(axis=1)
+    tris = _bisect_large(tris, 2.0 * float(np.median(rad0)))
     cen = tris.mean(axis=1)
     rad = _norm(tris - cen[:, None, :]).max(axis=1)
     tree = cKDTree(cen)
@@ -606,11 +648,26 @@ def measure(mesh: ObjMesh, ref: Reference | None, quadric: bool = False) -> dict
     min_angle = np.concatenate([m.min_angle for m in allm])
     out["min_angle_deg"] = float(min_angle.min())
     out["faces_below_3deg"] = int(np.count_nonzero(min_angle < SPLINTER_DEG))
-    out["triangles_below_3deg"] = int(np.count_nonzero(per[3].min_angle < SPLINTER_DEG)) if 3 in per else 0
+    tri_angle = per[3].min_angle if 3 in per else np.zeros(0)
+    out["triangles_below_3deg"] = int(np.count_nonzero(tri_angle < SPLINTER_DEG))
+    out["triangles_below_5deg"] = int(np.count_nonzero(tri_angle < 5.0))
+    if 3 in per:
+        # Aspect ratio: longest edge / shortest altitude = longest^2 / (2 area).
+        t = per[3]
+        with np.errstate(divide="ignore"):
+            aspect = t.size ** 2 / (2.0 * t.area)
+        out["max_triangle_aspect"] = float(aspect.max()) if np.isfinite(aspect).all() else None
     out["max_planarity_quads"] = float(per[4].planarity.max()) if 4 in per else 0.0
     poly = [m.planarity for k, m in per.items() if k >= 5]
     out["max_planarity_polygons"] = float(np.concatenate(poly).max()) if poly else 0.0
     out["max_planarity"] = max(out["max_planarity_quads"], out["max_planarity_polygons"])
+    # Far from the origin the file's own rounding (half an ulp per coordinate) bends faces:
+    # the planarity beyond what that rounding can explain.
+    verts = mesh.vertices[np.unique(np.concatenate([f.ravel() for f in mesh.faces.values()]))]
+    big = float(np.abs(verts).max())
+    excess = [np.maximum(m.planarity - ROUNDING * big / np.maximum(m.size, 1e-300), 0.0)
+              for k, m in per.items() if k >= 4]
+    out["max_planarity_beyond_rounding"] = float(np.concatenate(excess).max()) if excess else 0.0
     out["bowties"] = int(np.count_nonzero(~per[4].convex)) if 4 in per else 0
     out["nonconvex_polygons"] = int(sum(np.count_nonzero(~m.convex) for k, m in per.items() if k >= 5))
     out["degenerate_faces"] = int(sum(np.count_nonzero(m.degenerate) for m in allm))
@@ -620,8 +677,7 @@ def measure(mesh: ObjMesh, ref: Reference | None, quadric: bool = False) -> dict
         for name, c in zip(names.tolist(), n.tolist()):
             groups[f"{k}:{name or '-'}"] = c
     out["groups"] = groups
-    verts = mesh.vertices[np.unique(np.concatenate([f.ravel() for f in mesh.faces.values()]))]
-    out["max_abs_coordinate"] = float(np.abs(verts).max())
+    out["max_abs_coordinate"] = big
     if ref is not None:
         out.update(_against_reference(mesh, verts, total, ref, quadric))
     return out
@@ -654,10 +710,20 @@ def _against_reference(mesh: ObjMesh, verts: np.ndarray, total: float, ref: Refe
     return out
 
 
-def run_surface(s: Surface, workdir: Path) -> dict[str, Any]:
-    """Build one design through the CLI and measure it; a failed build is reported, not raised."""
-    obj = workdir / f"{s.name}.obj"
-    res = build(s.path, obj)
+def obj_path(s: Surface, workdir: Path) -> Path:
+    """Where the OBJ of ``s`` is written in ``workdir``."""
+    return workdir / f"{s.name}.obj"
+
+
+def run_surface(s: Surface, workdir: Path, res: BuildResult | None = None) -> dict[str, Any]:
+    """Build one design through the CLI and measure it; a failed build is reported, not raised.
+
+    ``res``: the result of :func:`build` run already (e.g. concurrently) into
+    :func:`obj_path`.
+    """
+    obj = obj_path(s, workdir)
+    if res is None:
+        res = build(s.path, obj)
     row: dict[str, Any] = {"surface": s.name, "path": str(s.path), "description": s.description,
                            "flags": sorted(s.flags), "tolerance": s.tolerance,
                            "build_seconds": round(res.seconds, 3), "returncode": res.returncode,
@@ -682,6 +748,7 @@ def run_surface(s: Surface, workdir: Path) -> dict[str, Any]:
 
 COLUMNS = (
     ("surface", "surface", "{}"),
+    ("kind", "kind", "{}"),
     ("build s", "build_seconds", "{:.1f}"),
     ("F3/F4/F5+", None, None),
     ("tri area", "triangle_area_share", "{:.1%}"),
@@ -697,7 +764,14 @@ COLUMNS = (
 )
 
 
+_SHORT = {"general": "gen", "near-developable": "near-dev", "quadric": "quadric", "large": "large"}
+
+
 def _cell(row: dict, key: str | None, fmt: str | None) -> str:
+    if key == "kind":
+        tags = [_SHORT[f] for f in row.get("flags", ()) if f in _SHORT]
+        tol = row.get("tolerance")
+        return " ".join(tags + ([f"tol {tol:g}"] if tol is not None else []))
     if key is None:
         return f"{row.get('triangles', '')}/{row.get('quads', '')}/{row.get('polygons_5plus', '')}"
     value = row.get(key)
@@ -717,8 +791,9 @@ def markdown(rows: list[dict]) -> str:
     for row in rows:
         if row.get("status") != "ok":
             msg = str(row.get("error", "")).replace("|", "\\|")
-            lines.append(f"| {row['surface']} | {row['build_seconds']:.1f} | **{row['status']}**: "
-                         f"{msg} |" + " |" * (len(COLUMNS) - 3))
+            lines.append(f"| {row['surface']} | {_cell(row, 'kind', None)} | "
+                         f"{row['build_seconds']:.1f} | **{row['status']}**: {msg} |"
+                         + " |" * (len(COLUMNS) - 4))
         else:
             lines.append("| " + " | ".join(_cell(row, k, f) for _, k, f in COLUMNS) + " |")
     return "\n".join(lines)
@@ -735,6 +810,8 @@ def main(argv: list[str] | None = None) -> int:
                    help="measure only the designs given on the command line")
     p.add_argument("--json", metavar="FILE", help="write the figures as JSON")
     p.add_argument("--keep", metavar="DIR", help="keep the OBJ files in DIR")
+    p.add_argument("-j", "--jobs", type=int, default=1,
+                   help="builds run at once (default 1: build times undisturbed)")
     args = p.parse_args(argv)
     surfaces = [] if args.no_defaults else default_surfaces(args.large)
     if args.only:
@@ -745,11 +822,14 @@ def main(argv: list[str] | None = None) -> int:
         work = Path(args.keep) if args.keep else Path(tmp)
         work.mkdir(parents=True, exist_ok=True)
         t0 = time.perf_counter()
-        for s in surfaces:
-            row = run_surface(s, work)
+        pool = ThreadPoolExecutor(max(1, args.jobs))
+        futures = [pool.submit(build, s.path, obj_path(s, work)) for s in surfaces]
+        for s, fut in zip(surfaces, futures):
+            row = run_surface(s, work, fut.result())
             rows.append(row)
             print(f"{s.name}: {row['status']} ({row['build_seconds']:.1f} s build, "
                   f"{row.get('measure_seconds', 0):.1f} s measure)", file=sys.stderr)
+        pool.shutdown()
         total = time.perf_counter() - t0
     print(markdown(rows))
     print(f"\n{len(rows)} surfaces in {total:.0f} s")
