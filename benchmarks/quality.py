@@ -639,14 +639,41 @@ def measure(mesh: ObjMesh, ref: Reference | None, quadric: bool = False) -> dict
         "vertices": len(np.unique(np.concatenate([f.ravel() for f in mesh.faces.values()])))
         if mesh.faces else 0,
         "area": total,
-        "triangle_area_share": area.get(3, 0.0) / total if total > 0 else float("nan"),
-        "nonquad_area_share": (total - area.get(4, 0.0)) / total if total > 0 else float("nan"),
+        "triangle_area_share": area.get(3, 0.0) / total if total > 0 else None,
+        "nonquad_area_share": (total - area.get(4, 0.0)) / total if total > 0 else None,
     }
     if not per:
         return out
-    allm = [m for m in per.values()]
-    min_angle = np.concatenate([m.min_angle for m in allm])
+    verts = mesh.vertices[np.unique(np.concatenate([f.ravel() for f in mesh.faces.values()]))]
+    big = float(np.abs(verts).max())
+    out.update(_angle_figures(mesh, per))
+    out.update(_planarity_figures(per, big))
+    out["bowties"] = int(np.count_nonzero(~per[4].convex)) if 4 in per else 0
+    out["nonconvex_polygons"] = int(sum(np.count_nonzero(~m.convex) for k, m in per.items() if k >= 5))
+    out["degenerate_faces"] = int(sum(np.count_nonzero(m.degenerate) for m in per.values()))
+    groups = {}
+    for k, g in mesh.groups.items():
+        names, n = np.unique(g.astype(str), return_counts=True)
+        for name, c in zip(names.tolist(), n.tolist()):
+            groups[f"{k}:{name or '-'}"] = c
+    out["groups"] = groups
+    out["max_abs_coordinate"] = big
+    if ref is not None:
+        out.update(_against_reference(mesh, verts, total, ref, quadric))
+    return out
+
+
+def _angle_figures(mesh: ObjMesh, per: dict[int, FaceMeasures]) -> dict[str, Any]:
+    """Smallest angle (and where), splinter counts, largest triangle aspect ratio."""
+    out: dict[str, Any] = {}
+    min_angle = np.concatenate([m.min_angle for m in per.values()])
     out["min_angle_deg"] = float(min_angle.min())
+    k_worst = min(per, key=lambda k: float(per[k].min_angle.min()))
+    i_worst = int(np.argmin(per[k_worst].min_angle))
+    group = mesh.groups.get(k_worst)
+    out["min_angle_at"] = {
+        "centroid": mesh.vertices[mesh.faces[k_worst][i_worst]].mean(axis=0).tolist(),
+        "size": k_worst, "group": str(group[i_worst]) if group is not None else ""}
     out["faces_below_3deg"] = int(np.count_nonzero(min_angle < SPLINTER_DEG))
     tri_angle = per[3].min_angle if 3 in per else np.zeros(0)
     out["triangles_below_3deg"] = int(np.count_nonzero(tri_angle < SPLINTER_DEG))
@@ -657,29 +684,21 @@ def measure(mesh: ObjMesh, ref: Reference | None, quadric: bool = False) -> dict
         with np.errstate(divide="ignore"):
             aspect = t.size ** 2 / (2.0 * t.area)
         out["max_triangle_aspect"] = float(aspect.max()) if np.isfinite(aspect).all() else None
+    return out
+
+
+def _planarity_figures(per: dict[int, FaceMeasures], big: float) -> dict[str, Any]:
+    """Largest planarity of quads, of 5+-gons, and beyond the coordinates' rounding."""
+    out: dict[str, Any] = {}
     out["max_planarity_quads"] = float(per[4].planarity.max()) if 4 in per else 0.0
     poly = [m.planarity for k, m in per.items() if k >= 5]
     out["max_planarity_polygons"] = float(np.concatenate(poly).max()) if poly else 0.0
     out["max_planarity"] = max(out["max_planarity_quads"], out["max_planarity_polygons"])
     # Far from the origin the file's own rounding (half an ulp per coordinate) bends faces:
     # the planarity beyond what that rounding can explain.
-    verts = mesh.vertices[np.unique(np.concatenate([f.ravel() for f in mesh.faces.values()]))]
-    big = float(np.abs(verts).max())
     excess = [np.maximum(m.planarity - ROUNDING * big / np.maximum(m.size, 1e-300), 0.0)
               for k, m in per.items() if k >= 4]
     out["max_planarity_beyond_rounding"] = float(np.concatenate(excess).max()) if excess else 0.0
-    out["bowties"] = int(np.count_nonzero(~per[4].convex)) if 4 in per else 0
-    out["nonconvex_polygons"] = int(sum(np.count_nonzero(~m.convex) for k, m in per.items() if k >= 5))
-    out["degenerate_faces"] = int(sum(np.count_nonzero(m.degenerate) for m in allm))
-    groups = {}
-    for k, g in mesh.groups.items():
-        names, n = np.unique(g.astype(str), return_counts=True)
-        for name, c in zip(names.tolist(), n.tolist()):
-            groups[f"{k}:{name or '-'}"] = c
-    out["groups"] = groups
-    out["max_abs_coordinate"] = big
-    if ref is not None:
-        out.update(_against_reference(mesh, verts, total, ref, quadric))
     return out
 
 
@@ -783,19 +802,31 @@ def _cell(row: dict, key: str | None, fmt: str | None) -> str:
         return str(value)
 
 
-def markdown(rows: list[dict]) -> str:
-    """The rows as a markdown table; failed builds as one line with the error."""
+COMPARED = ("triangle_area_share", "min_angle_deg", "faces_below_3deg", "max_gap")
+
+
+def markdown(rows: list[dict], before: dict[str, dict] | None = None) -> str:
+    """The rows as a markdown table; failed builds as one line with the error.
+
+    ``before``: rows of an earlier run by surface name; the compared figures
+    then show ``new (was old)``.
+    """
     head = "| " + " | ".join(c[0] for c in COLUMNS) + " |"
     sep = "|" + "|".join("---" for _ in COLUMNS) + "|"
     lines = [head, sep]
     for row in rows:
+        old = (before or {}).get(row["surface"])
         if row.get("status") != "ok":
             msg = str(row.get("error", "")).replace("|", "\\|")
             lines.append(f"| {row['surface']} | {_cell(row, 'kind', None)} | "
                          f"{row['build_seconds']:.1f} | **{row['status']}**: {msg} |"
                          + " |" * (len(COLUMNS) - 4))
         else:
-            lines.append("| " + " | ".join(_cell(row, k, f) for _, k, f in COLUMNS) + " |")
+            cells = [_cell(row, k, f) for _, k, f in COLUMNS]
+            if old is not None and old.get("status") == "ok":
+                cells = [c + (f" (was {_cell(old, k, f)})" if k in COMPARED else "")
+                         for c, (_, k, f) in zip(cells, COLUMNS)]
+            lines.append("| " + " | ".join(cells) + " |")
     return "\n".join(lines)
 
 
@@ -810,6 +841,8 @@ def main(argv: list[str] | None = None) -> int:
                    help="measure only the designs given on the command line")
     p.add_argument("--json", metavar="FILE", help="write the figures as JSON")
     p.add_argument("--keep", metavar="DIR", help="keep the OBJ files in DIR")
+    p.add_argument("--baseline", metavar="FILE",
+                   help="JSON of an earlier run: show its figures next to the new ones")
     p.add_argument("-j", "--jobs", type=int, default=1,
                    help="builds run at once (default 1: build times undisturbed)")
     args = p.parse_args(argv)
@@ -831,7 +864,11 @@ def main(argv: list[str] | None = None) -> int:
                   f"{row.get('measure_seconds', 0):.1f} s measure)", file=sys.stderr)
         pool.shutdown()
         total = time.perf_counter() - t0
-    print(markdown(rows))
+    before = None
+    if args.baseline:
+        old = json.loads(Path(args.baseline).read_text(encoding="utf-8"))
+        before = {r["surface"]: r for r in old.get("surfaces", [])}
+    print(markdown(rows, before))
     print(f"\n{len(rows)} surfaces in {total:.0f} s")
     if args.json:
         doc = {"surfaces": rows, "seconds": round(total, 1),

@@ -48,7 +48,6 @@ ON_GENERATOR = 1e-10            # relative to the diagonal, plus the coordinates
 ALL = quality.default_surfaces(large=True)
 EXACT = [s for s in ALL if s.tolerance is None]
 TOLERANCE = [s for s in ALL if s.tolerance is not None]
-GENERAL = [s for s in EXACT if "general" in s.flags and "large" not in s.flags]
 LARGE = [s for s in EXACT if "large" in s.flags]
 QUADRIC = [s for s in ALL if "quadric" in s.flags]
 
@@ -85,6 +84,8 @@ def measured(tmp_path_factory):
         row = cache[surface.name]
         if row["status"] != "ok":
             pytest.fail(f"{surface.name}: {row['status']}: {row.get('error')}", pytrace=False)
+        if row["faces"] == 0:
+            pytest.fail(f"{surface.name}: the build wrote no faces", pytrace=False)
         return row
 
     yield get
@@ -148,6 +149,31 @@ def test_no_gap_to_the_smooth_patch(surface, measured):
         f"u = {at['u']:.4f}, t = {at['t']:.4f}")
 
 
+def _triangle_bound(surface) -> float | None:
+    """Largest triangle area share allowed: tolerance mode 10 %, 300 x 300 5 %, general 25 %.
+
+    Nearly developable surfaces in exact mode have no bound: exact planar quads
+    degenerate there, which is what tolerance mode is for.
+    """
+    if surface.tolerance is not None:
+        return MAX_TRIANGLE_SHARE_TOLERANCE
+    if "large" in surface.flags:
+        return MAX_TRIANGLE_SHARE_LARGE
+    return MAX_TRIANGLE_SHARE if "general" in surface.flags else None
+
+
+BOUNDED = [s for s in ALL if _triangle_bound(s) is not None]
+
+
+@pytest.mark.parametrize("surface", BOUNDED, ids=_ids(BOUNDED))
+def test_triangle_area_share(surface, measured):
+    row = measured(surface)
+    bound = _triangle_bound(surface)
+    assert row["triangle_area_share"] <= bound, (
+        f"{row['triangle_area_share']:.1%} of the area in {row['triangles']} triangles "
+        f"(at most {bound:.0%})")
+
+
 # --------------------------------------------------------------------------- exact mode
 
 @pytest.mark.parametrize("surface", EXACT, ids=_ids(EXACT))
@@ -157,28 +183,7 @@ def test_exact_mode_faces_planar(surface, measured):
         f"planarity {row['max_planarity']:.2e}")
 
 
-@pytest.mark.parametrize("surface", GENERAL, ids=_ids(GENERAL))
-def test_exact_mode_triangle_share(surface, measured):
-    row = measured(surface)
-    assert row["triangle_area_share"] <= MAX_TRIANGLE_SHARE, (
-        f"{row['triangle_area_share']:.1%} of the area in {row['triangles']} triangles")
-
-
-@pytest.mark.parametrize("surface", LARGE, ids=_ids(LARGE))
-def test_exact_mode_refinement_converges_to_quads(surface, measured):
-    row = measured(surface)
-    assert row["triangle_area_share"] <= MAX_TRIANGLE_SHARE_LARGE, (
-        f"{row['triangle_area_share']:.1%} of the area in {row['triangles']} triangles")
-
-
 # --------------------------------------------------------------------------- tolerance mode
-
-@pytest.mark.parametrize("surface", TOLERANCE, ids=_ids(TOLERANCE))
-def test_tolerance_mode_triangle_share(surface, measured):
-    row = measured(surface)
-    assert row["triangle_area_share"] <= MAX_TRIANGLE_SHARE_TOLERANCE, (
-        f"{row['triangle_area_share']:.1%} of the area in {row['triangles']} triangles")
-
 
 @pytest.mark.parametrize("surface", TOLERANCE, ids=_ids(TOLERANCE))
 def test_tolerance_mode_faces_within_tolerance(surface, measured):
