@@ -46,6 +46,7 @@ A design may carry a ``# quality: ...`` comment line with flags: ``general``
 from __future__ import annotations
 
 import argparse
+import hashlib
 import json
 import os
 import subprocess
@@ -730,8 +731,9 @@ def _against_reference(mesh: ObjMesh, verts: np.ndarray, total: float, ref: Refe
 
 
 def obj_path(s: Surface, workdir: Path) -> Path:
-    """Where the OBJ of ``s`` is written in ``workdir``."""
-    return workdir / f"{s.name}.obj"
+    """Where the OBJ of ``s`` is written in ``workdir`` (distinct for equal names in two folders)."""
+    tag = hashlib.sha1(str(s.path.resolve()).encode()).hexdigest()[:8]
+    return workdir / f"{s.path.stem}-{tag}.obj"
 
 
 def run_surface(s: Surface, workdir: Path, res: BuildResult | None = None) -> dict[str, Any]:
@@ -743,7 +745,8 @@ def run_surface(s: Surface, workdir: Path, res: BuildResult | None = None) -> di
     obj = obj_path(s, workdir)
     if res is None:
         res = build(s.path, obj)
-    row: dict[str, Any] = {"surface": s.name, "path": str(s.path), "description": s.description,
+    row: dict[str, Any] = {"surface": s.name, "path": _relative(s.path, suffix=True),
+                           "description": s.description,
                            "flags": sorted(s.flags), "tolerance": s.tolerance,
                            "build_seconds": round(res.seconds, 3), "returncode": res.returncode,
                            "warnings": [ln[len("warning: "):] for ln in res.stderr.splitlines()
@@ -830,6 +833,38 @@ def markdown(rows: list[dict], before: dict[str, dict] | None = None) -> str:
     return "\n".join(lines)
 
 
+def _unique_names(surfaces: list[Surface]) -> list[Surface]:
+    """Surfaces whose name another one shares are named by their path instead."""
+    stems = [s.name for s in surfaces]
+    return [s if stems.count(s.name) == 1 else
+            Surface(_relative(s.path), s.path, s.description, s.flags, s.tolerance)
+            for s in surfaces]
+
+
+def _relative(path: Path, suffix: bool = False) -> str:
+    """``path`` relative to the repository if inside it; without ``.toml`` unless ``suffix``."""
+    try:
+        rel = path.resolve().relative_to(ROOT)
+    except ValueError:
+        rel = path
+    return str(rel if suffix else rel.with_suffix(""))
+
+
+def _run_all(surfaces: list[Surface], work: Path, jobs: int) -> list[dict]:
+    """Build and measure every surface; with ``jobs > 1`` builds run ahead in threads."""
+    pool = ThreadPoolExecutor(jobs) if jobs > 1 else None
+    futures = [pool.submit(build, s.path, obj_path(s, work)) for s in surfaces] if pool else []
+    rows = []
+    for i, s in enumerate(surfaces):
+        row = run_surface(s, work, futures[i].result() if pool else None)
+        rows.append(row)
+        print(f"{s.name}: {row['status']} ({row['build_seconds']:.1f} s build, "
+              f"{row.get('measure_seconds', 0):.1f} s measure)", file=sys.stderr)
+    if pool:
+        pool.shutdown()
+    return rows
+
+
 def main(argv: list[str] | None = None) -> int:
     """Command line: build and measure the surfaces, print a table, optionally write JSON."""
     p = argparse.ArgumentParser(description=__doc__.split("\n\n", 1)[0])
@@ -850,19 +885,11 @@ def main(argv: list[str] | None = None) -> int:
     if args.only:
         surfaces = [s for s in surfaces if any(o in s.name for o in args.only)]
     surfaces += [_as_general(read_surface(d)) for d in args.designs]
-    rows = []
     with tempfile.TemporaryDirectory() as tmp:
         work = Path(args.keep) if args.keep else Path(tmp)
         work.mkdir(parents=True, exist_ok=True)
         t0 = time.perf_counter()
-        pool = ThreadPoolExecutor(max(1, args.jobs))
-        futures = [pool.submit(build, s.path, obj_path(s, work)) for s in surfaces]
-        for s, fut in zip(surfaces, futures):
-            row = run_surface(s, work, fut.result())
-            rows.append(row)
-            print(f"{s.name}: {row['status']} ({row['build_seconds']:.1f} s build, "
-                  f"{row.get('measure_seconds', 0):.1f} s measure)", file=sys.stderr)
-        pool.shutdown()
+        rows = _run_all(_unique_names(surfaces), work, args.jobs)
         total = time.perf_counter() - t0
     before = None
     if args.baseline:
