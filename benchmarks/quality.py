@@ -405,6 +405,7 @@ def reference_of(design: Path, n_ref: int = REF_GENERATORS, rows: int = REF_ROWS
     lines = "lines" in spec or "file" in spec
     resample = "conoid" in spec or len(spec.get("between", ())) == 2
     t = np.linspace(0.0, 1.0, rows + 1)
+    n_ref = max(n_ref, 4 * (len(rulings) - 1) + 1)          # well finer than the design
     if resample:
         dense = rulings_from_spec({**spec, "count": n_ref}, curves, base_dir=d.base_dir)
         ga, gb, gu = dense.a, dense.b, dense.u
@@ -434,7 +435,7 @@ def line_distance(p: np.ndarray, a: np.ndarray, b: np.ndarray, chunk: int = 4096
 
 
 def surface_generator_distance(p: np.ndarray, ref: Reference, iters: int = 100
-                               ) -> tuple[np.ndarray, np.ndarray]:
+                               ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Distance of points to the nearest generator of the smooth surface, and its t.
 
     Starts from the nearest dense patch point and runs Gauss-Newton on the
@@ -447,6 +448,8 @@ def surface_generator_distance(p: np.ndarray, ref: Reference, iters: int = 100
     dist : (n,) float64
     t : (n,) float64
         Line parameter of the foot (0 on c1, 1 on c2).
+    length : (n,) float64
+        Length of that generator between c1 and c2.
     """
     surf = ref.surface
     T = ref.grid.shape[1]
@@ -471,7 +474,7 @@ def surface_generator_distance(p: np.ndarray, ref: Reference, iters: int = 100
     a, b = surf.a(u), surf.b(u)
     d = b - a
     t = np.einsum("ij,ij->i", p - a, d) / np.einsum("ij,ij->i", d, d)
-    return _norm(p - a - t[:, None] * d), t
+    return _norm(p - a - t[:, None] * d), t, _norm(d)
 
 
 def quadric_distance(p: np.ndarray, ref: Reference) -> np.ndarray:
@@ -606,20 +609,60 @@ def distance_to_mesh(p: np.ndarray, tris: np.ndarray) -> np.ndarray:
 
 
 def patch_samples(ref: Reference, n_u: int = GAP_U) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """Points of the smooth patch where the gap is measured, with their (u, t).
+    """Points of the smooth patch where the gap is measured, with where they are.
 
     ``n_u`` dense generators sampled along their length, plus every dense
     generator's two end points (the borders on c1 and c2, where gaps open).
+
+    Returns
+    -------
+    points : (n, 3) float64
+    gen : (n,) int64
+        Index of the dense generator (row of ``ref.grid``) of each point.
+    t : (n,) float64
+        Line parameter on it.
     """
     N, T = ref.grid.shape[:2]
     t = np.linspace(0.0, 1.0, T)
     iu = np.unique(np.linspace(0, N - 1, min(n_u, N)).round().astype(np.int64))
-    inner = ref.grid[iu].reshape(-1, 3)
-    uu = np.repeat(ref.grid_u[iu], T)
-    tt = np.tile(t, len(iu))
-    ends = np.concatenate([ref.grid[:, 0], ref.grid[:, -1]])
-    return (np.concatenate([inner, ends]), np.concatenate([uu, ref.grid_u, ref.grid_u]),
-            np.concatenate([tt, np.zeros(N), np.ones(N)]))
+    gen = np.concatenate([np.repeat(iu, T), np.arange(N), np.arange(N)])
+    tt = np.concatenate([np.tile(t, len(iu)), np.zeros(N), np.ones(N)])
+    return _on_generators(ref, gen, tt), gen, tt
+
+
+def _on_generators(ref: Reference, gen: np.ndarray, t: np.ndarray) -> np.ndarray:
+    """Points at parameter ``t`` on dense generators ``gen`` (exact: generators are straight)."""
+    a, b = ref.grid[gen, 0], ref.grid[gen, -1]
+    return a + t[:, None] * (b - a)
+
+
+def max_gap(ref: Reference, tris: np.ndarray, worst: int = 32, fine: int = 24
+            ) -> tuple[float, int, float]:
+    """Largest distance from the smooth patch to the triangles, and where (generator, t).
+
+    The coarse samples of :func:`patch_samples` find the region; around each
+    of the ``worst`` largest, every dense generator within one sample spacing
+    is sampled ``fine`` times as densely in ``t``, so the maximum is found to
+    a small fraction of the sample spacing.
+    """
+    pts, gen, tt = patch_samples(ref)
+    gap = distance_to_mesh(pts, tris)
+    N, T = ref.grid.shape[:2]
+    du = max(1, int(np.ceil((N - 1) / max(GAP_U - 1, 1))))
+    dt = 1.0 / (T - 1)
+    top = np.argsort(gap)[::-1][:worst]
+    off_u = np.arange(-du, du + 1)
+    off_t = np.linspace(-dt, dt, 2 * fine + 1)
+    g2 = np.clip(gen[top, None, None] + off_u[None, :, None], 0, N - 1)
+    t2 = np.clip(tt[top, None, None] + off_t[None, None, :], 0.0, 1.0)
+    g2, t2 = np.broadcast_arrays(g2, t2)
+    g2, t2 = g2.ravel(), t2.ravel()
+    gap2 = distance_to_mesh(_on_generators(ref, g2, t2), tris)
+    allg = np.concatenate([gap, gap2])
+    k = int(np.argmax(allg))
+    where_g = np.concatenate([gen, g2])[k]
+    where_t = np.concatenate([tt, t2])[k]
+    return float(allg[k]), int(where_g), float(where_t)
 
 
 # --------------------------------------------------------------------------
@@ -712,21 +755,20 @@ def _against_reference(mesh: ObjMesh, verts: np.ndarray, total: float, ref: Refe
     gd = line_distance(verts, ref.a, ref.b) / diag
     out["max_design_generator_distance"] = float(gd.max())
     if ref.surface is not None and not ref.from_lines:
-        sd, t = surface_generator_distance(verts, ref)
+        sd, t, glen = surface_generator_distance(verts, ref)
         sd = np.minimum(sd / diag, gd)                         # design generators are generators
         out["max_generator_distance"] = float(sd.max())
         out["vertices_off_design_generators"] = int(np.count_nonzero(gd > 1e-9))
-        glen = _norm(ref.grid[:, -1] - ref.grid[:, 0]).mean()
-        out["max_overshoot"] = float(max(0.0, -t.min(), t.max() - 1.0) * glen / diag)
+        beyond = np.maximum(np.maximum(-t, t - 1.0), 0.0) * glen
+        out["max_overshoot"] = float(beyond.max() / diag)
     else:
         out["max_generator_distance"] = out["max_design_generator_distance"]
     if quadric:
         out["max_quadric_distance"] = float(quadric_distance(verts, ref).max() / diag)
-    pts, uu, tt = patch_samples(ref)
-    gap = distance_to_mesh(pts, _triangles(mesh)) / diag
-    worst = int(np.argmax(gap))
-    out["max_gap"] = float(gap[worst])
-    out["max_gap_at"] = {"u": float(uu[worst]), "t": float(tt[worst])}
+    gap, gen, tg = max_gap(ref, _triangles(mesh))
+    out["max_gap"] = gap / diag
+    out["max_gap_at"] = {"u": float(ref.grid_u[gen]), "t": tg,
+                         "point": _on_generators(ref, np.array([gen]), np.array([tg]))[0].tolist()}
     return out
 
 

@@ -274,3 +274,17 @@ def test_the_smooth_patch_itself_passes_and_a_hole_is_found(tmp_path):
     assert row["max_quadric_distance"] < 1e-12
     holed = quality.ObjMesh(verts, {4: np.delete(quads, len(quads) // 2, 0)}, {})
     assert quality.measure(holed, ref)["max_gap"] > 5e-3
+    # One interior vertex pushed off the surface by 1e-6 of the diagonal, and the last row
+    # of vertices moved 2 % of the generator beyond c2: both are seen.
+    moved = verts.copy()
+    moved[ids[n // 2, m // 2]] += 1e-6 * ref.diagonal * np.array([0.0, 0.0, 1.0])
+    row = quality.measure(quality.ObjMesh(moved, {4: quads}, {}), ref, quadric=True)
+    assert 1e-7 < row["max_generator_distance"] < 2e-6
+    assert 1e-7 < row["max_quadric_distance"] < 2e-6
+    beyond = verts.copy()
+    last = ids[:, -1]
+    beyond[last] += 0.02 * (g[:, -1] - g[:, 0])
+    row = quality.measure(quality.ObjMesh(beyond, {4: quads}, {}), ref)
+    length = np.linalg.norm(g[:, -1] - g[:, 0], axis=1).max()
+    assert row["max_overshoot"] == pytest.approx(0.02 * length / ref.diagonal, rel=1e-6)
+    assert row["max_generator_distance"] < 1e-12 and row["coverage"] > 1.005
