@@ -74,7 +74,8 @@ CROSS_MARGIN = 1e-9         # diagonals must cross inside (margin, 1 - margin) o
 ROUNDING = 4 * np.finfo(np.float64).eps
 REF_GENERATORS = 1601       # generators of the dense reference sampling
 REF_ROWS = 96               # divisions of each reference generator
-GAP_U = 400                 # reference generators used as gap sample lines
+GAP_U = 200                 # reference generators used as gap sample lines ...
+GAP_T = 49                  # ... sampled at this many t; refined around the worst (max_gap)
 EXIT_DESIGN_ERROR = 2
 
 
@@ -573,7 +574,7 @@ def distance_to_mesh(p: np.ndarray, tris: np.ndarray) -> np.ndarray:
     """(n,) exact distance from points to the nearest of the triangles (n_t, 3, 3).
 
     Large triangles are first bisected (same point set) to a few times the
-    median size; then an upper bound from the triangles with the nearest
+    median size or 1/64 of the extent, whichever is smaller; then an upper bound from the triangles with the nearest
     centroids, then every triangle whose bounding sphere reaches within that
     bound, by classes of triangle size (so a few long slivers do not widen
     every query).
@@ -581,7 +582,11 @@ def distance_to_mesh(p: np.ndarray, tris: np.ndarray) -> np.ndarray:
     if len(tris) == 0:
         return np.full(len(p), np.inf)
     rad0 = _norm(tris - tris.mean(axis=1)[:, None, :]).max(axis=1)
-    tris = _bisect_large(tris, 2.0 * float(np.median(rad0)))
+    flat = tris.reshape(-1, 3)
+    extent = float(_norm(flat.max(axis=0) - flat.min(axis=0)))
+    # Pieces of at most twice the median size and 1/64 of the extent: meshes of a few
+    # long strips (developable surfaces) otherwise make every triangle a candidate.
+    tris = _bisect_large(tris, min(2.0 * float(np.median(rad0)), extent / 64))
     cen = tris.mean(axis=1)
     rad = _norm(tris - cen[:, None, :]).max(axis=1)
     tree = cKDTree(cen)
@@ -593,18 +598,32 @@ def distance_to_mesh(p: np.ndarray, tris: np.ndarray) -> np.ndarray:
         tr = tris[near[:, j]]
         ub = np.minimum(ub, point_triangle_distance(p, tr[:, 0], tr[:, 1], tr[:, 2]))
     best = ub.copy()
-    cls = np.floor(np.log2(np.maximum(rad, 1e-300) / max(rad.min(), 1e-300))).astype(np.int64)
+    # Size classes a factor 4 apart; within one, the k nearest centroids, k growing only
+    # for the points whose k-th is still within reach.
+    cls = np.floor(np.log(np.maximum(rad, 1e-300) / max(rad.min(), 1e-300)) / np.log(4.0))
     for c in np.unique(cls):
         ids = np.flatnonzero(cls == c)
-        res = cKDTree(cen[ids]).query_ball_point(p, ub * (1 + 1e-9) + rad[ids].max())
-        counts = np.fromiter((len(r) for r in res), dtype=np.int64, count=len(p))
-        if counts.sum() == 0:
-            continue
-        pi = np.repeat(np.arange(len(p)), counts)
-        ti = ids[np.concatenate([np.asarray(r, dtype=np.int64) for r in res if r])]
-        tr = tris[ti]
-        dist = point_triangle_distance(p[pi], tr[:, 0], tr[:, 1], tr[:, 2])
-        np.minimum.at(best, pi, dist)
+        ctree = cKDTree(cen[ids])
+        rmax = rad[ids].max()
+        todo, k, seen = np.arange(len(p)), 8, 0
+        while todo.size:
+            kk = min(k, len(ids))
+            dist, nb = ctree.query(p[todo], k=kk)
+            dist, nb = dist.reshape(len(todo), kk)[:, seen:], nb.reshape(len(todo), kk)[:, seen:]
+            # The best distance so far bounds the answer: farther spheres cannot matter.
+            ok = dist <= (best[todo] * (1 + 1e-9) + rmax)[:, None]
+            counts = ok.sum(axis=1)
+            pi = np.repeat(todo, counts)
+            if pi.size:
+                tr = tris[ids[nb[ok]]]
+                d = point_triangle_distance(p[pi], tr[:, 0], tr[:, 1], tr[:, 2])
+                has = counts > 0                       # pairs come grouped by point
+                starts = (np.cumsum(counts) - counts)[has]
+                hit = todo[has]
+                best[hit] = np.minimum(best[hit], np.minimum.reduceat(d, starts))
+            if kk == len(ids):
+                break
+            todo, seen, k = todo[ok[:, -1]], kk, 4 * k
     return best
 
 
@@ -622,10 +641,10 @@ def patch_samples(ref: Reference, n_u: int = GAP_U) -> tuple[np.ndarray, np.ndar
     t : (n,) float64
         Line parameter on it.
     """
-    N, T = ref.grid.shape[:2]
-    t = np.linspace(0.0, 1.0, T)
+    N = len(ref.grid)
+    t = np.linspace(0.0, 1.0, GAP_T)
     iu = np.unique(np.linspace(0, N - 1, min(n_u, N)).round().astype(np.int64))
-    gen = np.concatenate([np.repeat(iu, T), np.arange(N), np.arange(N)])
+    gen = np.concatenate([np.repeat(iu, len(t)), np.arange(N), np.arange(N)])
     tt = np.concatenate([np.tile(t, len(iu)), np.zeros(N), np.ones(N)])
     return _on_generators(ref, gen, tt), gen, tt
 
@@ -636,22 +655,22 @@ def _on_generators(ref: Reference, gen: np.ndarray, t: np.ndarray) -> np.ndarray
     return a + t[:, None] * (b - a)
 
 
-def max_gap(ref: Reference, tris: np.ndarray, worst: int = 32, fine: int = 24
+def max_gap(ref: Reference, tris: np.ndarray, worst: int = 12, fine: int = 12
             ) -> tuple[float, int, float]:
     """Largest distance from the smooth patch to the triangles, and where (generator, t).
 
     The coarse samples of :func:`patch_samples` find the region; around each
-    of the ``worst`` largest, every dense generator within one sample spacing
-    is sampled ``fine`` times as densely in ``t``, so the maximum is found to
-    a small fraction of the sample spacing.
+    of the ``worst`` largest, nine dense generators across one sample spacing
+    either side are sampled ``fine`` times as densely in ``t``, so the maximum
+    is found to a small fraction of the sample spacing.
     """
     pts, gen, tt = patch_samples(ref)
     gap = distance_to_mesh(pts, tris)
-    N, T = ref.grid.shape[:2]
+    N = len(ref.grid)
     du = max(1, int(np.ceil((N - 1) / max(GAP_U - 1, 1))))
-    dt = 1.0 / (T - 1)
+    dt = 1.0 / (GAP_T - 1)
     top = np.argsort(gap)[::-1][:worst]
-    off_u = np.arange(-du, du + 1)
+    off_u = np.unique(np.linspace(-du, du, 9).round().astype(np.int64))
     off_t = np.linspace(-dt, dt, 2 * fine + 1)
     g2 = np.clip(gen[top, None, None] + off_u[None, :, None], 0, N - 1)
     t2 = np.clip(tt[top, None, None] + off_t[None, None, :], 0.0, 1.0)
