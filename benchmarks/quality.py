@@ -6,6 +6,7 @@ Usage::
     python benchmarks/quality.py --large            # ... and the 300 x 300 ones
     python benchmarks/quality.py my.toml --json q.json
     python benchmarks/quality.py --only corner --keep out/
+    python benchmarks/quality.py --baseline benchmarks/quality-before.json   # new (was old)
 
 Each design is built with ``python -m ruledmesh.cli build DESIGN -o X.obj`` in a
 subprocess; the OBJ is read back with the reader below and measured with the
@@ -38,9 +39,11 @@ bounding box):
   worst point.
 
 A design may carry a ``# quality: ...`` comment line with flags: ``general``
-(a general skew surface: the issue's triangle-share bound applies),
+(a general skew surface: the 25 % triangle-share bound applies in exact mode),
 ``near-developable``, ``large`` (only with ``--large``), ``quadric``.
-``[mesh] planarity_tolerance`` marks a tolerance-mode design.
+``[mesh] planarity_tolerance`` marks a tolerance-mode design.  A build that
+fails is reported with its error (``design-error`` for exit code 2) instead of
+figures.  ``tests/test_quality.py`` asserts the bar on these figures.
 """
 
 from __future__ import annotations
