@@ -10,9 +10,17 @@ just computed and to one read back from ``mesh.obj`` and ``offset.obj``.
   through both axes);
 * *edge-plane planarity*: the planarity of the quad ``V_i V_j W_j W_i`` (the
   beam's mid-plane), by the paper's diagonal criterion;
-* *edge parallelism*: the sine of the angle between an edge and its offset;
-* *face parallelism*: the sine of the angle between a face's normal and its
-  offset's normal.
+* *edge parallelism*: how far the offset edge leaves the direction of its
+  edge, ``|e x (W_j - W_i)| / |e|``, relative to the mesh's bounding-box
+  diagonal;
+* *face parallelism*: how far the offset face's corners leave the plane
+  through its first corner parallel to the face, relative to the diagonal
+  (0 for an offset face planar and parallel to its face).
+
+The last two are lengths relative to the model's size, not angles, so that a
+sliver edge a thousandth of the model long is judged by the same rounding
+as the rest of the model: the angle of a short edge moved far from the origin
+carries rounding of the order of the coordinates divided by its length.
 """
 
 from __future__ import annotations
@@ -21,6 +29,7 @@ import numpy as np
 
 from ..analysis.faces import face_normals, planarity, quad_planarity
 from ..mesh import Mesh
+from ..tolerances import DEFAULT, Tolerances
 
 __all__ = [
     "axis_deviation",
@@ -38,7 +47,8 @@ def _unit(v: np.ndarray) -> np.ndarray:
     return v / np.maximum(np.linalg.norm(v, axis=-1), _TINY)[..., None]
 
 
-def edge_torsion(vertices: np.ndarray, offset: np.ndarray, edges: np.ndarray) -> np.ndarray:
+def edge_torsion(vertices: np.ndarray, offset: np.ndarray, edges: np.ndarray, *,
+                 tol: Tolerances = DEFAULT) -> np.ndarray:
     """Torsion of every edge, in degrees.
 
     Parameters
@@ -46,12 +56,15 @@ def edge_torsion(vertices: np.ndarray, offset: np.ndarray, edges: np.ndarray) ->
     vertices, offset : (V, 3) float64
         The two layers; the axis at ``i`` is ``offset[i] - vertices[i]``.
     edges : (E, 2) int64
+    tol : Tolerances
+        An axis within ``tol.degenerate`` (sine) of its edge's line, or of
+        zero length, spans no plane with it: the edge counts as torsion-free
+        (the other axis and the edge are always coplanar).
 
     Returns
     -------
     (E,) float64
-        Angle in [0, 90] between the planes (edge, axis i) and (edge, axis j);
-        0 where an axis is along the edge or zero (no plane to compare).
+        Angle in [0, 90] between the planes (edge, axis i) and (edge, axis j).
     """
     i, j = edges[:, 0], edges[:, 1]
     e = _unit(vertices[j] - vertices[i])
@@ -61,7 +74,8 @@ def edge_torsion(vertices: np.ndarray, offset: np.ndarray, edges: np.ndarray) ->
     # |mi x mj| = |det(e, ai, aj)| for a unit edge vector.
     sin = np.abs(np.einsum("ij,ij->i", e, np.cross(ai, aj)))
     cos = np.abs(np.einsum("ij,ij->i", mi, mj))
-    return np.degrees(np.arctan2(sin, cos))
+    spans = np.minimum(np.linalg.norm(mi, axis=1), np.linalg.norm(mj, axis=1)) > tol.degenerate
+    return np.where(spans, np.degrees(np.arctan2(sin, cos)), 0.0)
 
 
 def edge_plane_planarity(vertices: np.ndarray, offset: np.ndarray, edges: np.ndarray) -> np.ndarray:
@@ -71,19 +85,26 @@ def edge_plane_planarity(vertices: np.ndarray, offset: np.ndarray, edges: np.nda
     return quad_planarity(quads)
 
 
+def _diagonal(vertices: np.ndarray) -> float:
+    return float(np.linalg.norm(np.ptp(vertices, axis=0))) if len(vertices) else 1.0
+
+
 def edge_parallelism(vertices: np.ndarray, offset: np.ndarray, edges: np.ndarray) -> np.ndarray:
-    """(E,) float64: sine of the angle between each edge and its offset (0 = parallel)."""
+    """(E,) float64: offset edges' departure from their edges' directions / diagonal (0 = parallel)."""
     i, j = edges[:, 0], edges[:, 1]
     a = _unit(vertices[j] - vertices[i])
-    b = _unit(offset[j] - offset[i])
-    return np.linalg.norm(np.cross(a, b), axis=1)
+    return np.linalg.norm(np.cross(a, offset[j] - offset[i]), axis=1) / (_diagonal(vertices) or 1.0)
 
 
 def face_parallelism(mesh: Mesh, offset: np.ndarray) -> np.ndarray:
-    """(F,) float64: sine of the angle between each face and its offset face."""
+    """(F,) float64: offset corners' distance from the plane parallel to their face / diagonal."""
     n0, _ = face_normals(mesh)
-    n1, _ = face_normals(mesh.with_vertices(offset))
-    return np.linalg.norm(np.cross(n0, n1), axis=1)
+    face_of = np.repeat(np.arange(mesh.n_faces), mesh.valences)
+    first = offset[mesh.face_indices[np.repeat(mesh.face_offsets[:-1], mesh.valences)]]
+    gap = np.abs(np.einsum("ij,ij->i", offset[mesh.face_indices] - first, n0[face_of]))
+    out = np.zeros(mesh.n_faces)
+    np.maximum.at(out, face_of, gap)
+    return out / (_diagonal(mesh.vertices) or 1.0)
 
 
 def offset_planarity(mesh: Mesh, offset: np.ndarray) -> np.ndarray:

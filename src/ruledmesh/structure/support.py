@@ -120,8 +120,8 @@ class SupportStructure:
         return summarise(self)
 
 
-def measure_structure(mesh: Mesh, offset: np.ndarray, edges: np.ndarray | None = None
-                      ) -> dict[str, np.ndarray]:
+def measure_structure(mesh: Mesh, offset: np.ndarray, edges: np.ndarray | None = None, *,
+                      tol: Tolerances = DEFAULT) -> dict[str, np.ndarray]:
     """Every exactness measure of a mesh and its offset layer.
 
     Parameters
@@ -130,6 +130,9 @@ def measure_structure(mesh: Mesh, offset: np.ndarray, edges: np.ndarray | None =
     offset : (V, 3) float64
     edges : (E, 2) int64, optional
         Face edges (computed when omitted).
+    tol : Tolerances
+        ``degenerate`` decides when an axis runs along its edge (see
+        :func:`~ruledmesh.structure.measures.edge_torsion`).
 
     Returns
     -------
@@ -140,7 +143,7 @@ def measure_structure(mesh: Mesh, offset: np.ndarray, edges: np.ndarray | None =
     edges = face_edges(mesh)[0] if edges is None else edges
     v = mesh.vertices
     return {
-        "torsion_deg": M.edge_torsion(v, offset, edges),
+        "torsion_deg": M.edge_torsion(v, offset, edges, tol=tol),
         "edge_planarity": M.edge_plane_planarity(v, offset, edges),
         "edge_parallelism": M.edge_parallelism(v, offset, edges),
         "offset_planarity": M.offset_planarity(mesh, offset),
@@ -155,7 +158,7 @@ def _is_exact(measures: dict[str, np.ndarray], tol: Tolerances) -> bool:
 
 
 def _candidate(mesh, offset, normals, edges, distance, tol) -> dict[str, Any]:
-    measures = measure_structure(mesh, offset, edges)
+    measures = measure_structure(mesh, offset, edges, tol=tol)
     x = offset - mesh.vertices
     along = np.einsum("ij,ij->i", x, normals) * np.sign(distance)
     dev = M.axis_deviation(x, np.sign(distance) * normals)
@@ -248,12 +251,16 @@ def support_structure(mesh: Mesh, distance: float, *, method: AxisMethod | str =
         circ = float(circularity(mesh).max(initial=0.0))
         if circ <= tol.circularity:
             axes = circular_axes(v, edges, normals)
+            cand = _candidate(mesh, v + distance * axes, normals, edges, distance, tol)
             # One projection onto the parallel space removes the rounding the
-            # reflections accumulated along the spanning tree.
+            # reflections accumulated along the spanning tree; it is kept only as
+            # a correction of rounding size (faces with an odd number of sides can
+            # make the reflected field inconsistent, and then no polish helps).
             polished = closest_parallel_offset(v, edges, axes, distance).offset
-            cand = _candidate(mesh, v + polished, normals, edges, distance, tol)
-            if not cand["exact"]:
-                cand = _candidate(mesh, v + distance * axes, normals, edges, distance, tol)
+            if np.max(np.abs(polished - distance * axes)) <= tol.degenerate * abs(distance):
+                polished_cand = _candidate(mesh, v + polished, normals, edges, distance, tol)
+                if polished_cand["exact"]:
+                    cand = polished_cand
             tried["circular"] = {**cand, "circularity_max": circ}
             if cand["exact"] or method is AxisMethod.CIRCULAR:
                 return finish(AxisMethod.CIRCULAR, cand)
