@@ -57,9 +57,9 @@ def add_parser(sub) -> None:
     p.add_argument("--axes", default="auto", choices=["auto", "circular", "parallel", "normal"],
                    help="how to choose the node axes (default auto: circular, else the closest "
                         "parallel mesh if near-normal, else the normals)")
-    p.add_argument("--max-deviation", type=float, default=10.0, metavar="DEG",
-                   help="auto: largest angle between a parallel mesh's axes and the normals "
-                        "(default 10)")
+    p.add_argument("--max-deviation", type=float, default=15.0, metavar="DEG",
+                   help="auto: largest angle between exact (circular or parallel) axes and the "
+                        "normals (default 15)")
     p.add_argument("--beams", type=_list(("edges", "generators")), default=["edges"],
                    metavar="LIST", help="beams to build: edges, generators, both "
                                         "(edges,generators) or none (default edges)")

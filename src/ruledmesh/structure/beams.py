@@ -25,7 +25,7 @@ table of what a fabricator needs per solid.
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from typing import Any
 
 import numpy as np
@@ -63,12 +63,19 @@ class Solids:
         One name per solid (``beam 12``, ``panel 3``, ``generator 5``).
     table : dict of (S,) arrays
         Per-solid columns (see the functions that make them).
+    skipped : (K,) int64
+        Edges, generators or faces that got no solid, because it would
+        not be a valid solid there (see ``skip_reason``).
+    skip_reason : str
+        Why, for the notes of ``structure.json``; empty when nothing was skipped.
     """
 
     mesh: Mesh
     solid: np.ndarray
     names: list[str]
     table: dict[str, np.ndarray]
+    skipped: np.ndarray = field(default_factory=lambda: np.zeros(0, np.int64))
+    skip_reason: str = ""
 
     @property
     def count(self) -> int:
@@ -121,13 +128,20 @@ def _slabs(p0, p1, q0, q1, normal, width) -> tuple[np.ndarray, np.ndarray]:
     return corners.reshape(-1, 3), faces
 
 
-def _box_solids(vertices, faces, names, table, info) -> Solids:
-    s = len(names)
+def _box_solids(vertices, faces, names, table, info, keep: np.ndarray, reason: str) -> Solids:
+    """The boxes whose ``keep`` is true, as Solids (the others listed as skipped)."""
+    vertices = vertices.reshape(-1, 8, 3)[keep].reshape(-1, 3)
+    faces = faces.reshape(-1, 6, 4)[keep]
+    faces = (faces - faces[:, :1, :1] + 8 * np.arange(len(faces))[:, None, None]).reshape(-1, 4)
+    s = int(np.count_nonzero(keep))
     solid = np.repeat(np.arange(s), 6)
     offsets = np.arange(len(faces) + 1, dtype=np.int64) * 4
     idx = _orient_outwards(vertices, offsets, faces.reshape(-1), solid, s)
     mesh = Mesh(vertices, offsets, idx, np.full(len(faces), FaceKind.QUAD, np.uint8), info=info)
-    return Solids(mesh, solid, names, table)
+    skipped = np.flatnonzero(~keep)
+    return Solids(mesh, solid, [n for n, k in zip(names, keep.tolist()) if k],
+                  {k: np.asarray(v)[keep] for k, v in table.items()}, skipped,
+                  reason if skipped.size else "")
 
 
 def edge_setbacks(structure: SupportStructure, width: float) -> np.ndarray:
@@ -223,7 +237,9 @@ def edge_beams(structure: SupportStructure, width: float, *, depth: float | None
     # Project the bottoms into the beam plane: exact already where torsion-free.
     b0 = b0 - np.einsum("ij,ij->i", b0 - v[i], m)[:, None] * m
     b1 = b1 - np.einsum("ij,ij->i", b1 - v[j], m)[:, None] * m
-    back = _fit_setbacks(back, length, np.einsum("ij,ij->i", b1 - b0, eu))
+    bottom = np.einsum("ij,ij->i", b1 - b0, eu)
+    keep = bottom > 0.0
+    back = _fit_setbacks(back, length, np.where(keep, bottom, length))
     p0 = v[i] + back[:, :1] * eu
     p1 = v[j] - back[:, 1:] * eu
     q0 = b0 + back[:, :1] * eu
@@ -233,15 +249,13 @@ def edge_beams(structure: SupportStructure, width: float, *, depth: float | None
              "setback0": back[:, 0], "setback1": back[:, 1],
              "depth0": np.linalg.norm(b0 - v[i], axis=1), "depth1": np.linalg.norm(b1 - v[j], axis=1)}
     names = [f"beam {k}" for k in range(len(edges))]
-    return _box_solids(verts, faces, names, table, {"construction": "edge beams", "width": width})
+    return _box_solids(verts, faces, names, table, {"construction": "edge beams", "width": width},
+                       keep, "their offset edge runs backwards (the offset or depth is larger "
+                             "than the radius of curvature there)")
 
 
 def _fit_setbacks(back: np.ndarray, top: np.ndarray, bottom: np.ndarray) -> np.ndarray:
     """Setbacks scaled down where they would leave less than 10 % of a beam's top or bottom."""
-    if np.any(bottom <= 0.0):
-        raise GeometryError(f"{int(np.count_nonzero(bottom <= 0.0))} offset edges run backwards "
-                            "(the offset is larger than the curvature radius there); "
-                            "use a smaller offset or depth")
     room = 0.9 * np.minimum(top, bottom)
     total = back.sum(axis=1)
     scale = np.where(total > room, room / np.maximum(total, _TINY), 1.0)
@@ -331,6 +345,7 @@ def generator_beams(structure: SupportStructure, width: float, *,
     misfit = np.maximum(90.0 - _angle(m, _unit(b0 - v[n0])), 90.0 - _angle(m, _unit(b1 - v[n1])))
     b0 = b0 - np.einsum("ij,ij->i", b0 - v[n0], m)[:, None] * m
     b1 = b1 - np.einsum("ij,ij->i", b1 - v[n1], m)[:, None] * m
+    keep = np.einsum("ij,ij->i", b0 - v[n0], b1 - v[n1]) > 0.0
     verts, faces = _slabs(v[n0], v[n1], b0, b1, m, width)
     table = {"generator": sched["generator"], "node0": n0, "node1": n1, "length": sched["length"],
              "axis_misfit_deg": misfit,
@@ -339,7 +354,9 @@ def generator_beams(structure: SupportStructure, width: float, *,
              "depth0": np.linalg.norm(b0 - v[n0], axis=1),
              "depth1": np.linalg.norm(b1 - v[n1], axis=1)}
     names = [f"generator {k}" for k in sched["generator"].tolist()]
-    return _box_solids(verts, faces, names, table, {"construction": "generator beams", "width": width})
+    return _box_solids(verts, faces, names, table,
+                       {"construction": "generator beams", "width": width}, keep,
+                       "the axes at their two ends point to opposite sides of the generator")
 
 
 def _panel_faces(offsets: np.ndarray, nxt: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
@@ -407,31 +424,35 @@ def thick_panels(structure: SupportStructure, thickness: float, *, side: str = "
     thickness = check_float(thickness, "thickness", lo=0.0, lo_open=True)
     if side not in ("outer", "inner"):
         raise ParameterError(f'expected "outer" or "inner", got "{side}"', "side")
-    mesh = structure.mesh
-    normals, area = face_normals(mesh)
+    full = structure.mesh
+    normals, area = face_normals(full)
+    sign = -1.0 if side == "outer" else 1.0
+    face_of = np.repeat(np.arange(full.n_faces), full.valences)
+    cos = np.einsum("ij,ij->i", sign * structure.axes[full.face_indices], normals[face_of])
+    first = np.repeat(full.face_offsets[:-1], full.valences)
+    # A panel needs every corner's axis well out of its plane, all on one side.
+    bad_corner = (np.abs(cos) < _MIN_AXIS_COS) | (np.sign(cos) != np.sign(cos[first]))
+    good = np.bincount(face_of, bad_corner, minlength=full.n_faces) == 0
+    mesh = full.select_faces(good)
+    keep_corner = good[face_of]
+    cos, face_ids = cos[keep_corner], np.flatnonzero(good)
     _, _, nxt = face_edges(mesh)
     idx = mesh.face_indices
-    face_of = np.repeat(np.arange(mesh.n_faces), mesh.valences)
-    axes = structure.axes[idx] * (-1.0 if side == "outer" else 1.0)
-    cos = np.einsum("ij,ij->i", axes, normals[face_of])
-    if np.any(np.abs(cos) < _MIN_AXIS_COS):
-        bad = np.unique(face_of[np.abs(cos) < _MIN_AXIS_COS])
-        raise GeometryError(f"{bad.size} faces have node axes almost in their plane "
-                            f"(first: face {int(bad[0])}); no panel thickness along such axes")
-    first = np.repeat(mesh.face_offsets[:-1], mesh.valences)
-    if np.any(np.sign(cos) != np.sign(cos[first])):
-        raise GeometryError("some faces have node axes on both sides of their plane")
+    local_face = np.repeat(np.arange(mesh.n_faces), mesh.valences)
     top = mesh.vertices[idx]
-    bottom = top + (thickness / np.abs(cos))[:, None] * axes
+    bottom = top + (thickness / np.abs(cos))[:, None] * (sign * structure.axes[idx])
     verts = np.concatenate([top, bottom])
     offsets, indices, solid = _panel_faces(mesh.face_offsets, nxt)
     indices = _orient_outwards(verts, offsets, indices, solid, mesh.n_faces)
     sides = np.stack([top[nxt], top, bottom, bottom[nxt]], axis=1)
     side_plan = np.zeros(mesh.n_faces)
-    np.maximum.at(side_plan, face_of, quad_planarity(sides))
+    np.maximum.at(side_plan, local_face, quad_planarity(sides))
     out = Mesh(verts, offsets, indices, np.full(len(offsets) - 1, FaceKind.POLYGON, np.uint8),
                info={"construction": "thick panels", "thickness": thickness})
-    table: dict[str, Any] = {"face": np.arange(mesh.n_faces), "kind": mesh.face_kind.astype(np.int64),
+    table: dict[str, Any] = {"face": face_ids, "kind": mesh.face_kind.astype(np.int64),
                              "sides": mesh.valences, "thickness": np.full(mesh.n_faces, thickness),
-                             "side_planarity_max": side_plan, "area": area}
-    return Solids(out, solid, [f"panel {k}" for k in range(mesh.n_faces)], table)
+                             "side_planarity_max": side_plan, "area": area[good]}
+    skipped = np.flatnonzero(~good)
+    return Solids(out, solid, [f"panel {k}" for k in face_ids.tolist()], table, skipped,
+                  "their node axes lie almost in their plane (more than 84 degrees from the "
+                  "normal) or on both sides of it" if skipped.size else "")

@@ -162,6 +162,15 @@ def write_structure(structure: SupportStructure, folder: str | os.PathLike, *,
     notes: list[str] = []
     fmts = _formats(formats, notes)
     solids = _plan(structure, beams, width, depth, setback, thickness, panel_side)
+    for stem, sol in solids.items():
+        if sol.skipped.size:
+            shown = ", ".join(map(str, sol.skipped[:10].tolist()))
+            more = f" and {sol.skipped.size - 10} more" if sol.skipped.size > 10 else ""
+            notes.append(f"{stem}: {sol.skipped.size} left out ({shown}{more}): {sol.skip_reason}")
+    folded = int(structure.summary()["reversed_edges"])
+    if folded:
+        notes.append(f"the offset layer folds over: {folded} offset edges run against their "
+                     "edges (the offset is larger than the radius of curvature there)")
     mesh = structure.mesh
     files: list[tuple[str, Callable[[], bytes]]] = [
         ("mesh.obj", lambda: obj_dumpb(mesh)),
@@ -185,7 +194,8 @@ def write_structure(structure: SupportStructure, folder: str | os.PathLike, *,
     summary = structure.summary()
     summary.update({
         "unit": unit,
-        "solids": {stem: {"count": sol.count, **_solid_stats(sol)} for stem, sol in solids.items()},
+        "solids": {stem: {"count": sol.count, "skipped": sol.skipped.tolist(), **_solid_stats(sol)}
+                   for stem, sol in solids.items()},
         "options": options or {}, "notes": notes,
         "files": [name for name, _ in blobs] + ["structure.json"],
     })

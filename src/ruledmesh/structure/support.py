@@ -7,7 +7,8 @@ to choose the axes, tried in this order by ``method="auto"``:
 ``circular``
     The mesh is circular (every face has a circumcircle): exact vertex
     offsets through the circles' axes, at the constant distance ``D``
-    (:mod:`~ruledmesh.structure.circular`).
+    (:mod:`~ruledmesh.structure.circular`); taken when exact, on the side of
+    ``D`` and within ``max_deviation`` degrees of the vertex normals.
 ``parallel``
     The member of the linear space of parallel meshes closest to
     ``V + D N`` (:mod:`~ruledmesh.structure.parallel`): exact wherever the
@@ -168,6 +169,19 @@ def _candidate(mesh, offset, normals, edges, distance, tol) -> dict[str, Any]:
             "torsion_max_deg": float(measures["torsion_deg"].max(initial=0.0))}
 
 
+def _acceptable(cand: dict[str, Any], max_deviation: float) -> bool:
+    return bool(cand["exact"] and cand["same_side"] and cand["deviation_max_deg"] <= max_deviation)
+
+
+def _why_not(cand: dict[str, Any], max_deviation: float) -> str:
+    if not cand["exact"]:
+        return "not exact"
+    if not cand["same_side"]:
+        return "some axes point to the other side of the mesh"
+    return (f"axes deviate up to {cand['deviation_max_deg']:.3g} deg from the normals "
+            f"(limit {max_deviation:g})")
+
+
 def _prepare(mesh: Mesh, distance: float) -> tuple[Mesh, np.ndarray, np.ndarray]:
     if not isinstance(mesh, Mesh):
         raise ParameterError(f"expected a Mesh, got {type(mesh).__name__}", "mesh")
@@ -200,7 +214,7 @@ def tol_degenerate(scale: float, tol: Tolerances = DEFAULT) -> float:
 
 
 def support_structure(mesh: Mesh, distance: float, *, method: AxisMethod | str = "auto",
-                      max_deviation: float = 10.0, tol: Tolerances = DEFAULT) -> SupportStructure:
+                      max_deviation: float = 15.0, tol: Tolerances = DEFAULT) -> SupportStructure:
     """Node axes and the offset layer of ``mesh`` at distance ``distance``.
 
     Parameters
@@ -215,8 +229,8 @@ def support_structure(mesh: Mesh, distance: float, *, method: AxisMethod | str =
         circular; ``"parallel"`` takes the closest parallel mesh whatever its
         deviation from the normals.
     max_deviation : float
-        ``"auto"`` accepts the parallel mesh when no axis deviates more than
-        this from its normal, in degrees.
+        ``"auto"`` accepts the circular or the parallel axes when none
+        deviates more than this from its normal, in degrees.
     tol : Tolerances
         ``planarity`` decides exactness, ``circularity`` whether the mesh is
         circular.
@@ -261,8 +275,13 @@ def support_structure(mesh: Mesh, distance: float, *, method: AxisMethod | str =
                 polished_cand = _candidate(mesh, v + polished, normals, edges, distance, tol)
                 if polished_cand["exact"]:
                     cand = polished_cand
-            tried["circular"] = {**cand, "circularity_max": circ}
-            if cand["exact"] or method is AxisMethod.CIRCULAR:
+            accept = _acceptable(cand, max_deviation)
+            if accept:
+                tried["circular"] = {**cand, "circularity_max": circ}
+            else:
+                tried["circular"] = {**cand, "circularity_max": circ,
+                                     "rejected": _why_not(cand, max_deviation)}
+            if accept or method is AxisMethod.CIRCULAR:
                 return finish(AxisMethod.CIRCULAR, cand)
         elif method is AxisMethod.CIRCULAR:
             raise GeometryError(f"the mesh is not circular (largest circularity {circ:.3g}, "
@@ -272,19 +291,22 @@ def support_structure(mesh: Mesh, distance: float, *, method: AxisMethod | str =
     if method in (AxisMethod.AUTO, AxisMethod.PARALLEL):
         fit = closest_parallel_offset(v, edges, normals, distance)
         cand = _candidate(mesh, v + fit.offset, normals, edges, distance, tol)
-        accept = cand["exact"] and cand["same_side"] and cand["deviation_max_deg"] <= max_deviation
+        accept = _acceptable(cand, max_deviation)
         if not accept:
-            why = ("not exact" if not cand["exact"] else "axes cross the mesh"
-                   if not cand["same_side"] else
-                   f"axes deviate up to {cand['deviation_max_deg']:.3g} deg from the normals "
-                   f"(limit {max_deviation:g})")
-            cand = {**cand, "rejected": why}
+            cand = {**cand, "rejected": _why_not(cand, max_deviation)}
         tried["parallel"] = cand
         if accept or method is AxisMethod.PARALLEL:
             return finish(AxisMethod.PARALLEL, cand)
     cand = _candidate(mesh, v + distance * normals, normals, edges, distance, tol)
     tried["normal"] = cand
     return finish(AxisMethod.NORMAL, cand)
+
+
+def _reversed_edges(s: SupportStructure) -> int:
+    """Offset edges pointing against their edges: the offset layer folds over there."""
+    i, j = s.edges[:, 0], s.edges[:, 1]
+    v, w = s.mesh.vertices, s.offset
+    return int(np.count_nonzero(np.einsum("ij,ij->i", v[j] - v[i], w[j] - w[i]) <= 0.0))
 
 
 def _stats(values: np.ndarray) -> dict[str, float]:
@@ -308,6 +330,7 @@ def summarise(s: SupportStructure) -> dict[str, Any]:
         "torsion_max_deg": float(torsion.max(initial=0.0)),
         "torsion_median_deg": float(np.median(torsion)) if torsion.size else 0.0,
         "twisted_edges": twisted,
+        "reversed_edges": _reversed_edges(s),
         "edges": len(s.edges),
         "axis_deviation_deg": {"median": float(np.median(dev)), "max": float(dev.max())},
         "offset_distance": {**_stats(lengths), "ratio_to_offset": {
