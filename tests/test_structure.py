@@ -22,7 +22,11 @@ from ruledmesh.constructions import hyperboloid_mesh, torus_mesh
 from ruledmesh.design import build_file
 from ruledmesh.errors import GeometryError, ParameterError
 from ruledmesh.mesh import Mesh
-from ruledmesh.structure import closest_parallel_offset, measure_structure, support_structure
+from ruledmesh.structure import (
+    closest_parallel_offset,
+    measure_structure,
+    support_structure,
+)
 from ruledmesh.structure.beams import edge_beams, generator_beams, thick_panels
 from ruledmesh.structure.normals import face_edges, vertex_normals
 

@@ -289,7 +289,7 @@ def edge_table(structure: SupportStructure) -> dict[str, np.ndarray]:
     mesh, edges = structure.mesh, structure.edges
     sched = edge_schedule(mesh)
     if not np.array_equal(np.stack([sched["v0"], sched["v1"]], 1), edges):
-        raise GeometryError("edge schedule and structure edges disagree")  # a bug, not bad input
+        raise RuntimeError("edge schedule and structure edges disagree")  # a bug, not bad input
     v = mesh.vertices
     eu = _unit(v[edges[:, 1]] - v[edges[:, 0]])
     a0, a1 = structure.axes[edges[:, 0]], structure.axes[edges[:, 1]]

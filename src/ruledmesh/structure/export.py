@@ -15,7 +15,6 @@ Lengths are in the mesh's units (IFC: metres, as :mod:`ruledmesh.io.ifc`).
 
 from __future__ import annotations
 
-import io
 import os
 import tempfile
 
