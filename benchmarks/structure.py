@@ -14,6 +14,7 @@ from __future__ import annotations
 import argparse
 import json
 import time
+from functools import partial
 from pathlib import Path
 
 from ruledmesh.design import build_design, parse_design
@@ -39,10 +40,10 @@ def run(sizes: list[int]) -> list[dict]:
         text = SKEW.read_text().replace("count = 41", f"count = {n + 1}").replace(
             "rows = 40 ", f"rows = {n} ")
         mesh = build_design(parse_design(text, "skew.toml", SKEW.parent)).mesh
-        d = 0.05 * mesh.diagonal()
-        t_s, s = _best(lambda: support_structure(mesh, d))
-        t_b, beams = _best(lambda: edge_beams(s, 0.002 * mesh.diagonal()))
-        t_o, _ = _best(lambda: solids_obj(beams))
+        d, width = 0.05 * mesh.diagonal(), 0.002 * mesh.diagonal()
+        t_s, s = _best(partial(support_structure, mesh, d))
+        t_b, beams = _best(partial(edge_beams, s, width))
+        t_o, _ = _best(partial(solids_obj, beams))
         rows.append({"n": n, "vertices": mesh.n_vertices, "faces": mesh.n_faces,
                      "structure_s": t_s, "beams_s": t_b, "beams_obj_s": t_o,
                      "method": s.method.value})

@@ -7,10 +7,11 @@ from __future__ import annotations
 
 from pathlib import Path
 
+from ruledmesh.constructions import hyperboloid_mesh
 from ruledmesh.design import build_file
 from ruledmesh.io import write_atomic
 from ruledmesh.structure import support_structure
-from ruledmesh.structure.beams import edge_beams
+from ruledmesh.structure.beams import edge_beams, thick_panels
 from ruledmesh.structure.figure import render_structure
 
 ROOT = Path(__file__).resolve().parent.parent
@@ -38,6 +39,14 @@ def main() -> None:
         write_atomic(IMG / f"{name}.png", render_structure(s, beams=solids, view=view,
                                                            size=(1000, 800), title=title))
         print(f"wrote docs/img/{name}.png")
+    # A close-up: a coarse hyperboloid strip with edge beams and 4 cm thick panels.
+    s = support_structure(hyperboloid_mesh(1.0, 1.5, 0.6, 12, 2), -0.25)
+    picture = render_structure(s, beams=edge_beams(s, 0.04), panels=thick_panels(s, 0.04),
+                               view=(40.0, -70.0), size=(1000, 700),
+                               title="circular axes, edge beams 0.04 wide to the offset layer, "
+                                     "panels 0.04 thick")
+    write_atomic(IMG / "structure-detail.png", picture)
+    print("wrote docs/img/structure-detail.png")
 
 
 if __name__ == "__main__":

@@ -29,6 +29,7 @@ def _polygons(mesh: Mesh) -> np.ndarray:
 
 
 def render_structure(structure: SupportStructure, *, beams: Solids | None = None,
+                     panels: Solids | None = None,
                      view: tuple[float, float] = (25.0, -60.0), size: tuple[int, int] = (1000, 800),
                      dpi: int = 100, title: str | None = None, fmt: str = "png") -> bytes:
     """The picture of ``structure`` as image bytes.
@@ -38,6 +39,9 @@ def render_structure(structure: SupportStructure, *, beams: Solids | None = None
     structure : SupportStructure
     beams : Solids, optional
         Beams to draw (e.g. :func:`~ruledmesh.structure.beams.edge_beams`).
+    panels : Solids, optional
+        Thick panels to draw (:func:`~ruledmesh.structure.beams.thick_panels`),
+        translucent blue instead of the mesh's faces.
     view : (elevation, azimuth) in degrees
     size : (width, height) in pixels
     dpi : int
@@ -62,8 +66,10 @@ def render_structure(structure: SupportStructure, *, beams: Solids | None = None
     fig = Figure(figsize=(size[0] / dpi, size[1] / dpi), dpi=dpi)
     FigureCanvasAgg(fig)
     ax = fig.add_axes((-0.02, -0.05, 0.88, 1.1), projection="3d", computed_zorder=False)
-    ax.add_collection3d(Poly3DCollection(_polygons(mesh), facecolors="#9ecae1", alpha=0.55,
-                                         edgecolors="none"))
+    shown = mesh if panels is None else panels.mesh
+    ax.add_collection3d(Poly3DCollection(_polygons(shown), facecolors="#9ecae1", alpha=0.55,
+                                         edgecolors="none" if panels is None else "#3182bd40",
+                                         linewidths=0.2))
     ax.add_collection3d(Poly3DCollection(_polygons(mesh.with_vertices(w)), facecolors="#d9d9d9",
                                          alpha=0.3, edgecolors="#80808060", linewidths=0.2))
     if beams is not None:

@@ -188,7 +188,7 @@ def write_structure(structure: SupportStructure, folder: str | os.PathLike, *,
         from .figure import render_structure
 
         files.append(("structure.png", lambda: render_structure(
-            structure, beams=solids.get("beams"))))
+            structure, beams=solids.get("beams"), panels=solids.get("panels"))))
     # Serialise everything before the first write: a refusal leaves the folder as it was.
     blobs = [(name, make()) for name, make in files]
     summary = structure.summary()
