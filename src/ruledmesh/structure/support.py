@@ -169,6 +169,24 @@ def _candidate(mesh, offset, normals, edges, distance, tol) -> dict[str, Any]:
             "torsion_max_deg": float(measures["torsion_deg"].max(initial=0.0))}
 
 
+def _circular_candidate(mesh: Mesh, edges: np.ndarray, normals: np.ndarray, distance: float,
+                        tol: Tolerances) -> dict[str, Any]:
+    """The circular offset at ``distance``, measured."""
+    v = mesh.vertices
+    axes = circular_axes(v, edges, normals)
+    cand = _candidate(mesh, v + distance * axes, normals, edges, distance, tol)
+    # One projection onto the parallel space removes the rounding the
+    # reflections accumulated along the spanning tree; it is kept only as a
+    # correction of rounding size (faces with an odd number of sides can make
+    # the reflected field inconsistent, and then no polish helps).
+    polished = closest_parallel_offset(v, edges, axes, distance).offset
+    if np.max(np.abs(polished - distance * axes)) <= tol.degenerate * abs(distance):
+        polished_cand = _candidate(mesh, v + polished, normals, edges, distance, tol)
+        if polished_cand["exact"]:
+            return polished_cand
+    return cand
+
+
 def _acceptable(cand: dict[str, Any], max_deviation: float) -> bool:
     return bool(cand["exact"] and cand["same_side"] and cand["deviation_max_deg"] <= max_deviation)
 
@@ -264,23 +282,11 @@ def support_structure(mesh: Mesh, distance: float, *, method: AxisMethod | str =
     if method in (AxisMethod.AUTO, AxisMethod.CIRCULAR):
         circ = float(circularity(mesh).max(initial=0.0))
         if circ <= tol.circularity:
-            axes = circular_axes(v, edges, normals)
-            cand = _candidate(mesh, v + distance * axes, normals, edges, distance, tol)
-            # One projection onto the parallel space removes the rounding the
-            # reflections accumulated along the spanning tree; it is kept only as
-            # a correction of rounding size (faces with an odd number of sides can
-            # make the reflected field inconsistent, and then no polish helps).
-            polished = closest_parallel_offset(v, edges, axes, distance).offset
-            if np.max(np.abs(polished - distance * axes)) <= tol.degenerate * abs(distance):
-                polished_cand = _candidate(mesh, v + polished, normals, edges, distance, tol)
-                if polished_cand["exact"]:
-                    cand = polished_cand
+            cand = _circular_candidate(mesh, edges, normals, distance, tol)
             accept = _acceptable(cand, max_deviation)
-            if accept:
-                tried["circular"] = {**cand, "circularity_max": circ}
-            else:
-                tried["circular"] = {**cand, "circularity_max": circ,
-                                     "rejected": _why_not(cand, max_deviation)}
+            tried["circular"] = {**cand, "circularity_max": circ}
+            if not accept:
+                tried["circular"]["rejected"] = _why_not(cand, max_deviation)
             if accept or method is AxisMethod.CIRCULAR:
                 return finish(AxisMethod.CIRCULAR, cand)
         elif method is AxisMethod.CIRCULAR:
