@@ -99,6 +99,13 @@ def _check(args) -> None:
         raise ParameterError(f"expected a number >= 0 or auto, got {args.setback:g}", "--setback")
 
 
+def _progress(quiet: bool):
+    """A progress line per file on a terminal; nothing in pipes and logs."""
+    if quiet or not sys.stderr.isatty():
+        return None
+    return lambda name: print(f"making {name} ...", file=sys.stderr, flush=True)
+
+
 # Library parameter -> the command-line option that sets it.
 _OPTION_OF = {"distance": "--offset", "method": "--axes", "max_deviation": "--max-deviation"}
 
@@ -129,7 +136,8 @@ def run(args) -> int:
     summary = write_structure(structure, args.output, beams=args.beams, width=args.width,
                               depth=args.depth, setback=args.setback, thickness=args.thickness,
                               panel_side=args.panel_side, formats=args.formats, unit=args.unit,
-                              render=args.render, options=options)
+                              render=args.render, options=options,
+                              progress=_progress(args.quiet))
     for note in summary["notes"]:
         print(f"warning: {note}", file=sys.stderr)
     if not args.quiet:

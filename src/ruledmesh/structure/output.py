@@ -127,7 +127,8 @@ def write_structure(structure: SupportStructure, folder: str | os.PathLike, *,
                     depth: float | None = None, setback: float | str = "auto",
                     thickness: float | None = None, panel_side: str = "outer",
                     formats: Iterable[str] | None = None, unit: str = "",
-                    render: bool = False, options: dict[str, Any] | None = None) -> dict[str, Any]:
+                    render: bool = False, options: dict[str, Any] | None = None,
+                    progress: Callable[[str], None] | None = None) -> dict[str, Any]:
     """Write the structure's files into ``folder`` (created if missing).
 
     Parameters
@@ -152,6 +153,9 @@ def write_structure(structure: SupportStructure, folder: str | os.PathLike, *,
         Also write ``structure.png`` (needs matplotlib).
     options : dict, optional
         Recorded in ``structure.json`` as given (the command line's options).
+    progress : callable, optional
+        Called with each file's name before it is made (IFC files of
+        thousands of solids take seconds).
 
     Returns
     -------
@@ -190,7 +194,11 @@ def write_structure(structure: SupportStructure, folder: str | os.PathLike, *,
         files.append(("structure.png", lambda: render_structure(
             structure, beams=solids.get("beams"), panels=solids.get("panels"))))
     # Serialise everything before the first write: a refusal leaves the folder as it was.
-    blobs = [(name, make()) for name, make in files]
+    blobs = []
+    for name, make in files:
+        if progress is not None:
+            progress(name)
+        blobs.append((name, make()))
     summary = structure.summary()
     summary.update({
         "unit": unit,
