@@ -128,21 +128,32 @@ def test_hyperboloids_give_an_exact_structure_in_the_files(tmp_path, name):
     assert report["torsion_max_deg"] == pytest.approx(torsion_from_files(v, w, edges).max(), abs=1e-9)
 
 
-@pytest.mark.parametrize("name", TWISTED)
-def test_reported_torsion_matches_the_files(tmp_path, name):
+def exact_in_files(v, w, faces, edges) -> bool:
+    """Exactness as the files show it: edge planes and offset faces planar to 1e-12."""
+    worst_plane = max(plane_gap(np.array([v[i], v[j], w[j], w[i]])) for i, j in edges)
+    worst_face = max((plane_gap(w[f]) for f in faces if len(f) > 3), default=0.0)
+    return worst_plane <= 1e-12 and worst_face <= 1e-12
+
+
+# The helicoid is a catalogue construction; the skew mesh comes from the §4.3 mesher,
+# whose meshes may change: for it only the agreement of report and files is required,
+# and the normal axes (never torsion-free on a skew surface) the inexact case.
+@pytest.mark.parametrize("name, axes", [("fig8-helicoid", "auto"), ("skew", "auto"),
+                                        ("skew", "normal")])
+def test_reported_torsion_matches_the_files(tmp_path, name, axes):
     mesh = build_file(EXAMPLES / f"{name}.toml").mesh
-    out, report = run_structure(tmp_path, EXAMPLES / f"{name}.toml", 0.05 * mesh.diagonal())
+    out, report = run_structure(tmp_path, EXAMPLES / f"{name}.toml", 0.05 * mesh.diagonal(),
+                                "--axes", axes)
     v, _ = read_obj(out / "mesh.obj")
     w, _ = read_obj(out / "offset.obj")
     faces = obj_faces_in_order(out / "mesh.obj")
     edges = edges_of(faces)
     torsion = torsion_from_files(v, w, edges)
     assert report["torsion_max_deg"] == pytest.approx(torsion.max(), abs=1e-8)
-    # Near-normal axes on these meshes are not torsion-free, and the report says so.
-    assert torsion.max() > 1.0
-    assert report["exact"] is False
-    gaps = [plane_gap(np.array([v[i], v[j], w[j], w[i]])) for i, j in edges]
-    assert max(gaps) > 1e-12
+    assert report["exact"] is exact_in_files(v, w, faces, edges)
+    if name == "fig8-helicoid" or axes == "normal":
+        # Near-normal axes on these meshes are not torsion-free, and the report says so.
+        assert torsion.max() > 1.0 and report["exact"] is False
     # The per-edge schedule carries the same torsion, edge by edge.
     with open(out / "edges.csv", newline="") as fh:
         rows = list(csv.DictReader(fh))
@@ -154,7 +165,7 @@ def test_reported_torsion_matches_the_files(tmp_path, name):
 
 @pytest.mark.parametrize("name", TWISTED)
 def test_exact_only_when_it_is(tmp_path, name):
-    """Forcing the closest parallel mesh gives an exact, far-from-normal structure."""
+    """Forcing the closest parallel mesh gives an exact structure, far from normal on the helicoid."""
     mesh = build_file(EXAMPLES / f"{name}.toml").mesh
     out, report = run_structure(tmp_path, EXAMPLES / f"{name}.toml", 0.05 * mesh.diagonal(),
                                 "--axes", "parallel")
@@ -162,11 +173,10 @@ def test_exact_only_when_it_is(tmp_path, name):
     w, _ = read_obj(out / "offset.obj")
     faces = obj_faces_in_order(out / "mesh.obj")
     edges = edges_of(faces)
-    worst_plane = max(plane_gap(np.array([v[i], v[j], w[j], w[i]])) for i, j in edges)
-    worst_face = max(plane_gap(w[f]) for f in faces if len(f) > 3)
-    assert report["exact"] is (worst_plane <= 1e-12 and worst_face <= 1e-12)
+    assert report["exact"] is exact_in_files(v, w, faces, edges)
     assert report["exact"] is True
-    assert report["axis_deviation_deg"]["max"] > 15.0     # why auto refuses it (default limit)
+    if name == "fig8-helicoid":
+        assert report["axis_deviation_deg"]["max"] > 15.0     # why auto refuses it
     assert report["torsion_max_deg"] == pytest.approx(torsion_from_files(v, w, edges).max(), abs=1e-8)
 
 
