@@ -245,7 +245,7 @@ def test_svg_and_dxf_sheets_read_back(tmp_path):
             d = np.linalg.norm(np.roll(pts, -1, axis=0) - pts, axis=1)
             np.testing.assert_allclose(d, len3[mesh.face_offsets[f]:mesh.face_offsets[f + 1]],
                                        atol=1e-9)
-            assert f"#{f}" in texts
+            assert f"P{f}" in texts
             assert f"{d[0]:.3f}" in texts
         doc = ezdxf.readfile(tmp_path / "sheets" / f"sheet-{s:03d}.dxf")
         auditor = doc.audit()
