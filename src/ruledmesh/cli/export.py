@@ -36,6 +36,9 @@ def add_parser(sub) -> None:
                         "corner in whole units); recorded in the header")
     p.add_argument("--panels", choices=["each", "joined"], default="each",
                    help="IFC/3DM: one object per panel (default) or one per face kind")
+    p.add_argument("--extras", choices=["file", "inline", "omit"], default="file",
+                   help="PLY: face kinds and generators in NAME.ruledmesh.ply (default; every "
+                        "reader takes NAME.ply), inline in one file (not meshio), or omitted")
     p.add_argument("-q", "--quiet", action="store_true", help="print nothing on success")
     p.set_defaults(run=run)
 
@@ -79,7 +82,7 @@ def run(args) -> int:
     module = _module(output.suffix.lower(), WRITERS, "write")
     accepted = inspect.signature(module.dumpb).parameters
     options = {"shading": args.shading, "quads": args.quads, "design": design,
-               "origin": _origin(args.origin), "panels": args.panels}
+               "origin": _origin(args.origin), "panels": args.panels, "extras": args.extras}
     options = {k: v for k, v in options.items() if k in accepted and v is not None}
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always", RuledMeshWarning)

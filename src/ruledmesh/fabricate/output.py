@@ -29,6 +29,7 @@ from ..io import write_atomic
 from ..mesh import Mesh
 from ..tolerances import DEFAULT, Tolerances
 from . import hotwire as hw
+from . import machine as hm
 from .nesting import layout
 from .panels import congruence_classes, panel_statistics, panel_table
 from .schedules import csv_bytes, edge_schedule, member_schedule, node_schedule
@@ -38,12 +39,31 @@ from .unroll import unroll
 __all__ = ["fabricate"]
 
 
+def _hotwire(mesh: Mesh, unit: str, machine: hm.Machine, **options: Any):
+    """The wire path on ``machine`` and its G-code; raises before anything is written."""
+    path = hw.wire_paths(mesh, **options)
+    if machine.wire_length is not None:
+        _, k = hm.machine_unit(unit)
+        axis = hw.AXES[path.span]
+        lo, hi = mesh.bounding_box()[:, axis]
+        length = machine.wire_length / k
+        if hi - lo > length * (1 + 1e-12):
+            raise GeometryError(
+                f"the hot-wire cut does not fit the machine: it needs a wire length of at least "
+                f"{(hi - lo) * k:.1f} (the machine has {machine.wire_length:g}); nothing written")
+        c = 0.5 * (lo + hi)
+        path = hw.wire_paths(mesh, **{**options, "span": path.span},
+                             planes=(c - length / 2, c + length / 2))
+    return path, hw.gcode(path, units=unit, machine=machine)
+
+
 def fabricate(mesh: Mesh, folder: str | os.PathLike, *, sheet: tuple[float, float] | None = None,
-              gap: float | None = None, unit: str = "", decimals: int = 3,
+              gap: float | None = None, unit: str | None = None, decimals: int = 3,
               length_tol: float | None = None, angle_tol: float = 1e-4, dxf: bool | None = None,
               hotwire: bool | None = None, span: str = "auto", up: str | None = None,
               kerf: float = 0.0, kerf_side: str = "left", feed: float = 300.0,
-              require_planar: bool = True, tol: Tolerances = DEFAULT) -> dict[str, Any]:
+              machine: hm.Machine | None = None, require_planar: bool = True,
+              tol: Tolerances = DEFAULT) -> dict[str, Any]:
     """Write the fabrication files of ``mesh`` into ``folder`` (created if missing).
 
     Parameters
@@ -54,9 +74,9 @@ def fabricate(mesh: Mesh, folder: str | os.PathLike, *, sheet: tuple[float, floa
         Sheet size in mesh units (default: one square sheet that fits all).
     gap : float, optional
         Clearance between panels (default 2 % of the largest panel).
-    unit : str
-        Names the mesh unit in SVG/DXF/G-code: ``""``, ``"mm"``, ``"cm"``,
-        ``"m"``, ``"in"``, ``"ft"``.
+    unit : str, optional
+        The mesh unit (``"mm"``, ``"cm"``, ``"m"``, ``"in"``, ``"ft"``) for
+        SVG/DXF sizes and G-code; default :attr:`Mesh.units <ruledmesh.mesh.Mesh.units>`.
     decimals : int
         Decimals of the edge-length labels.
     length_tol, angle_tol : float
@@ -69,6 +89,10 @@ def fabricate(mesh: Mesh, folder: str | os.PathLike, *, sheet: tuple[float, floa
         ``True`` makes a refusal an error.
     span, up, kerf, kerf_side, feed
         Hot-wire options (see :func:`~ruledmesh.fabricate.hotwire.wire_paths`).
+    machine : Machine, optional
+        The hot-wire machine (travel, wire length, tilt, feed, lead, clearance
+        in G-code units); a cut it cannot run is refused before anything is
+        written.  Default: no limits, ``feed``.
     require_planar : bool
         Refuse bent panels (see :func:`~ruledmesh.fabricate.unroll.unroll`).
     tol : Tolerances
@@ -86,16 +110,18 @@ def fabricate(mesh: Mesh, folder: str | os.PathLike, *, sheet: tuple[float, floa
         write_atomic(folder / name, data)
         written.append(name)
 
+    unit = mesh.units if not unit else unit
     unrolled = unroll(mesh, require_planar=require_planar, tol=tol)
     lay = layout(unrolled, sheet, gap=gap)
     labels = panel_labels(lay, decimals=decimals)
     # Everything that can refuse runs before the first file is written.
-    path = None
+    path = program_text = None
     if hotwire is not False and len(mesh.members):
         try:
-            path = hw.wire_paths(mesh, span=span, up=up, kerf=kerf, kerf_side=kerf_side, tol=tol)
+            path, program_text = _hotwire(mesh, unit, machine or hm.Machine(feed=feed), span=span,
+                                          up=up, kerf=kerf, kerf_side=kerf_side, tol=tol)
         except GeometryError as exc:
-            if hotwire:
+            if hotwire or machine is not None:
                 raise
             notes.append(f"hot-wire paths skipped: {exc}")
     elif hotwire and not len(mesh.members):
@@ -129,9 +155,11 @@ def fabricate(mesh: Mesh, folder: str | os.PathLike, *, sheet: tuple[float, floa
     wire: dict[str, Any] | None = None
     if path is not None:
         put("hotwire.csv", csv_bytes(hw.path_table(path)))
-        gunits = unit if unit in ("mm", "in") else ""
-        put("hotwire.gcode", hw.gcode(path, feed=feed, units=gunits).encode("ascii"))
+        put("hotwire.gcode", program_text.encode("ascii"))
+        prog = hm.program(path, unit, machine or hm.Machine(feed=feed))
         wire = {"dialect": "XYUV (G1 X Y U V F)", "span": path.span, "up": path.up,
+                "gcode_unit": prog.unit, "travel_needed": prog.extent().tolist(),
+                "max_tilt_deg": prog.tilt_deg, "wire_length": prog.wire_length,
                 "depth": path.depth, "planes": path.planes.tolist(),
                 "shift": path.shift.tolist(), "kerf": path.kerf, "kerf_side": path.kerf_side,
                 "steps": int(path.generator.size)}
