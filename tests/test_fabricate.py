@@ -119,7 +119,7 @@ def test_layout_panels_disjoint_and_on_sheet():
                | (hi[ids][:, None] + 0.02 - 1e-12 <= lo[ids][None])).any(axis=2)
         np.fill_diagonal(sep, True)
         assert sep.all()
-    with pytest.raises(ParameterError, match="does not fit"):
+    with pytest.raises(ParameterError, match="not fit on a 0.3 x 0.3 sheet .*smallest sheet that fits"):
         layout(u, sheet=(0.3, 0.3))
 
 

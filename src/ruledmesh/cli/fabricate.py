@@ -34,7 +34,15 @@ def add_parser(sub) -> None:
                    help="unit of the (scaled) coordinates (default: the mesh's own, from the "
                         "design's units key or the file)")
     p.add_argument("--sheet", type=_size, metavar="WxH", help="sheet size (default: one square sheet)")
-    p.add_argument("--gap", type=float, help="clearance between panels (default: 2%% of the largest)")
+    p.add_argument("--gap", type=float,
+                   help="clearance between panels and from the sheet border (default: --tool)")
+    p.add_argument("--tool", type=float,
+                   help="diameter or kerf of the sheet cutter, mesh units (default 3 mm)")
+    p.add_argument("--nesting", default="auto", choices=["auto", "true-shape", "shelf"],
+                   help="sheet packer: true-shape (spyrrow, pip install 'ruledmesh[nesting]'), "
+                        "shelf packing of bounding boxes, or auto (true-shape when installed)")
+    p.add_argument("--nest-time", type=int, default=4,
+                   help="seconds the true-shape nesting may search (default 4)")
     p.add_argument("--decimals", type=int, default=3, help="decimals of edge-length labels (default 3)")
     p.add_argument("--length-tol", type=float, help="congruence tolerance on edge lengths "
                    "(default 1e-9 x diagonal)")
@@ -81,7 +89,8 @@ def run(args) -> int:
                        feed=args.feed, lead=args.lead, clearance=args.clearance)
                if any(v is not None for v in limits) or args.max_tilt != 90.0 else None)
     summary = fabricate(
-        mesh, args.output, sheet=args.sheet, gap=args.gap, machine=machine,
+        mesh, args.output, sheet=args.sheet, gap=args.gap, machine=machine, tool=args.tool,
+        nesting=args.nesting, nest_seconds=args.nest_time,
         decimals=args.decimals, length_tol=args.length_tol, angle_tol=args.angle_tol,
         dxf=False if args.no_dxf else None,
         hotwire=True if args.span != "auto" else None, span=args.span, up=args.up,
@@ -91,8 +100,10 @@ def run(args) -> int:
         print(f"warning: {note}", file=sys.stderr)
     if not args.quiet:
         st = summary["panels"]
+        sheets = summary["sheets"]
         print(f"wrote {len(summary['files'])} files to {args.output}: {st['count']} panels "
-              f"({st['distinct_panels']} distinct) on {summary['sheets']['count']} sheets"
+              f"({st['distinct_panels']} distinct) on {sheets['count']} sheets, "
+              f"{100 * sheets['utilisation']:.1f} % used ({sheets['nesting']} nesting)"
               + ("" if summary["hotwire"] is None else
                  f", hot-wire path of {summary['hotwire']['steps']} generators"))
     return 0
