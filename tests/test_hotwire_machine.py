@@ -123,7 +123,8 @@ def test_cli_machine_fits(tmp_path):
     save(tmp_path / "m.obj", grid())
     out = tmp_path / "fab"
     assert main(["fabricate", str(tmp_path / "m.obj"), "-o", str(out), "--travel", "5000x3000",
-                 "--wire-length", "1200", "--max-tilt", "45", "--feed", "250", "-q"]) == 0
+                 "--wire-length", "1200", "--max-tilt", "45", "--feed", "250", "--nesting", "shelf",
+                 "-q"]) == 0
     summary = json.loads((out / "summary.json").read_text())
     wire = summary["hotwire"]
     assert wire["gcode_unit"] == "mm" and wire["wire_length"] == pytest.approx(1200.0)

@@ -299,7 +299,7 @@ def test_ply_round_trip_both_layouts(tmp_path, skew):
 
 # ------------------------------------------------------------- per-panel identity
 def _panel_labels(tmp_path, mesh):
-    fabricate(mesh, tmp_path / "fab", dxf=False, hotwire=False)
+    fabricate(mesh, tmp_path / "fab", dxf=False, hotwire=False, nesting="shelf")
     rows = list(csv.DictReader(io.StringIO((tmp_path / "fab" / "panels.csv").read_text())))
     return [r["label"] for r in rows], rows
 

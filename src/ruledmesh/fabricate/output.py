@@ -148,14 +148,8 @@ def fabricate(mesh: Mesh, folder: str | os.PathLike, *, sheet: tuple[float, floa
 
     unit = mesh.units if not unit else unit
     unrolled = unroll(mesh, require_planar=require_planar, tol=tol)
-    if gap is None and tool is not None:
-        gap = tool
-    if nesting == "auto" and not _spyrrow_available():
-        notes.append("sheets packed by shelves: true-shape nesting needs spyrrow "
-                     "(pip install 'ruledmesh[nesting]')")
-    lay = layout(unrolled, sheet, gap=gap, units=unit, method=nesting, seconds=nest_seconds)
-    labels = panel_labels(lay, decimals=decimals)
-    # Everything that can refuse runs before the first file is written.
+    # Everything that can refuse runs before the first file is written, the quick
+    # checks before the nesting search.
     path = program_text = None
     if hotwire is not False and len(mesh.members):
         try:
@@ -167,6 +161,14 @@ def fabricate(mesh: Mesh, folder: str | os.PathLike, *, sheet: tuple[float, floa
             notes.append(f"hot-wire paths skipped: {exc}")
     elif hotwire and not len(mesh.members):
         raise GeometryError("the mesh has no generators (members) to cut along")
+
+    if gap is None and tool is not None:
+        gap = tool
+    if nesting == "auto" and not _spyrrow_available():
+        notes.append("sheets packed by shelves: true-shape nesting needs spyrrow "
+                     "(pip install 'ruledmesh[nesting]')")
+    lay = layout(unrolled, sheet, gap=gap, units=unit, method=nesting, seconds=nest_seconds)
+    labels = panel_labels(lay, decimals=decimals)
 
     tolerances = {"length_tol": length_tol if length_tol is not None
                   else 1e-9 * (mesh.diagonal() or 1.0), "angle_tol": angle_tol}
@@ -188,7 +190,7 @@ def fabricate(mesh: Mesh, folder: str | os.PathLike, *, sheet: tuple[float, floa
     put("members.csv", csv_bytes(member_schedule(mesh)))
 
     wire: dict[str, Any] | None = None
-    if path is not None:
+    if path is not None and program_text is not None:
         put("hotwire.csv", csv_bytes(hw.path_table(path)))
         put("hotwire.gcode", program_text.encode("ascii"))
         wire = _wire_summary(path, unit, machine or hm.Machine(feed=feed))

@@ -103,7 +103,7 @@ def sheets_from_strip(unrolled: Unrolled, rotation: np.ndarray, translation: np.
     lo = np.minimum.reduceat(pts[:, 0], off[:-1])
     hi = np.maximum.reduceat(pts[:, 0], off[:-1])
     sheet = np.full(unrolled.n_faces, -1, dtype=np.int64)
-    starts = []
+    starts: list[float] = []
     # One step per sheet (a handful), each vectorised over the panels.
     while np.any(sheet < 0):
         free = sheet < 0

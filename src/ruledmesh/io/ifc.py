@@ -92,7 +92,7 @@ class _Writer:
         return f.createIfcLocalPlacement(relative_to, f.createIfcAxis2Placement3D(
             f.createIfcCartesianPoint((0.0, 0.0, 0.0)), None, None))
 
-    def entity(self, ifc_class: str, name: str, **attrs: Any):
+    def entity(self, ifc_class: str, name: str | None, **attrs: Any):
         """A rooted entity with a fresh GlobalId (faster than the API's root.create_entity)."""
         return self.f.create_entity(ifc_class, GlobalId=self.ifc.guid.new(), Name=name, **attrs)
 

@@ -30,6 +30,7 @@ Where the kinds and generators go (``extras``):
 from __future__ import annotations
 
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 
@@ -199,7 +200,7 @@ def _parse(data: bytes):
         elif parts[:1] == ["property"]:
             elements[-1][2].append(tuple(parts[1:]))
     pos = end + len(b"end_header\n")
-    out: dict[str, dict[str, np.ndarray]] = {}
+    out: dict[str, dict[str, Any]] = {}
     for name, count, props in elements:
         if all(p[0] != "list" for p in props):
             dtype = np.dtype([(p[1], _TYPES[p[0]]) for p in props])
@@ -231,7 +232,7 @@ def _parse(data: bytes):
         out[name]["__lists__"] = lists
     vert = out.get("vertex", {})
     vertices = np.column_stack([vert["x"], vert["y"], vert["z"]]).astype(np.float64)
-    face = out.get("face", {"__lists__": []})
+    face: dict[str, Any] = out.get("face", {"__lists__": []})
     faces = face["__lists__"]
     kinds = None
     if "kind" in face and face["kind"].size == len(faces):
