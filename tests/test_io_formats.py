@@ -103,8 +103,8 @@ def test_obj_read_by_meshio(tmp_path, name):
     np.testing.assert_array_equal(np.array(lines) - 1, mesh.members)
 
 
-# PLY keeps to the vertex and face elements every reader knows; face kinds and
-# members travel in comment lines, so meshio reads faces and vertices exactly.
+# The PLY file keeps to the vertex and face elements every reader knows; face kinds
+# and members travel in the companion file, so meshio reads faces and vertices exactly.
 def test_ply_read_by_meshio(tmp_path):
     meshio = pytest.importorskip("meshio")
     mesh = MESHES["mixed"]
@@ -158,7 +158,7 @@ def test_dxf_audit_and_read_back_with_ezdxf(tmp_path, name):
 def test_3dm_read_back_with_rhino3dm(tmp_path, name):
     r3 = pytest.importorskip("rhino3dm")
     mesh = MESHES[name]
-    save(tmp_path / "m.3dm", mesh)
+    save(tmp_path / "m.3dm", mesh, panels="joined")
     model = r3.File3dm.Read(str(tmp_path / "m.3dm"))
     layers = [layer.Name for layer in model.Layers]
     meshes = {}
@@ -204,7 +204,7 @@ def test_ifc_read_back_and_valid(tmp_path, name):
     import ifcopenshell.validate
 
     mesh = MESHES[name]
-    save(tmp_path / "m.ifc", mesh)
+    save(tmp_path / "m.ifc", mesh, panels="joined")
     model = ifcopenshell.open(str(tmp_path / "m.ifc"))
     assert model.schema == "IFC4"
     log = ifcopenshell.validate.json_logger()

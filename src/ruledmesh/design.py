@@ -24,7 +24,7 @@ from .registry import (MESH_METHODS, SURFACE_KINDS, TRANSFORMS, BuildContext, Bu
 
 __all__ = ["Design", "load_design", "parse_design", "build_design", "build_file"]
 
-TOP_LEVEL = ("curves", "rulings", "mesh", "surface", "transform", "name", "description")
+TOP_LEVEL = ("curves", "rulings", "mesh", "surface", "transform", "name", "description", "units")
 
 
 @dataclass(frozen=True)
@@ -100,6 +100,9 @@ def _table(data: Mapping, key: str, required: bool = False) -> Mapping:
 def _build(design: Design) -> Built:
     data = design.data
     ctx = design.context
+    from .units import unit_of
+
+    units = unit_of(data.get("units"), "units", err=DesignError)
     load_plugins()
     mesh_table = _table(data, "mesh")
     if "surface" in data:
@@ -142,7 +145,9 @@ def _build(design: Design) -> Built:
         if not isinstance(kind, str) or kind not in TRANSFORMS:
             raise _unknown(f"{path}.type", kind, TRANSFORMS)
         built = TRANSFORMS[kind](built, table, path)
-    return built
+    from dataclasses import replace
+
+    return replace(built, mesh=built.mesh.with_info(units=units.value))
 
 
 # Refuse builds whose estimated peak memory exceeds this, before allocating anything.

@@ -14,6 +14,7 @@ __all__ = [
     "ParameterError",
     "GeometryError",
     "ExportError",
+    "RuledMeshWarning",
 ]
 
 
@@ -76,3 +77,8 @@ class GeometryError(RuledMeshError, ValueError):
 
 class ExportError(RuledMeshError):
     """A mesh cannot be written in the requested format."""
+
+
+class RuledMeshWarning(UserWarning):
+    """A result was written but loses something the user should know about
+    (e.g. float32 precision at site coordinates); the CLI prints it as a warning."""

@@ -287,6 +287,16 @@ class Mesh:
         lo, hi = self.bounding_box()
         return float(np.linalg.norm(hi - lo))
 
+    @property
+    def units(self) -> str:
+        """Length unit of the coordinates (``info["units"]``; ``"m"`` when not stated).
+
+        One of ``"m"``, ``"cm"``, ``"mm"``, ``"in"``, ``"ft"`` (see :mod:`ruledmesh.units`).
+        """
+        from .units import unit_of
+
+        return unit_of(self.info.get("units"), "info.units").value
+
     def count_kinds(self) -> dict[str, int]:
         """Number of faces of each kind present, by label."""
         counts = np.bincount(self.face_kind, minlength=len(FaceKind))
@@ -306,6 +316,24 @@ class Mesh:
     def with_info(self, **info: Any) -> "Mesh":
         """The same mesh with ``info`` updated."""
         return replace(self, info={**self.info, **info})
+
+    def with_units(self, units: str, *, convert: bool = True) -> "Mesh":
+        """The mesh in ``units``: coordinates scaled from :attr:`units` (or only relabelled).
+
+        Parameters
+        ----------
+        units : {"m", "cm", "mm", "in", "ft"}
+        convert : bool
+            Scale the coordinates (default); ``False`` states the unit without
+            moving anything (for a mesh read from a file that did not say).
+        """
+        from .units import conversion_factor, unit_of
+
+        target = unit_of(units).value
+        factor = conversion_factor(self.units, target) if convert else 1.0
+        if factor == 1.0:
+            return self.with_info(units=target)
+        return self.with_vertices(self.vertices * factor, units=target)
 
     def select_faces(self, mask: np.ndarray) -> "Mesh":
         """The mesh made of the faces where ``mask`` is true (vertices kept)."""

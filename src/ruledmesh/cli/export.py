@@ -16,7 +16,9 @@ def add_parser(sub) -> None:
                     "shorter diagonal); the others keep quads and polygons.",
         epilog="examples:\n"
                "  ruledmesh export skew.obj -o skew.glb\n"
-               "  ruledmesh export examples/skew.toml -o skew.json   (mesh + design tables)",
+               "  ruledmesh export examples/skew.toml -o skew.json   (mesh + design tables)\n"
+               "  ruledmesh export skew.obj -o skew.ifc --units mm\n"
+               "  ruledmesh export site.obj -o site.stl --origin auto",
     )
     p.add_argument("mesh", help="mesh file (.obj, .ply, .json) or design file (.toml)")
     p.add_argument("-o", "--output", required=True, help="file to write; its extension picks the format")
@@ -24,11 +26,42 @@ def add_parser(sub) -> None:
                    help="glTF normals: face normals (flat) or averaged vertex normals")
     p.add_argument("--quads", choices=["shorter", "best"], default="shorter",
                    help="how STL/glTF/3DM split quads: shorter diagonal, or larger smallest angle")
+    p.add_argument("--units", choices=["m", "cm", "mm", "in", "ft"],
+                   help="convert to this unit (coordinates scaled; written into every format "
+                        "that has a unit; glTF is always metres)")
+    p.add_argument("--input-units", choices=["m", "cm", "mm", "in", "ft"],
+                   help="unit of the input when its file does not state one (default m)")
+    p.add_argument("--origin", metavar="X,Y,Z|auto",
+                   help="STL: subtract this point before float32 rounding (auto: the lower "
+                        "corner in whole units); recorded in the header")
+    p.add_argument("--panels", choices=["each", "joined"], default="each",
+                   help="IFC/3DM: one object per panel (default) or one per face kind")
+    p.add_argument("--extras", choices=["file", "inline", "omit"], default="file",
+                   help="PLY: face kinds and generators in NAME.ruledmesh.ply (default; every "
+                        "reader takes NAME.ply), inline in one file (not meshio), or omitted")
     p.add_argument("-q", "--quiet", action="store_true", help="print nothing on success")
     p.set_defaults(run=run)
 
 
+def _origin(text: str | None):
+    from ..errors import ParameterError
+
+    if text is None or text == "auto":
+        return text
+    try:
+        point = [float(x) for x in text.split(",")]
+    except ValueError:
+        point = []
+    if len(point) != 3:
+        raise ParameterError(f'expected X,Y,Z or "auto", got "{text}"', "--origin")
+    return point
+
+
 def run(args) -> int:
+    import sys
+    import warnings
+
+    from ..errors import RuledMeshWarning
     from ..io import WRITERS, _module, load, save
 
     source = Path(args.mesh)
@@ -42,12 +75,21 @@ def run(args) -> int:
         design = parsed.data
     else:
         mesh = load(source)
+    if args.input_units:
+        mesh = mesh.with_units(args.input_units, convert=False)
+    if args.units:
+        mesh = mesh.with_units(args.units)
     module = _module(output.suffix.lower(), WRITERS, "write")
     accepted = inspect.signature(module.dumpb).parameters
-    options = {"shading": args.shading, "quads": args.quads, "design": design}
+    options = {"shading": args.shading, "quads": args.quads, "design": design,
+               "origin": _origin(args.origin), "panels": args.panels, "extras": args.extras}
     options = {k: v for k, v in options.items() if k in accepted and v is not None}
-    save(output, mesh, **options)
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always", RuledMeshWarning)
+        save(output, mesh, **options)
+    for w in caught:
+        print(f"warning: {w.message}", file=sys.stderr)
     if not args.quiet:
         print(f"wrote {output}: {mesh.n_faces} faces, {mesh.n_vertices} vertices, "
-              f"{len(mesh.members)} members")
+              f"{len(mesh.members)} members, units {mesh.units}")
     return 0

@@ -31,9 +31,18 @@ def add_parser(sub) -> None:
     p.add_argument("-o", "--output", required=True, help="folder to write into (created if missing)")
     p.add_argument("--scale", type=float, default=1.0, help="multiply coordinates first (e.g. 1000: m -> mm)")
     p.add_argument("--unit", default="", choices=["", "mm", "cm", "m", "in", "ft"],
-                   help="name of the (scaled) mesh unit in the files")
+                   help="unit of the (scaled) coordinates (default: the mesh's own, from the "
+                        "design's units key or the file)")
     p.add_argument("--sheet", type=_size, metavar="WxH", help="sheet size (default: one square sheet)")
-    p.add_argument("--gap", type=float, help="clearance between panels (default: 2%% of the largest)")
+    p.add_argument("--gap", type=float,
+                   help="clearance between panels and from the sheet border (default: --tool)")
+    p.add_argument("--tool", type=float,
+                   help="diameter or kerf of the sheet cutter, mesh units (default 3 mm)")
+    p.add_argument("--nesting", default="auto", choices=["auto", "true-shape", "shelf"],
+                   help="sheet packer: true-shape (spyrrow, pip install 'ruledmesh[nesting]'), "
+                        "shelf packing of bounding boxes, or auto (true-shape when installed)")
+    p.add_argument("--nest-time", type=int, default=4,
+                   help="seconds the true-shape nesting may search (default 4)")
     p.add_argument("--decimals", type=int, default=3, help="decimals of edge-length labels (default 3)")
     p.add_argument("--length-tol", type=float, help="congruence tolerance on edge lengths "
                    "(default 1e-9 x diagonal)")
@@ -46,7 +55,17 @@ def add_parser(sub) -> None:
     p.add_argument("--kerf", type=float, default=0.0, help="hot wire: slot width (default 0)")
     p.add_argument("--kerf-side", default="left", choices=["left", "right"],
                    help="hot wire: offset side, relative to travel (default left)")
-    p.add_argument("--feed", type=float, default=300.0, help="hot wire: feed per minute (default 300)")
+    p.add_argument("--feed", type=float, default=300.0,
+                   help="hot wire: feed in G-code units (mm or in) per minute (default 300)")
+    p.add_argument("--travel", type=_size, metavar="WxH",
+                   help="hot wire: tower travel, horizontal x vertical, in G-code units (mm or in)")
+    p.add_argument("--wire-length", type=float,
+                   help="hot wire: distance between the towers, G-code units (default: the cut's width)")
+    p.add_argument("--max-tilt", type=float, default=90.0,
+                   help="hot wire: largest wire angle from the span axis, degrees")
+    p.add_argument("--lead", type=float, help="hot wire: lead-in/out length (default 10 mm / 0.5 in)")
+    p.add_argument("--clearance", type=float,
+                   help="hot wire: safe rapid height above the cut (default 10 mm / 0.5 in)")
     p.add_argument("--allow-bent", action="store_true",
                    help="project non-planar faces instead of refusing them")
     p.add_argument("-q", "--quiet", action="store_true", help="print nothing on success")
@@ -55,6 +74,7 @@ def add_parser(sub) -> None:
 
 def run(args) -> int:
     from ..design import build_file
+    from ..fabricate.machine import Machine
     from ..fabricate.output import fabricate
     from ..io import load
 
@@ -62,8 +82,15 @@ def run(args) -> int:
     mesh = build_file(path).mesh if path.suffix.lower() == ".toml" else load(path)
     if args.scale != 1.0:
         mesh = mesh.with_vertices(mesh.vertices * args.scale)
+    if args.unit:
+        mesh = mesh.with_units(args.unit, convert=False)
+    limits = (args.travel, args.wire_length, args.lead, args.clearance)
+    machine = (Machine(travel=args.travel, wire_length=args.wire_length, max_tilt=args.max_tilt,
+                       feed=args.feed, lead=args.lead, clearance=args.clearance)
+               if any(v is not None for v in limits) or args.max_tilt != 90.0 else None)
     summary = fabricate(
-        mesh, args.output, sheet=args.sheet, gap=args.gap, unit=args.unit,
+        mesh, args.output, sheet=args.sheet, gap=args.gap, machine=machine, tool=args.tool,
+        nesting=args.nesting, nest_seconds=args.nest_time,
         decimals=args.decimals, length_tol=args.length_tol, angle_tol=args.angle_tol,
         dxf=False if args.no_dxf else None,
         hotwire=True if args.span != "auto" else None, span=args.span, up=args.up,
@@ -73,8 +100,10 @@ def run(args) -> int:
         print(f"warning: {note}", file=sys.stderr)
     if not args.quiet:
         st = summary["panels"]
+        sheets = summary["sheets"]
         print(f"wrote {len(summary['files'])} files to {args.output}: {st['count']} panels "
-              f"({st['distinct_panels']} distinct) on {summary['sheets']['count']} sheets"
+              f"({st['distinct_panels']} distinct) on {sheets['count']} sheets, "
+              f"{100 * sheets['utilisation']:.1f} % used ({sheets['nesting']} nesting)"
               + ("" if summary["hotwire"] is None else
                  f", hot-wire path of {summary['hotwire']['steps']} generators"))
     return 0

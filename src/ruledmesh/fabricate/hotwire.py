@@ -29,15 +29,17 @@ side.  With ``kerf = 0`` (default) the wire centre runs on the surface.
 
 G-code dialect: "XYUV", the RS-274 second linear pair used by 4-axis foam
 cutters (GMFC, DevFoam, LinuxCNC and Mach3/4 foam configurations):
-``G1 X.. Y.. U.. V.. F..``, absolute coordinates (``G90``), ``G21``/``G20``
-for mm/inch, the wire heated with ``M3`` and switched off with ``M5``
-(configurable: some controllers use ``M8``/``M9``).  GRBL-family boards
+``G1 X.. Y.. U.. V.. F..``, absolute coordinates (``G90``), ``G21`` and
+millimetres for metric meshes, ``G20`` and inches for imperial ones, the
+wire heated with ``M3`` and switched off with ``M5`` (configurable: some
+controllers use ``M8``/``M9``); lead-in, lead-out and safe rapids as
+:mod:`.machine` describes, comments as ``;`` lines without G-code words.  GRBL-family boards
 without U/V words need the axes renamed (e.g. U->Z, V->A).
 """
 
 from __future__ import annotations
 
-import io
+import re
 from dataclasses import dataclass
 
 import numpy as np
@@ -46,9 +48,10 @@ from .._validation import check_float
 from ..errors import GeometryError, ParameterError
 from ..mesh import Mesh
 from ..tolerances import DEFAULT, Tolerances
+from .machine import Machine, check, program
 from .schedules import member_schedule
 
-__all__ = ["WirePath", "wire_paths", "gcode", "path_table", "AXES"]
+__all__ = ["AXES", "WirePath", "comment", "gcode", "path_table", "wire_paths"]
 
 AXES = {"x": 0, "y": 1, "z": 2}
 
@@ -232,52 +235,78 @@ def path_table(path: WirePath) -> dict[str, np.ndarray]:
 
 
 def _minus(name: str, shift: float) -> str:
-    return f"{name} {'-' if shift >= 0 else '+'} {abs(shift):.10g}"
+    return f"{name} {'minus' if shift >= 0 else 'plus'} {abs(shift):.10g}"
+
+
+# A letter right before a digit is what G-code parsers read as a word (G1, M3, X0.5),
+# even inside comments for some (gcodeparser); parentheses and ';' nest badly.
+_WORDLIKE = re.compile(r"([A-Za-z])(?=[-+.]?\d)")
+
+
+def comment(text: str) -> str:
+    """A ``;`` comment line that no G-code parser reads as words.
+
+    >>> comment("tower XY (left) at y=0.5; G1 moves")
+    '; tower XY left at y=0.5, G 1 moves'
+    """
+    text = text.replace(";", ",").replace("(", "").replace(")", "")
+    return "; " + _WORDLIKE.sub(r"\1 ", text).replace("  ", " ")
 
 
 def gcode(path: WirePath, *, feed: float = 300.0, units: str = "mm", wire_on: str = "M3",
-          wire_off: str = "M5", preheat: float = 1.0, decimals: int = 4) -> str:
-    """The path as XYUV G-code.
+          wire_off: str = "M5", preheat: float = 1.0, decimals: int = 4,
+          machine: Machine | None = None) -> str:
+    """The path as a shop-ready XYUV G-code program (see :mod:`.machine`).
 
     Parameters
     ----------
     path : WirePath
     feed : float
-        Feed rate in units per minute.
-    units : {"mm", "in", ""}
-        Emits ``G21`` / ``G20`` (nothing for ``""``; the coordinates are mesh
-        units in every case, scale the mesh first).
+        Feed rate in machine units per minute (``machine.feed`` when a machine is given).
+    units : str
+        Unit of the mesh coordinates (``"m"``, ``"cm"``, ``"mm"``, ``"in"``, ``"ft"``):
+        coordinates are written in millimetres with ``G21`` (metric) or in
+        inches with ``G20`` (imperial).
     wire_on, wire_off : str
         Commands heating the wire and switching it off.
     preheat : float
         Seconds to dwell (``G4 P``) after heating, before moving.
     decimals : int
+    machine : Machine, optional
+        Lead-in/out length and safe height; checked with :func:`.machine.check`.
+
+    Raises
+    ------
+    GeometryError
+        When the program does not fit ``machine``.
     """
-    feed = check_float(feed, "feed", lo=0.0, lo_open=True)
+    machine = Machine(feed=feed) if machine is None else machine
     preheat = check_float(preheat, "preheat", lo=0.0)
-    if units not in ("mm", "in", ""):
-        raise ParameterError(f'expected "mm", "in" or "", got {units!r}', "units")
+    prog = program(path, units, machine)
+    check(prog, machine)
     f = f".{decimals}f"
-    out = io.StringIO()
-    out.write("(ruledmesh hot-wire path, XYUV dialect: G1 X Y U V F)\n")
-    out.write(f"(tower XY in plane {path.span} = {path.planes[0]:.10g}, tower UV in plane "
-              f"{path.span} = {path.planes[1]:.10g})\n")
-    out.write(f"(X/U = mesh {_minus(path.depth, path.shift[0])}, "
-              f"Y/V = mesh {_minus(path.up, path.shift[1])})\n")
-    out.write(f"(kerf {path.kerf:g}, offset to the {path.kerf_side} of travel; "
-              f"{path.generator.size} generators)\n")
-    out.write("G90\n")
-    if units:
-        out.write("G21\n" if units == "mm" else "G20\n")
-    xy, uv = path.xy, path.uv
-    out.write(f"G0 X{xy[0, 0]:{f}} Y{xy[0, 1]:{f}} U{uv[0, 0]:{f}} V{uv[0, 1]:{f}}\n")
-    out.write(f"{wire_on}\n")
+
+    def move(word: str, rows: np.ndarray) -> list[str]:
+        return [f"{word} X{x:{f}} Y{y:{f}} U{u:{f}} V{v:{f}}" for x, y, u, v in rows.tolist()]
+
+    lines = [comment("ruledmesh hot-wire program, XYUV dialect: G1 with X Y U V and F"),
+             comment(f"tower XY in plane {path.span} = {path.planes[0]:.10g}, tower UV in plane "
+                     f"{path.span} = {path.planes[1]:.10g} mesh units"),
+             comment(f"X and U along mesh {_minus(path.depth, path.shift[0])}, Y and V along mesh "
+                     f"{_minus(path.up, path.shift[1])}, then shifted by the lead-in"),
+             comment(f"kerf {path.kerf:g}, offset to the {path.kerf_side} of travel, "
+                     f"{path.generator.size} generators, lead {prog.lead:g} {prog.unit}"),
+             comment(f"needs travel {prog.extent()[0]:.1f} by {prog.extent()[1]:.1f} {prog.unit}, "
+                     f"wire tilt up to {prog.tilt_deg:.1f} degrees"),
+             "G90", "G21" if prog.unit == "mm" else "G20"]
+    lines += move("G0", prog.rapid_in)
+    lines.append(wire_on)
     if preheat:
-        out.write(f"G4 P{preheat:g}\n")
-    rows = np.column_stack([xy, uv])[1:]
-    lines = [f"G1 X{x:{f}} Y{y:{f}} U{u:{f}} V{v:{f}}" for x, y, u, v in rows.tolist()]
-    if lines:
-        lines[0] += f" F{feed:g}"
-        out.write("\n".join(lines) + "\n")
-    out.write(f"{wire_off}\nM30\n")
-    return out.getvalue()
+        lines.append(f"G4 P{preheat:g}")
+    cut = move("G1", prog.cut[1:])
+    cut[0] += f" F{machine.feed:g}"
+    lines += cut
+    lines.append(wire_off)
+    lines += move("G0", prog.rapid_out)
+    lines.append("M30")
+    return "\n".join(lines) + "\n"

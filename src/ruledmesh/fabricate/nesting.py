@@ -1,12 +1,21 @@
-"""Sheets: unrolled panels placed on rectangular sheets by a shelf packer.
+"""Sheets: unrolled panels placed on rectangular sheets.
 
-Each panel is first turned to its smallest bounding box, laid on its long
-side (:func:`~ruledmesh.fabricate.unroll.min_area_rotation`); the boxes are
-then packed first-fit by decreasing height into horizontal shelves, a new
-sheet opening when no shelf has room.  Shelf packing wastes the space between
-a panel and its box, but it is predictable, needs no optimiser, and panels
-never overlap (their boxes do not, with ``gap`` between them).  Rotations
-are proper (no mirroring): every panel keeps the face normal's side up.
+Two packers, chosen by ``method``:
+
+* ``"true-shape"``: the panels' real outlines nested with free rotation by
+  jagua-rs through ``spyrrow`` (:mod:`.true_shape`; optional extra
+  ``nesting``); ``"auto"`` uses it when it is installed (the default of
+  :func:`~ruledmesh.fabricate.output.fabricate`);
+* ``"shelf"``: each panel turned to its smallest bounding box, laid on its
+  long side (:func:`~ruledmesh.fabricate.unroll.min_area_rotation`), the
+  boxes packed first-fit by decreasing height into horizontal shelves, a new
+  sheet opening when no shelf has room.  It wastes the space between a panel
+  and its box, but it is predictable, fast and needs nothing installed.
+
+Panels never overlap, keep ``gap`` between them and from the sheet border,
+and rotations are proper (no mirroring): every panel keeps the face
+normal's side up.  The default gap is the cutter's diameter or kerf
+(``tool``, default 3 mm in the mesh's units), not a fraction of the panels.
 """
 
 from __future__ import annotations
@@ -19,7 +28,7 @@ from .._validation import check_float
 from ..errors import ParameterError
 from .unroll import Unrolled, corner_structure, min_area_rotation
 
-__all__ = ["Layout", "layout", "auto_sheet"]
+__all__ = ["DEFAULT_TOOL_MM", "METHODS", "Layout", "auto_sheet", "default_gap", "layout"]
 
 
 @dataclass(frozen=True, eq=False)
@@ -45,6 +54,8 @@ class Layout:
     n_sheets : int
     gap : float
         Clearance kept between panels and from the sheet border.
+    method : str
+        ``"true-shape"`` or ``"shelf"``: the packer that made the layout.
     """
 
     unrolled: Unrolled
@@ -56,6 +67,34 @@ class Layout:
     sheet_size: np.ndarray
     n_sheets: int
     gap: float
+    method: str = "shelf"
+
+    def panel_area(self) -> float:
+        """Total area of the panels."""
+        off = self.unrolled.face_offsets
+        if self.unrolled.n_faces == 0:
+            return 0.0
+        p = self.points
+        _, nxt, _ = corner_structure(off)
+        cross = p[:, 0] * p[nxt, 1] - p[nxt, 0] * p[:, 1]
+        return float(np.abs(0.5 * np.add.reduceat(cross, off[:-1])).sum())
+
+    def utilisation(self) -> float:
+        """Panel area over the area of all sheets used (0 without panels)."""
+        area = self.n_sheets * float(np.prod(self.sheet_size))
+        return self.panel_area() / area if area else 0.0
+
+    def utilisation_trimmed(self) -> float:
+        """Like :meth:`utilisation`, the last sheet counted only up to its rightmost panel
+        plus the gap (the rest is a reusable offcut): comparable to strip packing."""
+        if self.n_sheets == 0:
+            return 0.0
+        last = self.panels_on(self.n_sheets - 1)
+        off = self.unrolled.face_offsets
+        xs = np.concatenate([self.points[off[f]:off[f + 1], 0] for f in last.tolist()])
+        used = min(float(xs.max()) + self.gap, float(self.sheet_size[0]))
+        area = float(np.prod(self.sheet_size)) * (self.n_sheets - 1) + used * float(self.sheet_size[1])
+        return self.panel_area() / area
 
     def panels_on(self, s: int) -> np.ndarray:
         """(k,) int64: the faces placed on sheet ``s``."""
@@ -81,7 +120,61 @@ def auto_sheet(box: np.ndarray, gap: float) -> tuple[float, float]:
     return side, side
 
 
-def layout(unrolled: Unrolled, sheet: tuple[float, float] | None = None, *, gap: float | None = None) -> Layout:
+# Cutter diameter (router bit, waterjet or laser kerf) assumed when none is given, in mm.
+DEFAULT_TOOL_MM = 3.0
+METHODS = ("auto", "true-shape", "shelf")
+
+
+def default_gap(units: str = "m") -> float:
+    """The default clearance: :data:`DEFAULT_TOOL_MM` in ``units``.
+
+    >>> default_gap("mm"), default_gap("m")
+    (3.0, 0.003)
+    """
+    from ..units import conversion_factor
+
+    return DEFAULT_TOOL_MM * conversion_factor("mm", units)
+
+
+def _boxes(unrolled: Unrolled) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    """Smallest-box rotation of each panel, the rotated corners, box minimum and size."""
+    off = unrolled.face_offsets
+    if unrolled.n_faces == 0:
+        return np.zeros(0), unrolled.points, np.zeros((0, 2)), np.zeros((0, 2))
+    face, _, _ = corner_structure(off)
+    rot = min_area_rotation(unrolled.points, off)
+    rp = _rotate(unrolled.points, rot[face])
+    lo = np.stack([np.minimum.reduceat(rp[:, i], off[:-1]) for i in (0, 1)], axis=1)
+    hi = np.stack([np.maximum.reduceat(rp[:, i], off[:-1]) for i in (0, 1)], axis=1)
+    return rot, rp, lo, hi - lo
+
+
+def _rotate(p: np.ndarray, angle: np.ndarray) -> np.ndarray:
+    c, s = np.cos(angle), np.sin(angle)
+    return np.stack([c * p[:, 0] - s * p[:, 1], s * p[:, 0] + c * p[:, 1]], axis=1)
+
+
+def _check_fits(box: np.ndarray, gap: float, sw: float, sh: float) -> None:
+    """Refuse panels too large for the sheet, naming them and the sheet that would fit."""
+    from .labels import panel_labels
+
+    long, short = box.max(axis=1), box.min(axis=1)
+    big_side, small_side = max(sw, sh), min(sw, sh)
+    bad = np.flatnonzero((long + 2 * gap > big_side) | (short + 2 * gap > small_side))
+    if not bad.size:
+        return
+    names = panel_labels(len(box))
+    listed = ", ".join(f"{names[f]} ({long[f]:.6g} x {short[f]:.6g})" for f in bad[:5].tolist())
+    more = f" and {bad.size - 5} more" if bad.size > 5 else ""
+    need = (float(long.max() + 2 * gap), float(short.max() + 2 * gap))
+    count = "1 panel does" if bad.size == 1 else f"{bad.size} panels do"
+    raise ParameterError(
+        f"{count} not fit on a {sw:g} x {sh:g} sheet with gap {gap:.3g}: {listed}{more}; "
+        f"the smallest sheet that fits every panel is {need[0]:.6g} x {need[1]:.6g}", "sheet")
+
+
+def layout(unrolled: Unrolled, sheet: tuple[float, float] | None = None, *, gap: float | None = None,
+           units: str = "m", method: str = "shelf", seconds: int = 4, seed: int = 0) -> Layout:
     """Place the unrolled panels on sheets.
 
     Parameters
@@ -91,8 +184,18 @@ def layout(unrolled: Unrolled, sheet: tuple[float, float] | None = None, *, gap:
         Sheet size in mesh units; by default a square that takes every panel
         (:func:`auto_sheet`).
     gap : float, optional
-        Clearance between panels and from the border; by default 2 % of the
-        largest panel dimension.
+        Clearance between panels and from the border; by default
+        :func:`default_gap` (a 3 mm cutter) in ``units``.
+    units : str
+        The mesh unit (for the default gap).
+    method : {"shelf", "true-shape", "auto"}
+        Packer (see the module notes); ``"auto"``: true-shape when ``spyrrow``
+        is installed.  The default here is the fast shelf packer; ``ruledmesh
+        fabricate`` defaults to ``"auto"``.
+    seconds : int
+        Time budget of the true-shape solver.
+    seed : int
+        Seed of the true-shape solver.
 
     Returns
     -------
@@ -101,44 +204,65 @@ def layout(unrolled: Unrolled, sheet: tuple[float, float] | None = None, *, gap:
     Raises
     ------
     ParameterError
-        If a panel does not fit on the sheet even turned by 90 degrees.
+        If a panel does not fit on the sheet even turned, naming the panels,
+        their sizes and the smallest sheet that fits them all.
     """
-    off = unrolled.face_offsets
+    if method not in METHODS:
+        raise ParameterError(f'expected "auto", "true-shape" or "shelf", got {method!r}', "method")
     nf = unrolled.n_faces
-    face, _, _ = corner_structure(off)
-    rot = min_area_rotation(unrolled.points, off)
-    c, s = np.cos(rot)[face], np.sin(rot)[face]
-    p = unrolled.points
-    rp = np.stack([c * p[:, 0] - s * p[:, 1], s * p[:, 0] + c * p[:, 1]], axis=1)
-    lo = np.stack([np.minimum.reduceat(rp[:, 0], off[:-1]), np.minimum.reduceat(rp[:, 1], off[:-1])],
-                  axis=1) if nf else np.zeros((0, 2))
-    hi = np.stack([np.maximum.reduceat(rp[:, 0], off[:-1]), np.maximum.reduceat(rp[:, 1], off[:-1])],
-                  axis=1) if nf else np.zeros((0, 2))
-    box = hi - lo
-    if gap is None:
-        gap = 0.02 * float(box.max()) if nf else 0.0
-    gap = check_float(gap, "gap", lo=0.0)
+    rot, rp, lo, box = _boxes(unrolled)
+    gap = check_float(default_gap(units) if gap is None else gap, "gap", lo=0.0)
     if sheet is None:
         sheet = auto_sheet(box, gap) if nf else (1.0, 1.0)
     if isinstance(sheet, str) or np.ndim(sheet) != 1 or len(sheet) != 2:
         raise ParameterError(f"expected (width, height), got {sheet!r}", "sheet")
     sw = check_float(sheet[0], "sheet", lo=0.0, lo_open=True)
     sh = check_float(sheet[1], "sheet", lo=0.0, lo_open=True)
+    _check_fits(box, gap, sw, sh)
+    if method == "auto":
+        from .true_shape import available
 
+        method = "true-shape" if available() and nf else "shelf"
+    if method == "true-shape" and nf:
+        lay = _true_shape(unrolled, gap, sw, sh, seconds, seed)
+        if lay is not None:
+            return lay
+    return _shelf(unrolled, rot, rp, lo, box, gap, sw, sh)
+
+
+def _true_shape(unrolled: Unrolled, gap: float, sw: float, sh: float, seconds: int,
+                seed: int) -> Layout | None:
+    """Nest with spyrrow; None if the solver turned a panel wider than the sheet."""
+    from .true_shape import sheets_from_strip, strip_pack
+
+    off = unrolled.face_offsets
+    face, _, _ = corner_structure(off)
+    rotation, translation, _ = strip_pack(unrolled, sh - 2 * gap, gap, seconds, seed)
+    sheet_of, starts = sheets_from_strip(unrolled, rotation, translation, sw - 2 * gap)
+    offset = translation - np.c_[starts[sheet_of], np.zeros(len(sheet_of))] + gap
+    points = _rotate(unrolled.points, rotation[face]) + offset[face]
+    lo = np.stack([np.minimum.reduceat(points[:, i], off[:-1]) for i in (0, 1)], axis=1)
+    hi = np.stack([np.maximum.reduceat(points[:, i], off[:-1]) for i in (0, 1)], axis=1)
+    eps = 1e-9 * max(sw, sh)
+    if lo.min() < gap - eps or hi[:, 0].max() > sw - gap + eps or hi[:, 1].max() > sh - gap + eps:
+        return None
+    return Layout(unrolled, points, sheet_of, rotation, offset, hi - lo, np.array([sw, sh]),
+                  int(starts.size), gap, "true-shape")
+
+
+def _shelf(unrolled: Unrolled, rot, rp, lo, box, gap: float, sw: float, sh: float) -> Layout:
+    """The shelf packer of the module notes."""
+    off = unrolled.face_offsets
+    nf = unrolled.n_faces
+    face, _, _ = corner_structure(off)
+    hi = lo + box
     # A panel too wide for the sheet but fitting when stood up is turned by 90 degrees.
     too_wide = (box[:, 0] + 2 * gap > sw) & (box[:, 1] + 2 * gap <= sw) & (box[:, 0] + 2 * gap <= sh)
     if too_wide.any():
         rot = rot + np.where(too_wide, np.pi / 2, 0.0)
         lo = np.where(too_wide[:, None], np.stack([-hi[:, 1], lo[:, 0]], axis=1), lo)
         box = np.where(too_wide[:, None], box[:, ::-1], box)
-        c, s = np.cos(rot)[face], np.sin(rot)[face]
-        rp = np.stack([c * p[:, 0] - s * p[:, 1], s * p[:, 0] + c * p[:, 1]], axis=1)
-    big = np.flatnonzero((box[:, 0] + 2 * gap > sw) | (box[:, 1] + 2 * gap > sh))
-    if big.size:
-        f = int(big[0])
-        raise ParameterError(f"panel {f} ({box[f, 0]:.6g} x {box[f, 1]:.6g} plus gap {gap:.3g}) "
-                             f"does not fit on a {sw:g} x {sh:g} sheet", "sheet")
-
+        rp = _rotate(unrolled.points, rot[face])
     sheet_of = np.zeros(nf, dtype=np.int64)
     corner = np.zeros((nf, 2))
     # Shelves: sheet, y of the shelf's base, its height, and the x where it is free.
@@ -168,4 +292,4 @@ def layout(unrolled: Unrolled, sheet: tuple[float, float] | None = None, *, gap:
         sh_x[k] += w + gap
     offset = corner - lo
     return Layout(unrolled, rp + offset[face], sheet_of, rot, offset, box,
-                  np.array([sw, sh]), len(top) if nf else 0, gap)
+                  np.array([sw, sh]), len(top) if nf else 0, gap, "shelf")

@@ -29,6 +29,7 @@ from ..io import write_atomic
 from ..mesh import Mesh
 from ..tolerances import DEFAULT, Tolerances
 from . import hotwire as hw
+from . import machine as hm
 from .nesting import layout
 from .panels import congruence_classes, panel_statistics, panel_table
 from .schedules import csv_bytes, edge_schedule, member_schedule, node_schedule
@@ -38,12 +39,60 @@ from .unroll import unroll
 __all__ = ["fabricate"]
 
 
+def _want_dxf(dxf: bool | None, notes: list[str]) -> bool:
+    """Whether to write DXF sheets (default: when ezdxf is installed, else a note)."""
+    if dxf is not None:
+        return dxf
+    try:
+        import ezdxf  # noqa: F401
+    except ImportError:
+        notes.append("DXF sheets skipped: ezdxf is not installed (pip install 'ruledmesh[dxf]')")
+        return False
+    return True
+
+
+def _wire_summary(path: hw.WirePath, unit: str, machine: hm.Machine) -> dict[str, Any]:
+    prog = hm.program(path, unit, machine)
+    return {"dialect": "XYUV (G1 X Y U V F)", "span": path.span, "up": path.up,
+            "gcode_unit": prog.unit, "travel_needed": prog.extent().tolist(),
+            "max_tilt_deg": prog.tilt_deg, "wire_length": prog.wire_length,
+            "depth": path.depth, "planes": path.planes.tolist(),
+            "shift": path.shift.tolist(), "kerf": path.kerf, "kerf_side": path.kerf_side,
+            "steps": int(path.generator.size)}
+
+
+def _spyrrow_available() -> bool:
+    from .true_shape import available
+
+    return available()
+
+
+def _hotwire(mesh: Mesh, unit: str, machine: hm.Machine, **options: Any):
+    """The wire path on ``machine`` and its G-code; raises before anything is written."""
+    path = hw.wire_paths(mesh, **options)
+    if machine.wire_length is not None:
+        _, k = hm.machine_unit(unit)
+        axis = hw.AXES[path.span]
+        lo, hi = mesh.bounding_box()[:, axis]
+        length = machine.wire_length / k
+        if hi - lo > length * (1 + 1e-12):
+            raise GeometryError(
+                f"the hot-wire cut does not fit the machine: it needs a wire length of at least "
+                f"{(hi - lo) * k:.1f} (the machine has {machine.wire_length:g}); nothing written")
+        c = 0.5 * (lo + hi)
+        path = hw.wire_paths(mesh, **{**options, "span": path.span},
+                             planes=(c - length / 2, c + length / 2))
+    return path, hw.gcode(path, units=unit, machine=machine)
+
+
 def fabricate(mesh: Mesh, folder: str | os.PathLike, *, sheet: tuple[float, float] | None = None,
-              gap: float | None = None, unit: str = "", decimals: int = 3,
+              gap: float | None = None, unit: str | None = None, decimals: int = 3,
               length_tol: float | None = None, angle_tol: float = 1e-4, dxf: bool | None = None,
               hotwire: bool | None = None, span: str = "auto", up: str | None = None,
               kerf: float = 0.0, kerf_side: str = "left", feed: float = 300.0,
-              require_planar: bool = True, tol: Tolerances = DEFAULT) -> dict[str, Any]:
+              machine: hm.Machine | None = None, nesting: str = "auto", nest_seconds: int = 4,
+              tool: float | None = None, require_planar: bool = True,
+              tol: Tolerances = DEFAULT) -> dict[str, Any]:
     """Write the fabrication files of ``mesh`` into ``folder`` (created if missing).
 
     Parameters
@@ -53,10 +102,10 @@ def fabricate(mesh: Mesh, folder: str | os.PathLike, *, sheet: tuple[float, floa
     sheet : (width, height), optional
         Sheet size in mesh units (default: one square sheet that fits all).
     gap : float, optional
-        Clearance between panels (default 2 % of the largest panel).
-    unit : str
-        Names the mesh unit in SVG/DXF/G-code: ``""``, ``"mm"``, ``"cm"``,
-        ``"m"``, ``"in"``, ``"ft"``.
+        Clearance between panels and from the sheet border (default ``tool``).
+    unit : str, optional
+        The mesh unit (``"mm"``, ``"cm"``, ``"m"``, ``"in"``, ``"ft"``) for
+        SVG/DXF sizes and G-code; default :attr:`Mesh.units <ruledmesh.mesh.Mesh.units>`.
     decimals : int
         Decimals of the edge-length labels.
     length_tol, angle_tol : float
@@ -69,6 +118,17 @@ def fabricate(mesh: Mesh, folder: str | os.PathLike, *, sheet: tuple[float, floa
         ``True`` makes a refusal an error.
     span, up, kerf, kerf_side, feed
         Hot-wire options (see :func:`~ruledmesh.fabricate.hotwire.wire_paths`).
+    nesting : {"auto", "true-shape", "shelf"}
+        Sheet packer (see :mod:`.nesting`); ``"auto"``: true-shape when
+        ``spyrrow`` is installed, else shelf packing (with a note).
+    nest_seconds : int
+        Time budget of the true-shape nesting.
+    tool : float, optional
+        Diameter or kerf of the sheet cutter, mesh units (default 3 mm).
+    machine : Machine, optional
+        The hot-wire machine (travel, wire length, tilt, feed, lead, clearance
+        in G-code units); a cut it cannot run is refused before anything is
+        written.  Default: no limits, ``feed``.
     require_planar : bool
         Refuse bent panels (see :func:`~ruledmesh.fabricate.unroll.unroll`).
     tol : Tolerances
@@ -86,20 +146,29 @@ def fabricate(mesh: Mesh, folder: str | os.PathLike, *, sheet: tuple[float, floa
         write_atomic(folder / name, data)
         written.append(name)
 
+    unit = mesh.units if not unit else unit
     unrolled = unroll(mesh, require_planar=require_planar, tol=tol)
-    lay = layout(unrolled, sheet, gap=gap)
-    labels = panel_labels(lay, decimals=decimals)
-    # Everything that can refuse runs before the first file is written.
-    path = None
+    # Everything that can refuse runs before the first file is written, the quick
+    # checks before the nesting search.
+    path = program_text = None
     if hotwire is not False and len(mesh.members):
         try:
-            path = hw.wire_paths(mesh, span=span, up=up, kerf=kerf, kerf_side=kerf_side, tol=tol)
+            path, program_text = _hotwire(mesh, unit, machine or hm.Machine(feed=feed), span=span,
+                                          up=up, kerf=kerf, kerf_side=kerf_side, tol=tol)
         except GeometryError as exc:
-            if hotwire:
+            if hotwire or machine is not None:
                 raise
             notes.append(f"hot-wire paths skipped: {exc}")
     elif hotwire and not len(mesh.members):
         raise GeometryError("the mesh has no generators (members) to cut along")
+
+    if gap is None and tool is not None:
+        gap = tool
+    if nesting == "auto" and not _spyrrow_available():
+        notes.append("sheets packed by shelves: true-shape nesting needs spyrrow "
+                     "(pip install 'ruledmesh[nesting]')")
+    lay = layout(unrolled, sheet, gap=gap, units=unit, method=nesting, seconds=nest_seconds)
+    labels = panel_labels(lay, decimals=decimals)
 
     tolerances = {"length_tol": length_tol if length_tol is not None
                   else 1e-9 * (mesh.diagonal() or 1.0), "angle_tol": angle_tol}
@@ -108,13 +177,7 @@ def fabricate(mesh: Mesh, folder: str | os.PathLike, *, sheet: tuple[float, floa
     table.update({"sheet": lay.sheet + 1, "sheet_x": lay.offset[:, 0], "sheet_y": lay.offset[:, 1],
                   "rotation_deg": np.degrees(lay.rotation)})
     (folder / "sheets").mkdir(parents=True, exist_ok=True)
-    if dxf is None:
-        try:
-            import ezdxf  # noqa: F401
-            dxf = True
-        except ImportError:
-            dxf = False
-            notes.append("DXF sheets skipped: ezdxf is not installed (pip install 'ruledmesh[dxf]')")
+    dxf = _want_dxf(dxf, notes)
     for s in range(lay.n_sheets):
         put(f"sheets/sheet-{s + 1:03d}.svg",
             sheet_svg(lay, s, labels=labels, unit=unit, decimals=decimals).encode("utf-8"))
@@ -127,19 +190,17 @@ def fabricate(mesh: Mesh, folder: str | os.PathLike, *, sheet: tuple[float, floa
     put("members.csv", csv_bytes(member_schedule(mesh)))
 
     wire: dict[str, Any] | None = None
-    if path is not None:
+    if path is not None and program_text is not None:
         put("hotwire.csv", csv_bytes(hw.path_table(path)))
-        gunits = unit if unit in ("mm", "in") else ""
-        put("hotwire.gcode", hw.gcode(path, feed=feed, units=gunits).encode("ascii"))
-        wire = {"dialect": "XYUV (G1 X Y U V F)", "span": path.span, "up": path.up,
-                "depth": path.depth, "planes": path.planes.tolist(),
-                "shift": path.shift.tolist(), "kerf": path.kerf, "kerf_side": path.kerf_side,
-                "steps": int(path.generator.size)}
+        put("hotwire.gcode", program_text.encode("ascii"))
+        wire = _wire_summary(path, unit, machine or hm.Machine(feed=feed))
 
     summary = {
         "panels": panel_statistics(mesh, table=table, **tolerances),
         "sheets": {"count": lay.n_sheets, "size": lay.sheet_size.tolist(), "gap": lay.gap,
-                   "unit": unit},
+                   "unit": unit, "nesting": lay.method, "panel_area": lay.panel_area(),
+                   "utilisation": lay.utilisation(),
+                   "utilisation_trimmed": lay.utilisation_trimmed()},
         "max_out_of_plane": float(unrolled.out_of_plane.max()) if mesh.n_faces else 0.0,
         "hotwire": wire,
         "notes": notes,

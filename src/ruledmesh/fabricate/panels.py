@@ -20,6 +20,7 @@ import numpy as np
 
 from .._validation import check_float
 from ..mesh import FaceKind, Mesh
+from .labels import panel_labels
 from .unroll import Unrolled, interior_angles, polygon_edges, unroll
 
 __all__ = ["congruence_classes", "panel_table", "panel_statistics"]
@@ -124,6 +125,7 @@ def panel_table(mesh: Mesh, *, unrolled: Unrolled | None = None, classes: np.nda
     shoelace = p[:, 0] * p[nxt, 1] - p[nxt, 0] * p[:, 1]
     return {
         "id": np.arange(mesh.n_faces),
+        "label": panel_labels(mesh.n_faces),
         "kind": np.array([FaceKind(int(k)).label for k in mesh.face_kind]),
         "valence": mesh.valences,
         "area": 0.5 * np.add.reduceat(shoelace, off[:-1]),

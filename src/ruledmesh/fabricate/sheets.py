@@ -18,6 +18,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..errors import ExportError, ParameterError
+from .labels import panel_labels as panel_labels_of
 from .nesting import Layout
 from .unroll import corner_structure
 
@@ -57,7 +58,7 @@ class Labels:
 
 
 def panel_labels(layout: Layout, *, decimals: int = 3) -> Labels:
-    """Face ids at the panels' centres and edge lengths along their edges.
+    """Panel labels (:mod:`.labels`) at the panels' centres and edge lengths along their edges.
 
     The lengths are those of the placed (= unrolled = 3-D) edges, written with
     ``decimals`` decimals, inside the panel (panels run counter-clockwise, so
@@ -96,8 +97,8 @@ def panel_labels(layout: Layout, *, decimals: int = 3) -> Labels:
     size[id_slot] = face_size
     for i, t in zip(slot.tolist(), texts):
         text[i] = t
-    for i, f in zip(id_slot.tolist(), range(nf)):
-        text[i] = f"#{f}"
+    for i, name in zip(id_slot.tolist(), panel_labels_of(nf).tolist()):
+        text[i] = name
     return Labels(text, position, ang, size, np.r_[0, np.cumsum(val + 1)].astype(np.int64))
 
 

@@ -20,7 +20,7 @@ import numpy as np
 from ..errors import ExportError, ParameterError
 from ..mesh import Mesh
 
-__all__ = ["save", "load", "write_atomic", "require", "WRITERS", "READERS", "formats"]
+__all__ = ["READERS", "WRITERS", "formats", "load", "require", "save", "write_atomic"]
 
 # extension -> module (relative to ruledmesh.io) providing dumpb / loadb.
 WRITERS: dict[str, str] = {
@@ -197,6 +197,10 @@ def save(path: str | os.PathLike, mesh: Mesh, **options) -> Path:
     module = _module(path.suffix.lower(), WRITERS, "write")
     check_finite(mesh)
     data = module.dumpb(mesh, **options)
+    # Formats that keep part of the mesh in companion files (PLY generators).
+    extra = module.companions(path, mesh, **options) if hasattr(module, "companions") else {}
+    for other, other_data in extra.items():
+        write_atomic(other, other_data)
     return write_atomic(path, data)
 
 
@@ -209,6 +213,9 @@ def load(path: str | os.PathLike) -> Mesh:
     except OSError as exc:
         raise ParameterError(f"cannot read {path}: {exc.strerror}", "path") from None
     try:
-        return module.loadb(data)
+        mesh = module.loadb(data)
+        if hasattr(module, "load_companions"):
+            mesh = module.load_companions(path, mesh)
+        return mesh
     except ParameterError as exc:
         raise ParameterError(f"{path}: {exc.detail}", exc.field) from None

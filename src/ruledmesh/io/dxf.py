@@ -6,7 +6,9 @@ quads, pentagons stay pentagons) on layer ``ruledmesh-<kind>`` (e.g.
 use.  Each member (generator segment) is a LINE on layer ``generators`` whose
 XDATA (application ``RULEDMESH``, group 1071) is the generator id.  The file
 is DXF R2010 (MESH needs R2000 or later); coordinates are written at full
-double precision.  Requires the optional dependency ``ezdxf``
+double precision.  The drawing unit is the mesh's (``$INSUNITS``: 6 m, 5 cm,
+4 mm, 1 in, 2 ft) and ``$MEASUREMENT`` is 1 (metric) or 0 (imperial), so
+AutoCAD, BricsCAD and Rhino scale it correctly on insert.  Requires the optional dependency ``ezdxf``
 (``pip install ruledmesh[dxf]``).
 """
 
@@ -17,10 +19,13 @@ import io
 import numpy as np
 
 from ..mesh import FaceKind, Mesh
+from ..units import Unit, unit_of
 
-__all__ = ["dumpb", "LAYER_COLOURS", "APPID"]
+__all__ = ["APPID", "INSUNITS", "LAYER_COLOURS", "dumpb"]
 
 APPID = "RULEDMESH"
+# $INSUNITS code of each mesh unit (DXF reference, header variables).
+INSUNITS = {Unit.M: 6, Unit.CM: 5, Unit.MM: 4, Unit.IN: 1, Unit.FT: 2}
 # AutoCAD colour index per face kind.
 LAYER_COLOURS = {FaceKind.QUAD: 8, FaceKind.BORDER: 30, FaceKind.FILL: 5, FaceKind.SPLIT: 1,
                  FaceKind.TRIANGLE: 3, FaceKind.POLYGON: 6, FaceKind.STRIP: 4}
@@ -49,7 +54,9 @@ def dumpb(mesh: Mesh) -> bytes:
     bytes
     """
     ezdxf = _import_ezdxf()
-    doc = ezdxf.new("R2010", units=0)
+    unit = unit_of(mesh.units)
+    doc = ezdxf.new("R2010", units=INSUNITS[unit])
+    doc.header["$MEASUREMENT"] = 1 if unit.metric else 0
     doc.appids.add(APPID)
     msp = doc.modelspace()
     for kind in np.unique(mesh.face_kind).tolist():

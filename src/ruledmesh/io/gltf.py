@@ -16,9 +16,14 @@ Layout of the file ruledmesh writes:
   (``shading="smooth"``);
 * the generators go into a second mesh ``"generators"`` as a LINES
   primitive, one segment per member, with ``_MEMBER_ID``;
+* glTF is Y-up and in metres by specification, ruledmesh designs are Z-up
+  in their own unit: positions are scaled to metres and turned so the
+  design's +Z is glTF's +Y, glTF ``(x, y, z) = s * (x, z, -y)`` of the
+  design (a proper rotation about +X; ``s`` the unit in metres), which
+  Blender, three.js and every viewer show upright;
 * positions are float32 relative to the bounding-box centre, which is the
   nodes' ``translation`` (float64 in the JSON): large site coordinates keep
-  their precision.
+  their precision (a corner at 2.6e6 m is placed to float64 precision).
 
 To recover the polygons: in each triangle primitive, group vertices by
 ``_FACE_ID``; within a group the vertices are the polygon in boundary order
@@ -39,7 +44,7 @@ from ..errors import ExportError
 from ..mesh import FaceKind, Mesh
 from ..triangulate import triangulate
 
-__all__ = ["dumpb", "KIND_COLOURS"]
+__all__ = ["KIND_COLOURS", "Z_UP_TO_Y_UP", "dumpb", "gltf_positions"]
 
 # Linear RGBA base colours per face kind (readable on white and black).
 KIND_COLOURS = {
@@ -55,6 +60,15 @@ _FLOAT, _UINT = 5126, 5125
 _ARRAY_BUFFER, _ELEMENT_ARRAY_BUFFER = 34962, 34963
 _TRIANGLES, _LINES = 4, 1
 _EXACT_FLOAT_INT = 2 ** 24  # ids written as float32 must stay exact
+# Design (Z-up) to glTF (Y-up): (x, y, z) -> (x, z, -y), a rotation by -90 degrees about +X.
+Z_UP_TO_Y_UP = np.array([[1.0, 0.0, 0.0], [0.0, 0.0, 1.0], [0.0, -1.0, 0.0]])
+
+
+def gltf_positions(vertices: np.ndarray, units: str = "m") -> np.ndarray:
+    """(V, 3) float64: design coordinates in ``units`` as glTF coordinates (metres, Y-up)."""
+    from ..units import metres_per_unit
+
+    return metres_per_unit(units) * (np.asarray(vertices, dtype=np.float64) @ Z_UP_TO_Y_UP.T)
 
 
 class _Builder:
@@ -119,6 +133,8 @@ def dumpb(mesh: Mesh, shading: str = "flat", quads: str = "shorter") -> bytes:
         raise ExportError("glTF export is limited to 2**24 faces and vertices (float32 ids)")
     if mesh.n_faces == 0:
         raise ExportError("the mesh has no faces; a glTF file needs at least one triangle")
+    source_units = mesh.units
+    mesh = mesh.with_vertices(gltf_positions(mesh.vertices, source_units))
     centre = mesh.bounding_box().mean(axis=0)
     # Newell sums lose digits far from the origin: take normals of the centred mesh.
     normals, areas = face_normals(mesh.with_vertices(mesh.vertices - centre))
@@ -168,7 +184,8 @@ def dumpb(mesh: Mesh, shading: str = "flat", quads: str = "shorter") -> bytes:
                    "face_id_attribute": "_FACE_ID", "vertex_id_attribute": "_VERTEX_ID",
                    "polygons": "per primitive, vertices grouped by _FACE_ID are the polygon "
                                "in boundary order; triangles are consecutive per face",
-                   "shading": shading}}}]
+                   "shading": shading, "source_units": source_units,
+                   "axes": "glTF (x, y, z) in metres = design (x, z, -y) times the unit"}}}]
     nodes = [{"name": "panels", "mesh": 0, "translation": centre.tolist()}]
     if len(mesh.members):
         seg = mesh.vertices[mesh.members.reshape(-1)] - centre

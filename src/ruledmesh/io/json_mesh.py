@@ -22,17 +22,27 @@ round trip through this format is bit-exact.
 from __future__ import annotations
 
 import json
+from collections.abc import Mapping
 from enum import Enum
 from pathlib import PurePath
-from typing import Any, Mapping
+from typing import Any
 
 import numpy as np
 
 from ..errors import ParameterError
 from ..mesh import FaceKind, Mesh
 
-__all__ = ["FORMAT", "DESIGN_FORMAT", "VERSION", "SCHEMA", "to_dict", "dumpb", "loadb", "from_dict",
-           "dump_design"]
+__all__ = [
+    "DESIGN_FORMAT",
+    "FORMAT",
+    "SCHEMA",
+    "VERSION",
+    "dump_design",
+    "dumpb",
+    "from_dict",
+    "loadb",
+    "to_dict",
+]
 
 FORMAT = "ruledmesh.mesh"
 DESIGN_FORMAT = "ruledmesh.design"

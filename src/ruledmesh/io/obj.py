@@ -6,7 +6,11 @@ Rhino and Blender show each kind as its own group.  Members (generator
 segments) follow under ``g generators``, one ``l`` line each; the generator
 index of each member is kept in a trailing ``# member ids`` comment block that
 ruledmesh reads back and other readers ignore.  Coordinates are written with
-17 significant digits, so a round trip is exact.
+17 significant digits, so a round trip is exact.  OBJ has no unit field: the
+unit is stated in the header comment ``# units: mm`` (read back by
+ruledmesh).  OBJ has no up-axis either: Rhino reads it Z-up (as written),
+Blender's importer turns Y-up files to its Z-up by default, so import with
+"Up Axis: Z" (``forward_axis='Y', up_axis='Z'``) to keep the design upright.
 """
 
 from __future__ import annotations
@@ -17,8 +21,9 @@ import numpy as np
 
 from ..errors import ParameterError
 from ..mesh import FaceKind, Mesh
+from ..units import unit_of
 
-__all__ = ["dumps", "dumpb", "loads", "loadb"]
+__all__ = ["dumpb", "dumps", "loadb", "loads"]
 
 
 def _runs(values: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -42,6 +47,8 @@ def dumps(mesh: Mesh) -> str:
     """
     out = io.StringIO()
     out.write("# ruledmesh OBJ\n")
+    # OBJ has no unit: state it where people and ruledmesh's reader look.
+    out.write(f"# units: {mesh.units}\n")
     for key in ("construction", "source"):
         if key in mesh.info:
             out.write(f"# {key}: {mesh.info[key]}\n")
@@ -89,6 +96,7 @@ def loads(text: str) -> Mesh:
     members: list[tuple[int, int]] = []
     member_ids: list[int] | None = None
     group_kind = FaceKind.POLYGON
+    units = None
     labels = {k.label: k for k in FaceKind}
 
     def index(tok: str, lineno: int) -> int:
@@ -104,6 +112,9 @@ def loads(text: str) -> Mesh:
             continue
         if line.startswith("# member ids:"):
             member_ids = [int(x) for x in line.split(":", 1)[1].split()]
+            continue
+        if line.startswith("# units:"):
+            units = unit_of(line.split(":", 1)[1].strip(), f"obj line {lineno}: units").value
             continue
         if line[0] == "#":
             continue
@@ -133,7 +144,7 @@ def loads(text: str) -> Mesh:
     return Mesh.from_faces(np.array(verts, dtype=np.float64).reshape(-1, 3), faces,
                            np.array(kinds, dtype=np.uint8),
                            members=np.array(members, dtype=np.int64).reshape(-1, 2),
-                           member_id=member_ids)
+                           member_id=member_ids, info={} if units is None else {"units": units})
 
 
 def loadb(data: bytes) -> Mesh:
