@@ -49,6 +49,11 @@ def build_parser() -> argparse.ArgumentParser:
                 raise
             continue
         module.add_parser(sub)
+    from ._common import HelpFormatter
+
+    # One formatter for every subcommand: prose wrapped, examples one per line.
+    for child in sub.choices.values():
+        child.formatter_class = HelpFormatter
     return parser
 
 

@@ -3,7 +3,6 @@
 from __future__ import annotations
 
 import inspect
-from pathlib import Path
 
 
 def add_parser(sub) -> None:
@@ -16,7 +15,9 @@ def add_parser(sub) -> None:
                     "shorter diagonal); the others keep quads and polygons.",
         epilog="examples:\n"
                "  ruledmesh export skew.obj -o skew.glb\n"
-               "  ruledmesh export examples/skew.toml -o skew.json   (mesh + design tables)",
+               "  ruledmesh export examples/skew.toml -o skew.json\n"
+               "  ruledmesh export skew.obj -o skew.stl --quads best\n\n"
+               "A .json export of a design file holds the mesh and the design tables.",
     )
     p.add_argument("mesh", help="mesh file (.obj, .ply, .json) or design file (.toml)")
     p.add_argument("-o", "--output", required=True, help="file to write; its extension picks the format")
@@ -24,30 +25,27 @@ def add_parser(sub) -> None:
                    help="glTF normals: face normals (flat) or averaged vertex normals")
     p.add_argument("--quads", choices=["shorter", "best"], default="shorter",
                    help="how STL/glTF/3DM split quads: shorter diagonal, or larger smallest angle")
-    p.add_argument("-q", "--quiet", action="store_true", help="print nothing on success")
+    p.add_argument("-q", "--quiet", action="store_true", help="print nothing on success (no progress, no summary)")
     p.set_defaults(run=run)
 
 
 def run(args) -> int:
-    from ..io import WRITERS, _module, load, save
+    from ..analysis.report import kind_counts
+    from ..io import WRITERS, _module, save
+    from ._common import check_output_file, progress_for, read_source
 
-    source = Path(args.mesh)
-    output = Path(args.output)
-    design = None
-    if source.suffix.lower() == ".toml":
-        from ..design import build_design, load_design
-
-        parsed = load_design(source)
-        mesh = build_design(parsed).mesh
-        design = parsed.data
-    else:
-        mesh = load(source)
+    output = check_output_file(args.output, WRITERS)
+    progress = progress_for(args)
+    source = read_source(args.mesh, progress)
+    mesh = source.mesh
+    design = source.design.data if source.design is not None else None
     module = _module(output.suffix.lower(), WRITERS, "write")
     accepted = inspect.signature(module.dumpb).parameters
     options = {"shading": args.shading, "quads": args.quads, "design": design}
     options = {k: v for k, v in options.items() if k in accepted and v is not None}
-    save(output, mesh, **options)
+    with progress.task(f"write {args.output}"):
+        save(output, mesh, **options)
     if not args.quiet:
-        print(f"wrote {output}: {mesh.n_faces} faces, {mesh.n_vertices} vertices, "
-              f"{len(mesh.members)} members")
+        print(f"wrote {args.output}: {mesh.n_faces} faces ({kind_counts(mesh.count_kinds())}), "
+              f"{mesh.n_vertices} vertices, {len(mesh.members)} members")
     return 0

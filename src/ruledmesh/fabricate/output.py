@@ -27,6 +27,7 @@ import numpy as np
 from ..errors import GeometryError
 from ..io import write_atomic
 from ..mesh import Mesh
+from ..progress import SILENT, Progress, stages
 from ..tolerances import DEFAULT, Tolerances
 from . import hotwire as hw
 from .nesting import layout
@@ -43,7 +44,8 @@ def fabricate(mesh: Mesh, folder: str | os.PathLike, *, sheet: tuple[float, floa
               length_tol: float | None = None, angle_tol: float = 1e-4, dxf: bool | None = None,
               hotwire: bool | None = None, span: str = "auto", up: str | None = None,
               kerf: float = 0.0, kerf_side: str = "left", feed: float = 300.0,
-              require_planar: bool = True, tol: Tolerances = DEFAULT) -> dict[str, Any]:
+              require_planar: bool = True, tol: Tolerances = DEFAULT,
+              progress: Progress | None = None) -> dict[str, Any]:
     """Write the fabrication files of ``mesh`` into ``folder`` (created if missing).
 
     Parameters
@@ -72,6 +74,8 @@ def fabricate(mesh: Mesh, folder: str | os.PathLike, *, sheet: tuple[float, floa
     require_planar : bool
         Refuse bent panels (see :func:`~ruledmesh.fabricate.unroll.unroll`).
     tol : Tolerances
+    progress : Progress, optional
+        Told the stages and each sheet as it is written (see :mod:`ruledmesh.progress`).
 
     Returns
     -------
@@ -86,27 +90,34 @@ def fabricate(mesh: Mesh, folder: str | os.PathLike, *, sheet: tuple[float, floa
         write_atomic(folder / name, data)
         written.append(name)
 
-    unrolled = unroll(mesh, require_planar=require_planar, tol=tol)
-    lay = layout(unrolled, sheet, gap=gap)
-    labels = panel_labels(lay, decimals=decimals)
-    # Everything that can refuse runs before the first file is written.
-    path = None
-    if hotwire is not False and len(mesh.members):
-        try:
-            path = hw.wire_paths(mesh, span=span, up=up, kerf=kerf, kerf_side=kerf_side, tol=tol)
-        except GeometryError as exc:
-            if hotwire:
-                raise
-            notes.append(f"hot-wire paths skipped: {exc}")
-    elif hotwire and not len(mesh.members):
-        raise GeometryError("the mesh has no generators (members) to cut along")
+    progress = progress or SILENT
+    with stages(progress, "fabricate", ["unroll", "layout", "labels", "hot wire", "classes"]) as task:
+        unrolled = unroll(mesh, require_planar=require_planar, tol=tol)
+        task.advance(note="layout")
+        lay = layout(unrolled, sheet, gap=gap)
+        task.advance(note="labels")
+        labels = panel_labels(lay, decimals=decimals)
+        task.advance(note="hot wire")
+        # Everything that can refuse runs before the first file is written.
+        path = None
+        if hotwire is not False and len(mesh.members):
+            try:
+                path = hw.wire_paths(mesh, span=span, up=up, kerf=kerf, kerf_side=kerf_side, tol=tol)
+            except GeometryError as exc:
+                if hotwire:
+                    raise
+                notes.append(f"hot-wire paths skipped: {exc}")
+        elif hotwire and not len(mesh.members):
+            raise GeometryError("the mesh has no generators (members) to cut along")
 
-    tolerances = {"length_tol": length_tol if length_tol is not None
-                  else 1e-9 * (mesh.diagonal() or 1.0), "angle_tol": angle_tol}
-    classes = congruence_classes(mesh, unrolled=unrolled, **tolerances)
-    table = panel_table(mesh, unrolled=unrolled, classes=classes)
-    table.update({"sheet": lay.sheet + 1, "sheet_x": lay.offset[:, 0], "sheet_y": lay.offset[:, 1],
-                  "rotation_deg": np.degrees(lay.rotation)})
+        task.advance(note="classes")
+        tolerances = {"length_tol": length_tol if length_tol is not None
+                      else 1e-9 * (mesh.diagonal() or 1.0), "angle_tol": angle_tol}
+        classes = congruence_classes(mesh, unrolled=unrolled, **tolerances)
+        table = panel_table(mesh, unrolled=unrolled, classes=classes)
+        table.update({"sheet": lay.sheet + 1, "sheet_x": lay.offset[:, 0], "sheet_y": lay.offset[:, 1],
+                      "rotation_deg": np.degrees(lay.rotation)})
+        task.advance()
     (folder / "sheets").mkdir(parents=True, exist_ok=True)
     if dxf is None:
         try:
@@ -115,16 +126,23 @@ def fabricate(mesh: Mesh, folder: str | os.PathLike, *, sheet: tuple[float, floa
         except ImportError:
             dxf = False
             notes.append("DXF sheets skipped: ezdxf is not installed (pip install 'ruledmesh[dxf]')")
-    for s in range(lay.n_sheets):
-        put(f"sheets/sheet-{s + 1:03d}.svg",
-            sheet_svg(lay, s, labels=labels, unit=unit, decimals=decimals).encode("utf-8"))
-        if dxf:
-            put(f"sheets/sheet-{s + 1:03d}.dxf", sheet_dxf(lay, s, labels=labels, unit=unit))
+    with progress.task("sheets", total=lay.n_sheets) as sheets:
+        for s in range(lay.n_sheets):
+            put(f"sheets/sheet-{s + 1:03d}.svg",
+                sheet_svg(lay, s, labels=labels, unit=unit, decimals=decimals).encode("utf-8"))
+            if dxf:
+                put(f"sheets/sheet-{s + 1:03d}.dxf", sheet_dxf(lay, s, labels=labels, unit=unit))
+            sheets.advance()
 
-    put("panels.csv", csv_bytes(table))
-    put("nodes.csv", csv_bytes(node_schedule(mesh)))
-    put("edges.csv", csv_bytes(edge_schedule(mesh)))
-    put("members.csv", csv_bytes(member_schedule(mesh)))
+    with stages(progress, "schedules", ["panels", "nodes", "edges", "members"]) as sched:
+        put("panels.csv", csv_bytes(table))
+        sched.advance(note="nodes")
+        put("nodes.csv", csv_bytes(node_schedule(mesh)))
+        sched.advance(note="edges")
+        put("edges.csv", csv_bytes(edge_schedule(mesh)))
+        sched.advance(note="members")
+        put("members.csv", csv_bytes(member_schedule(mesh)))
+        sched.advance()
 
     wire: dict[str, Any] | None = None
     if path is not None:
