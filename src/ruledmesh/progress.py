@@ -23,6 +23,8 @@ may change the text shown after its label (the current stage).
 
 from __future__ import annotations
 
+import io
+import os
 import sys
 import threading
 from typing import Any, TextIO
@@ -82,12 +84,12 @@ def stages(progress: Progress | None, label: str, names: list[str]):
 
 
 class _BarTask(Task):
-    def __init__(self, owner: "TerminalProgress", bar: Any):
-        self._owner, self._bar = owner, bar
+    def __init__(self, owner: "TerminalProgress", bar: Any, label: str):
+        self._owner, self._bar, self._label = owner, bar, label
 
     def advance(self, n: int = 1, note: str | None = None) -> None:
         if note is not None:
-            self._bar.set_postfix_str(note, refresh=False)
+            self._bar.set_description_str(f"{self._label} ({note})", refresh=False)
         if n:
             self._bar.update(n)
         else:
@@ -98,9 +100,12 @@ class _BarTask(Task):
         self._bar.close()
 
 
-# A counted task shows a bar; an uncounted one only its label and elapsed time.
-_COUNTED = "{desc}: {percentage:3.0f}%|{bar:24}| {n_fmt}/{total_fmt} {postfix} [{elapsed}<{remaining}]"
-_UNCOUNTED = "{desc} {postfix} [{elapsed}]"
+# A counted task shows a bar; an uncounted one only its label and elapsed time.  Short
+# lists of stages of unequal length get no time estimate (it would mislead).
+_COUNTED = "{desc}: {percentage:3.0f}%|{bar:24}| {n_fmt}/{total_fmt} [{elapsed}<{remaining}]"
+_STAGES = "{desc}: {percentage:3.0f}%|{bar:24}| {n_fmt}/{total_fmt} [{elapsed}]"
+_UNCOUNTED = "{desc} [{elapsed}]"
+_FEW = 8
 
 
 class TerminalProgress(Progress):
@@ -133,8 +138,12 @@ class TerminalProgress(Progress):
             return Task()
         from tqdm import tqdm
 
-        bar = tqdm(desc=label, total=total, file=self.stream, leave=False, dynamic_ncols=True,
-                   bar_format=_COUNTED if total else _UNCOUNTED, mininterval=0.2)
+        # A terminal that reports no size (a fresh pseudo-terminal) would hide every bar.
+        size = self._size()
+        bar = tqdm(desc=label, total=total, file=self.stream, leave=False,
+                   dynamic_ncols=size is None, ncols=size and size[0], nrows=size and size[1],
+                   bar_format=(_UNCOUNTED if not total else _STAGES if total <= _FEW
+                               else _COUNTED), mininterval=0.2)
         with self._lock:
             self._bars.append(bar)
             if self._ticker is None:
@@ -143,7 +152,15 @@ class TerminalProgress(Progress):
                 self._ticker = threading.Thread(target=self._tick, args=(self._stop,),
                                                 daemon=True, name="ruledmesh-progress")
                 self._ticker.start()
-        return _BarTask(self, bar)
+        return _BarTask(self, bar, label)
+
+    def _size(self) -> tuple[int, int] | None:
+        """``None`` (follow the terminal) unless it reports a zero size, then 80 x 24."""
+        try:
+            size = os.get_terminal_size(self.stream.fileno())
+        except (AttributeError, OSError, ValueError, io.UnsupportedOperation):
+            return None
+        return None if size.columns > 0 and size.lines > 0 else (80, 24)
 
     def _forget(self, bar: Any) -> None:
         with self._lock:

@@ -129,10 +129,13 @@ def _existing(typed: str, what: str) -> Path:
         hint = ""
         parent = path.parent if str(path.parent) else Path(".")
         if parent.is_dir():
-            near = sorted(p.name for p in parent.iterdir() if p.suffix == path.suffix)[:3]
+            import difflib
+
+            names = [p.name for p in parent.iterdir() if p.is_file()]
+            near = difflib.get_close_matches(path.name, names, n=3, cutoff=0.6)
             if near:
-                where = "the current folder" if str(parent) == "." else str(parent)
-                hint = f" (in {where} there are: {', '.join(near)})"
+                where = "" if str(parent) == "." else f" in {parent}"
+                hint = f" (did you mean {' or '.join(near)}{where}?)"
         raise InputError(f"{typed}: file not found; check the path{hint}")
     if not os.access(path, os.R_OK):
         raise InputError(f"{typed}: cannot be read (permission denied)")
