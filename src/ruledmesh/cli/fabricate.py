@@ -41,7 +41,7 @@ def add_parser(sub) -> None:
                     "XYUV G-code) along the generators. See docs/fabrication.md.",
         epilog="examples:\n"
                "  ruledmesh fabricate skew.obj -o skew-fab\n"
-               "  ruledmesh fabricate skew.obj -o fab --scale 1000 --unit mm --sheet 2500x1250\n",
+               "  ruledmesh fabricate examples/fig5b-torus.toml -o torus-fab --scale 1000 --unit mm --sheet 2500x1250\n",
     )
     p.add_argument("mesh", help="mesh file (.obj, .ply, ...) or design file (.toml)")
     p.add_argument("-o", "--output", required=True, help="folder to write into (created if missing)")
