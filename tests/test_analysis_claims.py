@@ -156,3 +156,12 @@ def test_face_counts_in_one_vocabulary(capsys):
     assert main(["analyze", str(EXAMPLES / "skew.toml")]) == 0
     row = next(ln for ln in capsys.readouterr().out.splitlines() if ln.startswith("kinds"))
     assert row.split(None, 1)[1] == "633 quads, 9 border faces, 306 fill triangles"
+
+
+def test_designer_figures_use_the_same_words():
+    from ruledmesh.web.session import fast_figures
+
+    mesh = build_file(EXAMPLES / "skew.toml").mesh
+    figures, _ = fast_figures(mesh)
+    assert figures["kinds_text"] == kind_counts(mesh.count_kinds()) == \
+        "633 quads, 9 border faces, 306 fill triangles"
