@@ -47,7 +47,8 @@ def run(workdir: Path, *argv: str) -> subprocess.CompletedProcess:
 CASES = {
     "analyze-missing": (["analyze", "nope.obj"], "nope.obj: file not found"),
     "build-missing": (["build", "nope.toml", "-o", "x.obj"], "nope.toml: file not found"),
-    "build-missing-suggests": (["build", "skwe.toml", "-o", "x.obj"], "skwe.toml: file not found; check the path (did you mean skew.toml?)"),
+    "build-missing-suggests": (["build", "skwe.toml", "-o", "x.obj"],
+                               "skwe.toml: file not found; check the path (did you mean skew.toml?)"),
     "build-mesh-as-design": (["build", "skew.obj", "-o", "x.obj"],
                              "skew.obj: this is an OBJ mesh, not a design file; use `ruledmesh "
                              "analyze skew.obj`"),

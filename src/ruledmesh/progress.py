@@ -154,6 +154,14 @@ class TerminalProgress(Progress):
                 self._ticker.start()
         return _BarTask(self, bar, label)
 
+    def close(self) -> None:
+        """Close every bar still open (work an error interrupted) and stop redrawing."""
+        with self._lock:
+            bars = list(self._bars)
+        for bar in bars:
+            self._forget(bar)
+            bar.close()
+
     def _size(self) -> tuple[int, int] | None:
         """``None`` (follow the terminal) unless it reports a zero size, then 80 x 24."""
         try:

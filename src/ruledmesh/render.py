@@ -165,6 +165,19 @@ def _generator_subset(mesh: Mesh, generators: bool | str, width: int) -> np.ndar
     return mesh.members[index % step == 0]
 
 
+def _frame(ax, mesh: Mesh, elev: float, azim: float) -> None:
+    """Axis limits around the mesh at equal scale, the camera, no axes drawn."""
+    lo, hi = mesh.bounding_box()
+    span = np.maximum(hi - lo, 1e-9 * max(float(np.max(hi - lo)), 1.0))
+    ax.set_xlim(lo[0], lo[0] + span[0])
+    ax.set_ylim(lo[1], lo[1] + span[1])
+    ax.set_zlim(lo[2], lo[2] + span[2])
+    # Equal scale on the three axes: a flat-looking panel must look flat.
+    ax.set_box_aspect(tuple(np.maximum(span / span.max(), 0.02)), zoom=0.9)
+    ax.view_init(elev=elev, azim=azim)
+    ax.set_axis_off()
+
+
 def render(mesh: Mesh, *, color: ColorBy | str = ColorBy.PLANARITY, reference=None,
            view: tuple[float, float] = (25.0, -60.0), size: tuple[int, int] = (1000, 800),
            dpi: int = 100, generators: bool | str = "auto", edges: bool | str = "auto",
@@ -246,15 +259,7 @@ def render(mesh: Mesh, *, color: ColorBy | str = ColorBy.PLANARITY, reference=No
         ax.add_collection3d(Line3DCollection(segs, colors="#111111", zorder=3,
                                              linewidths=0.5 if thinned else 0.8))
 
-    lo, hi = mesh.bounding_box()
-    span = np.maximum(hi - lo, 1e-9 * max(float(np.max(hi - lo)), 1.0))
-    ax.set_xlim(lo[0], lo[0] + span[0])
-    ax.set_ylim(lo[1], lo[1] + span[1])
-    ax.set_zlim(lo[2], lo[2] + span[2])
-    # Equal scale on the three axes: a flat-looking panel must look flat.
-    ax.set_box_aspect(tuple(np.maximum(span / span.max(), 0.02)), zoom=0.9)
-    ax.view_init(elev=elev, azim=azim)
-    ax.set_axis_off()
+    _frame(ax, mesh, elev, azim)
     bar = fig.colorbar(polys, cax=fig.add_axes((0.88, 0.2, 0.025, 0.6)))
     bar.set_label(label)
     if ticks is not None:

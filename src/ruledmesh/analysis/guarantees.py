@@ -144,7 +144,7 @@ def check_guarantee(text: str, mesh: Mesh, tol: Tolerances = DEFAULT) -> dict[st
     """
     ids = np.flatnonzero((mesh.face_kind == FaceKind.QUAD) & (mesh.valences == 4))
     corners = mesh.vertices[mesh.face_indices[mesh.face_offsets[ids][:, None] + np.arange(4)]]
-    rows = []
+    rows: list[dict[str, Any]] = []
     for prop in _properties(text):
         measured = _measure(prop, mesh, corners, tol) if ids.size or prop == "planar" else None
         if measured is None:

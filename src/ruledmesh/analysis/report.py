@@ -50,7 +50,7 @@ KIND_NOUNS = {
 # Deliberately loose, "far off" only: meshes of the bundled designs reach 0.04 (hybrid
 # meshes near torsal lines) and coverage 0.73 (compounds covering part of the patch); a
 # skew mesh measured against the torus design gives 0.62 and 0.43.
-MISMATCH = {"closeness": 0.1, "coverage": (0.5, 2.0)}
+MISMATCH: dict[str, Any] = {"closeness": 0.1, "coverage": (0.5, 2.0)}
 
 # Extra figures from other modules: name -> fn(mesh) -> dict or None (None: not applicable).
 # Modules in _HOOK_MODULES register themselves here when imported.

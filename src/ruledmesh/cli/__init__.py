@@ -57,6 +57,16 @@ def build_parser() -> argparse.ArgumentParser:
     return parser
 
 
+def _run(args: argparse.Namespace) -> int:
+    """The subcommand; progress bars it leaves open are closed before any message."""
+    try:
+        return int(args.run(args) or 0)
+    finally:
+        progress = getattr(args, "progress", None)
+        if progress is not None:
+            progress.close()
+
+
 def main(argv: Sequence[str] | None = None) -> int:
     """Run the command line; returns the exit code.
 
@@ -70,7 +80,7 @@ def main(argv: Sequence[str] | None = None) -> int:
         parser.print_help()
         return 2
     try:
-        return int(args.run(args) or 0)
+        return _run(args)
     except RuledMeshError as exc:
         if args.debug:
             raise

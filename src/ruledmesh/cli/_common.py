@@ -50,7 +50,9 @@ class HelpFormatter(argparse.HelpFormatter):
 def progress_for(args: argparse.Namespace) -> Progress:
     """Bars on stderr when it is a terminal, unless ``-q`` or ``--json`` was given."""
     quiet = getattr(args, "quiet", False) or getattr(args, "json", False)
-    return TerminalProgress(enabled=not quiet)
+    # Kept on ``args`` so that main() closes bars an error leaves open before it reports.
+    args.progress = TerminalProgress(enabled=not quiet)
+    return args.progress
 
 
 # ---------------------------------------------------------------- recognising files

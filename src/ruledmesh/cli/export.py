@@ -25,7 +25,8 @@ def add_parser(sub) -> None:
                    help="glTF normals: face normals (flat) or averaged vertex normals")
     p.add_argument("--quads", choices=["shorter", "best"], default="shorter",
                    help="how STL/glTF/3DM split quads: shorter diagonal, or larger smallest angle")
-    p.add_argument("-q", "--quiet", action="store_true", help="print nothing on success (no progress, no summary)")
+    p.add_argument("-q", "--quiet", action="store_true",
+                   help="print nothing on success (no progress, no summary)")
     p.set_defaults(run=run)
 
 

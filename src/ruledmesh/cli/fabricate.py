@@ -41,7 +41,8 @@ def add_parser(sub) -> None:
                     "XYUV G-code) along the generators. See docs/fabrication.md.",
         epilog="examples:\n"
                "  ruledmesh fabricate skew.obj -o skew-fab\n"
-               "  ruledmesh fabricate examples/fig5b-torus.toml -o torus-fab --scale 1000 --unit mm --sheet 2500x1250\n",
+               "  ruledmesh fabricate examples/fig5b-torus.toml -o torus-fab --scale 1000 --unit mm "
+               "--sheet 2500x1250\n",
     )
     p.add_argument("mesh", help="mesh file (.obj, .ply, ...) or design file (.toml)")
     p.add_argument("-o", "--output", required=True, help="folder to write into (created if missing)")
@@ -66,7 +67,8 @@ def add_parser(sub) -> None:
     p.add_argument("--feed", type=float, default=300.0, help="hot wire: feed per minute (default 300)")
     p.add_argument("--allow-bent", action="store_true",
                    help="project non-planar faces instead of refusing them")
-    p.add_argument("-q", "--quiet", action="store_true", help="print nothing on success (no progress, no summary)")
+    p.add_argument("-q", "--quiet", action="store_true",
+                   help="print nothing on success (no progress, no summary)")
     p.set_defaults(run=run)
 
 

@@ -91,33 +91,35 @@ def fabricate(mesh: Mesh, folder: str | os.PathLike, *, sheet: tuple[float, floa
         written.append(name)
 
     progress = progress or SILENT
-    with stages(progress, "fabricate", ["unroll", "layout", "labels", "hot wire", "classes"]) as task:
-        unrolled = unroll(mesh, require_planar=require_planar, tol=tol)
-        task.advance(note="layout")
-        lay = layout(unrolled, sheet, gap=gap)
-        task.advance(note="labels")
-        labels = panel_labels(lay, decimals=decimals)
-        task.advance(note="hot wire")
-        # Everything that can refuse runs before the first file is written.
-        path = None
-        if hotwire is not False and len(mesh.members):
-            try:
-                path = hw.wire_paths(mesh, span=span, up=up, kerf=kerf, kerf_side=kerf_side, tol=tol)
-            except GeometryError as exc:
-                if hotwire:
-                    raise
-                notes.append(f"hot-wire paths skipped: {exc}")
-        elif hotwire and not len(mesh.members):
-            raise GeometryError("the mesh has no generators (members) to cut along")
+    # Not a ``with``: the caller closes what an error leaves open (TerminalProgress.close).
+    task = stages(progress, "fabricate", ["unroll", "layout", "labels", "hot wire", "classes"])
+    unrolled = unroll(mesh, require_planar=require_planar, tol=tol)
+    task.advance(note="layout")
+    lay = layout(unrolled, sheet, gap=gap)
+    task.advance(note="labels")
+    labels = panel_labels(lay, decimals=decimals)
+    task.advance(note="hot wire")
+    # Everything that can refuse runs before the first file is written.
+    path = None
+    if hotwire is not False and len(mesh.members):
+        try:
+            path = hw.wire_paths(mesh, span=span, up=up, kerf=kerf, kerf_side=kerf_side, tol=tol)
+        except GeometryError as exc:
+            if hotwire:
+                raise
+            notes.append(f"hot-wire paths skipped: {exc}")
+    elif hotwire and not len(mesh.members):
+        raise GeometryError("the mesh has no generators (members) to cut along")
 
-        task.advance(note="classes")
-        tolerances = {"length_tol": length_tol if length_tol is not None
-                      else 1e-9 * (mesh.diagonal() or 1.0), "angle_tol": angle_tol}
-        classes = congruence_classes(mesh, unrolled=unrolled, **tolerances)
-        table = panel_table(mesh, unrolled=unrolled, classes=classes)
-        table.update({"sheet": lay.sheet + 1, "sheet_x": lay.offset[:, 0], "sheet_y": lay.offset[:, 1],
-                      "rotation_deg": np.degrees(lay.rotation)})
-        task.advance()
+    task.advance(note="classes")
+    tolerances = {"length_tol": length_tol if length_tol is not None
+                  else 1e-9 * (mesh.diagonal() or 1.0), "angle_tol": angle_tol}
+    classes = congruence_classes(mesh, unrolled=unrolled, **tolerances)
+    table = panel_table(mesh, unrolled=unrolled, classes=classes)
+    table.update({"sheet": lay.sheet + 1, "sheet_x": lay.offset[:, 0], "sheet_y": lay.offset[:, 1],
+                  "rotation_deg": np.degrees(lay.rotation)})
+    task.advance()
+    task.close()
     (folder / "sheets").mkdir(parents=True, exist_ok=True)
     if dxf is None:
         try:
@@ -126,23 +128,9 @@ def fabricate(mesh: Mesh, folder: str | os.PathLike, *, sheet: tuple[float, floa
         except ImportError:
             dxf = False
             notes.append("DXF sheets skipped: ezdxf is not installed (pip install 'ruledmesh[dxf]')")
-    with progress.task("sheets", total=lay.n_sheets) as sheets:
-        for s in range(lay.n_sheets):
-            put(f"sheets/sheet-{s + 1:03d}.svg",
-                sheet_svg(lay, s, labels=labels, unit=unit, decimals=decimals).encode("utf-8"))
-            if dxf:
-                put(f"sheets/sheet-{s + 1:03d}.dxf", sheet_dxf(lay, s, labels=labels, unit=unit))
-            sheets.advance()
-
-    with stages(progress, "schedules", ["panels", "nodes", "edges", "members"]) as sched:
-        put("panels.csv", csv_bytes(table))
-        sched.advance(note="nodes")
-        put("nodes.csv", csv_bytes(node_schedule(mesh)))
-        sched.advance(note="edges")
-        put("edges.csv", csv_bytes(edge_schedule(mesh)))
-        sched.advance(note="members")
-        put("members.csv", csv_bytes(member_schedule(mesh)))
-        sched.advance()
+    _write_sheets(put, lay, labels, unit=unit, decimals=decimals, dxf=bool(dxf),
+                  progress=progress)
+    _write_schedules(put, mesh, table, progress)
 
     wire: dict[str, Any] | None = None
     if path is not None:
@@ -165,3 +153,28 @@ def fabricate(mesh: Mesh, folder: str | os.PathLike, *, sheet: tuple[float, floa
     }
     put("summary.json", (json.dumps(summary, indent=2) + "\n").encode("utf-8"))
     return summary
+
+
+def _write_sheets(put, lay, labels, *, unit: str, decimals: int, dxf: bool,
+                  progress: Progress) -> None:
+    """One SVG (and DXF) per sheet, reported sheet by sheet."""
+    with progress.task("sheets", total=lay.n_sheets) as sheets:
+        for s in range(lay.n_sheets):
+            put(f"sheets/sheet-{s + 1:03d}.svg",
+                sheet_svg(lay, s, labels=labels, unit=unit, decimals=decimals).encode("utf-8"))
+            if dxf:
+                put(f"sheets/sheet-{s + 1:03d}.dxf", sheet_dxf(lay, s, labels=labels, unit=unit))
+            sheets.advance()
+
+
+def _write_schedules(put, mesh: Mesh, table: dict, progress: Progress) -> None:
+    """The panel, node, edge and member schedules (CSV)."""
+    with stages(progress, "schedules", ["panels", "nodes", "edges", "members"]) as task:
+        put("panels.csv", csv_bytes(table))
+        task.advance(note="nodes")
+        put("nodes.csv", csv_bytes(node_schedule(mesh)))
+        task.advance(note="edges")
+        put("edges.csv", csv_bytes(edge_schedule(mesh)))
+        task.advance(note="members")
+        put("members.csv", csv_bytes(member_schedule(mesh)))
+        task.advance()
