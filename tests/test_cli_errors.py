@@ -48,7 +48,7 @@ CASES = {
     "analyze-missing": (["analyze", "nope.obj"], "nope.obj: file not found"),
     "build-missing": (["build", "nope.toml", "-o", "x.obj"], "nope.toml: file not found"),
     "build-missing-suggests": (["build", "skwe.toml", "-o", "x.obj"],
-                               "skwe.toml: file not found; check the path (did you mean skew.toml?)"),
+                               "skwe.toml: file not found; check the path (did you mean skew.toml"),
     "build-mesh-as-design": (["build", "skew.obj", "-o", "x.obj"],
                              "skew.obj: this is an OBJ mesh, not a design file; use `ruledmesh "
                              "analyze skew.obj`"),
@@ -158,3 +158,26 @@ def test_mesh_with_the_wrong_extension_is_read_by_content(workdir, capsys):
     finally:
         os.unlink(workdir / "skew-copy.txt")
     assert '"faces": 948' in capsys.readouterr().out
+
+
+def test_design_errors_name_the_path_as_typed(workdir):
+    (workdir / "sub").mkdir(exist_ok=True)
+    (workdir / "sub" / "bad.toml").write_text('[rulings]\ncount = "forty"\n')
+    (workdir / "sub" / "syntax.toml").write_text('[mesh\nrows = 3\n')
+    try:
+        proc = run(workdir, "build", "sub/bad.toml", "-o", "x.obj")
+        assert proc.returncode == 2 and proc.stderr.startswith("ruledmesh: error: sub/bad.toml: ")
+        proc = run(workdir, "build", "sub/syntax.toml", "-o", "x.obj")
+        assert proc.returncode == 2
+        assert proc.stderr.startswith("ruledmesh: error: sub/syntax.toml: invalid TOML")
+    finally:
+        shutil.rmtree(workdir / "sub")
+    assert not (workdir / "x.obj").exists()
+
+
+def test_os_errors_name_the_target_not_the_temporary_file():
+    from ruledmesh.cli import _published_name
+
+    assert _published_name("/w/.skew.obj.4242.5.0a1b2c3d.part") == "/w/skew.obj"
+    assert _published_name("out/.sheet-001.svg.k2j3h4_z.part") == "out/sheet-001.svg"
+    assert _published_name("skew.obj") == "skew.obj"

@@ -57,6 +57,20 @@ def build_parser() -> argparse.ArgumentParser:
     return parser
 
 
+def _published_name(filename) -> str:
+    """The file the user asked for, not the hidden ``.NAME.*.part`` temporary it is written as."""
+    import re
+    from pathlib import Path
+
+    path = Path(str(filename))
+    # ruledmesh.io.write_atomic's two temporary names: .NAME.PID.FD.HEX8.part, .NAME.XXXXXXXX.part
+    m = (re.fullmatch(r"\.(.+)\.\d+\.\d+\.[0-9a-f]{8}\.part", path.name)
+         or re.fullmatch(r"\.(.+)\.[A-Za-z0-9_]{8}\.part", path.name))
+    if not m:
+        return str(filename)
+    return str(path.with_name(m.group(1)))
+
+
 def _run(args: argparse.Namespace) -> int:
     """The subcommand; progress bars it leaves open are closed before any message."""
     try:
@@ -89,7 +103,7 @@ def main(argv: Sequence[str] | None = None) -> int:
     except OSError as exc:
         if args.debug:
             raise
-        where = f"{exc.filename}: " if exc.filename else ""
+        where = f"{_published_name(exc.filename)}: " if exc.filename else ""
         print(f"ruledmesh: error: {where}{exc.strerror or exc}", file=sys.stderr)
         return 2
     except KeyboardInterrupt:

@@ -158,10 +158,18 @@ def read_design(typed: str, progress: Progress | None = None, *, option: str = "
 
     Returns ``(Design, Built)``.
     """
-    from ..design import build_design, load_design
+    from dataclasses import replace
 
-    design = load_design(check_design_file(typed, option=option))
-    return design, build_design(design, progress)
+    from ..design import build_design, load_design
+    from ..errors import DesignError
+
+    path = check_design_file(typed, option=option)
+    try:
+        design = load_design(path)
+    except DesignError as exc:  # syntax errors carry the bare file name: give the typed path
+        raise exc.with_source(typed) from None
+    # Messages about fields name the file as typed too ("examples/skew.toml: rulings.count: ...").
+    return design, build_design(replace(design, source=typed), progress)
 
 
 def check_design_file(typed: str, *, option: str = "") -> Path:
