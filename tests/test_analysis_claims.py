@@ -154,8 +154,12 @@ def test_face_counts_in_one_vocabulary(capsys):
     assert kind_counts({"quad": 633, "border": 9, "fill": 306, "split": 1}) == \
         "633 quads, 9 border faces, 306 fill triangles, 1 split quad"
     assert main(["analyze", str(EXAMPLES / "skew.toml")]) == 0
-    row = next(ln for ln in capsys.readouterr().out.splitlines() if ln.startswith("kinds"))
+    table = capsys.readouterr().out.splitlines()
+    row = next(ln for ln in table if ln.startswith("kinds"))
     assert row.split(None, 1)[1] == "633 quads, 9 border faces, 306 fill triangles"
+    # the export triangulation's figures are not a face count: their row says so
+    assert any(ln.startswith("triangulation ") for ln in table)
+    assert not any(ln.startswith("triangles ") for ln in table)
 
 
 def test_designer_figures_use_the_same_words():

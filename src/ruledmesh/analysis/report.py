@@ -261,7 +261,9 @@ def format_table(report: Mapping[str, Any]) -> str:
     shown = {"kinds": kind_counts,
              "guarantee": lambda g: format_guarantee(report["guarantee_check"])
              if "guarantee_check" in report else str(g)}
-    rows = [(k, shown.get(k, _fmt)(v)) for k, v in report.items()
+    # "triangles" are the export triangulation's, not faces: the row says so.
+    names = {"triangles": "triangulation"}
+    rows = [(names.get(k, k), shown.get(k, _fmt)(v)) for k, v in report.items()
             if k not in ("warnings", "guarantee_check")]
     width = max(len(k) for k, _ in rows)
     lines = [f"{k.ljust(width)}  {v}" for k, v in rows]
