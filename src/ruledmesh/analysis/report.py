@@ -126,7 +126,7 @@ def analyze(mesh: Mesh, reference=None, extras: Mapping[str, Any] | None = None,
     _load_hooks()
     names = ["faces"] + ["closeness"] * (reference is not None) + list(METRIC_HOOKS)
     with stages(progress, "analyse", names) as task:
-        report = _figures(mesh, reference, tol)
+        report = _figures(mesh, tol)
         task.advance(note=names[1] if len(names) > 1 else None)
         if reference is not None:
             report.update(_closeness(mesh, reference, report["area"]["total"]))
@@ -145,7 +145,7 @@ def analyze(mesh: Mesh, reference=None, extras: Mapping[str, Any] | None = None,
     return report
 
 
-def _figures(mesh: Mesh, reference, tol: Tolerances) -> dict[str, Any]:
+def _figures(mesh: Mesh, tol: Tolerances) -> dict[str, Any]:
     """The figures every mesh has: counts, planarity, convexity, sizes, angles."""
     diag = mesh.diagonal() or 1.0
     plan = F.planarity(mesh)

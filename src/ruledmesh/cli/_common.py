@@ -144,6 +144,10 @@ def _existing(typed: str, what: str) -> Path:
     return path
 
 
+# Contents that say nothing against being a design file (the design parser judges them).
+_NOT_A_MESH = (None, "an empty file", "a file of comments only")
+
+
 @dataclass(frozen=True)
 class Source:
     """What a mesh-or-design argument turned out to be."""
@@ -177,7 +181,8 @@ def check_design_file(typed: str, *, option: str = "") -> Path:
     what = f"a design file{' for ' + option if option else ''}"
     path = _existing(typed, what)
     kind = file_kind(path)
-    if kind not in ("a TOML file", None) and not kind.startswith("a file of comments"):
+    # An empty design is still a design: the design parser says which table it lacks.
+    if kind != "a TOML file" and kind not in _NOT_A_MESH:
         use = (f"use `ruledmesh analyze {typed}` to measure it, or pass a design file (.toml)"
                if kind in MESH_KINDS else "pass a design file (.toml)")
         if kind == "a CSV table":
@@ -193,7 +198,7 @@ def read_source(typed: str, progress: Progress | None = None) -> Source:
 
     path = _existing(typed, "a mesh or design file")
     kind = file_kind(path)
-    if kind == "a TOML file" or (kind is None and path.suffix.lower() == ".toml"):
+    if kind == "a TOML file" or (path.suffix.lower() == ".toml" and kind in _NOT_A_MESH):
         design, built = read_design(typed, progress)
         return Source(built.mesh, built, design)
     ext = MESH_KINDS.get(kind or "", path.suffix.lower() if kind is None else None)
