@@ -192,7 +192,7 @@ def test_payload_matches_the_mesh():
     assert ["curves", "c1", "points", 3] in paths and ["curves", "c2", "points", 0] in paths
     assert [c["name"] for c in header["curves"]] == ["c1", "c2"]
     assert arrays["curve_points"].shape == (sum(c["count"] for c in header["curves"]), 3)
-    assert arrays["generators"].shape == (9, 2, 3)
+    assert arrays["generators"].shape == (len(s.built.rulings.a), 2, 3)   # 9 + kink generators
 
 
 # ---------------------------------------------------------------- HTTP

@@ -164,14 +164,16 @@ def test_sign_change_of_twist_is_a_torsal_cut():
     assert any("torsal strips" in w for w in mesh.info["warnings"])
 
 
-def test_parallel_generators_cylinder_is_refused_to_hop_but_meshed():
+def test_parallel_generators_cylinder_is_a_prism_of_strip_quads():
+    """No hop across parallel generators; each coplanar strip carries planar quads (§3.1)."""
     m = 12
     phi = np.linspace(0, 2, m)
     A = np.stack([np.cos(phi), np.sin(phi), np.zeros(m)], 1)
     B = A + [0, 0, 2]
     mesh = pq_mesh(A, B, rows=8)
     check_mesh(mesh)
-    assert mesh.count_kinds() == {"fill": mesh.n_faces}
+    assert mesh.count_kinds() == {"strip": mesh.n_faces}
+    assert np.all(np.diff(mesh.face_offsets) == 4)
 
 
 def test_untrimmed_mesh_keeps_the_extension():
@@ -223,8 +225,9 @@ def test_far_rows_are_never_emitted():
     assert convexity(mesh).all()
 
 
-def test_kink_of_a_director_polyline_restarts_the_rows():
-    """A polyline corner makes a crease; rows restarted there keep the quads convex."""
+def test_kink_of_a_director_polyline_gets_a_generator_and_matched_rows():
+    """A polyline corner makes a crease: a generator is put through it, the rows restart there
+    with a matched division, and the crease costs no band of splinters."""
     from pathlib import Path
 
     from ruledmesh.design import build_file
@@ -232,11 +235,18 @@ def test_kink_of_a_director_polyline_restarts_the_rows():
     built = build_file(Path(__file__).resolve().parents[1] / "examples" / "skew.toml")
     mesh = built.mesh
     check_mesh(mesh)
-    assert built.rulings.info["creases"] == [12, 25]     # the two corners of c2
+    info = built.rulings.info
+    assert len(info["crease_generators"]) == 2 and info["inserted"] >= 2
+    assert len(built.rulings.a) == 41 + info["inserted"]
+    # The two corners of c2 lie exactly on the inserted generators.
+    corners = np.array([[3, 4, 5], [6, 3, 3]], float)
+    for k, c in zip(info["crease_generators"], corners):
+        assert np.linalg.norm(built.rulings.b[k] - c) < 1e-9
+    assert "creases" not in info
     kinds = mesh.count_kinds()
-    assert any("crease strips" in w for w in mesh.info["warnings"])
-    # Without the restart 40 % of the faces were bow-ties split in two; now a few remain.
     assert kinds.get("split", 0) < 0.05 * kinds["quad"]
     A, B = built.rulings.a, built.rulings.b
     with pytest.raises(ParameterError, match="creases"):
         pq_mesh(A, B, creases=[len(A) - 1])
+    with pytest.raises(ParameterError, match="crease_generators"):
+        pq_mesh(A, B, crease_generators=[0])

@@ -143,11 +143,11 @@ CYLINDER = (_curve("c1", 'type = "arc"\ncenter = [0, 0, 0]\nradius = 2\nnormal =
             + '[rulings]\nbetween = ["c1", "c2"]\ncount = 9\n')
 
 
-def test_cylinder_pq_every_strip_is_torsal_triangles(tmp_path, capsys):
-    mesh, report, _ = expect_mesh(tmp_path, capsys, CYLINDER, kinds={"fill"},
+def test_cylinder_pq_every_strip_is_a_prism_of_strip_quads(tmp_path, capsys):
+    mesh, report, _ = expect_mesh(tmp_path, capsys, CYLINDER, kinds={"strip"},
                                   warning="8 torsal strips")
-    # two triangles per strip, each strip a planar rectangle between generators
-    assert report["faces"] == 16
+    # each strip a planar rectangle between generators, divided like the rows (20 / 2)
+    assert report["faces"] == 8 * 10
     assert abs(report["coverage"]["ratio"] - 1) < 0.02   # the polygonal cylinder vs the arc
 
 

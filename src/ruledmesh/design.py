@@ -199,7 +199,16 @@ def curve_kinks(curve) -> np.ndarray:
 
 
 def _with_creases(rulings, table: Mapping, curves: Mapping) -> Any:
-    """Record in ``rulings.info["creases"]`` the strips that contain a kink of a director curve."""
+    """Put a generator through every kink of a director curve.
+
+    A kink (a polyline corner, a C0 knot) makes a crease along the generator
+    through it.  A generator exactly there keeps every strip on one side of the
+    crease, so the §4.3 rows cross it like any other generator instead of a
+    strip straddling the bend.  The user's generators stay; the added ones are
+    counted in ``info["inserted"]``.  Where the correspondence cannot be
+    inverted (no smooth surface), the strips holding a kink are recorded in
+    ``info["creases"]`` and the mesher closes them with triangles.
+    """
     from dataclasses import replace
 
     names = table.get("between")
@@ -207,8 +216,11 @@ def _with_creases(rulings, table: Mapping, curves: Mapping) -> Any:
         names = [table["conoid"].get("curve")]
     if not isinstance(names, list):
         return rulings
+    new_u: list[float] = []
     pairs: set[int] = set()
-    for key, name in zip(("c1_params", "c2_params"), names):
+    surface = getattr(rulings, "surface", None)
+    for key, name, rail in zip(("c1_params", "c2_params"), names,
+                               (getattr(surface, "rail_a", None), getattr(surface, "rail_b", None))):
         params = rulings.info.get(key)
         curve = curves.get(name)
         if params is None or curve is None:
@@ -221,12 +233,45 @@ def _with_creases(rulings, table: Mapping, curves: Mapping) -> Any:
         order = np.argsort(params)
         pos = np.searchsorted(params[order], kinks)
         ok = (pos > 0) & (pos < params.size)
-        for lo_i, hi_i in zip(order[pos[ok] - 1], order[pos[ok]]):
-            if abs(int(lo_i) - int(hi_i)) == 1:
-                pairs.add(min(int(lo_i), int(hi_i)))
+        for kink, lo_i, hi_i in zip(kinks[ok], order[pos[ok] - 1], order[pos[ok]]):
+            if abs(int(lo_i) - int(hi_i)) != 1:
+                continue
+            lo_i, hi_i = min(int(lo_i), int(hi_i)), max(int(lo_i), int(hi_i))
+            u = _kink_parameter(rail, rulings.u[lo_i], rulings.u[hi_i], kink)
+            if u is None:
+                pairs.add(lo_i)
+            else:
+                new_u.append(u)
+    if new_u and surface is not None:
+        u_all = np.unique(np.concatenate([rulings.u, new_u]))
+        keep = np.r_[True, np.diff(u_all) > 1e-9]
+        u_all = u_all[keep]
+        inserted = len(u_all) - len(rulings.u)
+        info = {**rulings.info, "inserted": inserted,
+                "crease_generators": [int(np.argmin(np.abs(u_all - u))) for u in new_u]}
+        info.pop("c1_params", None)
+        info.pop("c2_params", None)
+        rulings = replace(rulings, a=surface.a(u_all), b=surface.b(u_all), u=u_all, info=info)
     if not pairs:
         return rulings
     return replace(rulings, info={**rulings.info, "creases": sorted(pairs)})
+
+
+def _kink_parameter(rail: Any, u0: float, u1: float, kink: float) -> float | None:
+    """The surface parameter in (u0, u1) where a rail reaches the curve parameter ``kink``."""
+    from scipy.optimize import brentq
+
+    sigma = getattr(rail, "sigma", None)
+    if sigma is None:
+        return None
+    f0 = float(sigma.value(np.float64(u0))) - kink
+    f1 = float(sigma.value(np.float64(u1))) - kink
+    if f0 == 0.0 or f1 == 0.0 or f0 * f1 > 0:
+        return None
+    u = brentq(lambda x: float(sigma.value(np.float64(x))) - kink, u0, u1, xtol=1e-15)
+    if u - u0 < 1e-6 * (u1 - u0) or u1 - u < 1e-6 * (u1 - u0):
+        return None
+    return float(u)
 
 
 def _unknown(path: str, value: Any, table: Mapping) -> DesignError:

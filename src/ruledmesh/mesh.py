@@ -33,6 +33,8 @@ class FaceKind(IntEnum):
     generator diagonal instead of being shipped as a bow-tie.
     ``TRIANGLE``: a triangle of a hybrid HP-patch mesh (paper §4.1).
     ``POLYGON``: any other planar polygon (caps, imported faces).
+    ``STRIP``: a quad between two consecutive generators that are coplanar (to
+    the planarity tolerance), with two vertices on each (paper §3.1).
     """
 
     QUAD = 0
@@ -41,6 +43,7 @@ class FaceKind(IntEnum):
     SPLIT = 3
     TRIANGLE = 4
     POLYGON = 5
+    STRIP = 6
 
     @property
     def label(self) -> str:

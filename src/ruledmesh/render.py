@@ -40,6 +40,7 @@ _KIND_COLORS = {
     FaceKind.SPLIT: "#b279a2",
     FaceKind.TRIANGLE: "#54a24b",
     FaceKind.POLYGON: "#9d755d",
+    FaceKind.STRIP: "#72b7b2",
 }
 
 

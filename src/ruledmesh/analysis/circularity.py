@@ -61,7 +61,9 @@ def _distance_from_circle(q, center, normal, radius):
     rel = q - center
     h = np.einsum("ij,ij->i", rel, normal)
     radial = np.linalg.norm(rel - h[:, None] * normal, axis=1)
-    finite = np.isfinite(radius)
+    # A circle of zero radius (three coincident corners, e.g. a design scaled
+    # to nothing) defines no circle: as a straight line through them, infinite.
+    finite = np.isfinite(radius) & (radius > 0)
     r = np.where(finite, radius, 1.0)
     out = np.sqrt(h * h + (radial - r) ** 2) / r
     return np.where(finite, out, np.inf)

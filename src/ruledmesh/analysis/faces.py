@@ -24,6 +24,9 @@ __all__ = [
     "face_centroids",
     "corner_angles",
     "edge_lengths",
+    "degenerate_faces",
+    "face_min_angles",
+    "area_shares",
 ]
 
 _TINY = 1e-300
@@ -236,3 +239,57 @@ def edge_lengths(mesh: Mesh) -> np.ndarray:
     """(E,) float64: length of every unique edge (see :meth:`Mesh.edges`)."""
     e = mesh.edges()
     return np.linalg.norm(mesh.vertices[e[:, 1]] - mesh.vertices[e[:, 0]], axis=1)
+
+
+def degenerate_faces(mesh: Mesh, tol: float = 1e-9) -> np.ndarray:
+    """(F,) bool: faces with no area, by the rule :mod:`ruledmesh.fabricate` refuses them by.
+
+    A face is degenerate when its (Newell) area is at most ``tol`` times the
+    square of its longest edge: a needle or a collapsed polygon, which cannot be
+    cut from a sheet.
+    """
+    _, area = face_normals(mesh)
+    return area <= tol * np.maximum(longest_edges(mesh), _TINY) ** 2
+
+
+def longest_edges(mesh: Mesh) -> np.ndarray:
+    """(F,) float64: the longest edge of every face."""
+    v = mesh.vertices
+    idx = mesh.face_indices
+    nxt = np.arange(idx.size) + 1
+    nxt[mesh.face_offsets[1:] - 1] = mesh.face_offsets[:-1]
+    length = np.linalg.norm(v[idx[nxt]] - v[idx], axis=1)
+    if length.size == 0:
+        return np.zeros(mesh.n_faces)
+    return np.maximum.reduceat(length, mesh.face_offsets[:-1])
+
+
+def face_min_angles(mesh: Mesh) -> np.ndarray:
+    """(F,) float64: the smallest interior angle of every face, degrees."""
+    ang = corner_angles(mesh)
+    if ang.size == 0:
+        return np.zeros(mesh.n_faces)
+    return np.minimum.reduceat(ang, mesh.face_offsets[:-1])
+
+
+def area_shares(mesh: Mesh) -> dict:
+    """Shares of the mesh area: by face kind, and in quads (4 corners) vs the rest.
+
+    Returns
+    -------
+    dict
+        ``by_kind`` (label -> share), ``quads``, ``triangles`` and ``polygons``
+        (5 or more corners) as shares of the total area.
+    """
+    from ..mesh import FaceKind
+
+    _, area = face_normals(mesh)
+    total = float(area.sum()) or 1.0
+    val = mesh.valences
+    by_kind = np.bincount(mesh.face_kind, weights=area, minlength=len(FaceKind))
+    return {
+        "by_kind": {FaceKind(k).label: float(by_kind[k] / total) for k in np.unique(mesh.face_kind)},
+        "quads": float(area[val == 4].sum() / total),
+        "triangles": float(area[val == 3].sum() / total),
+        "polygons": float(area[val > 4].sum() / total),
+    }

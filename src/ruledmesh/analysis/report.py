@@ -43,6 +43,7 @@ KIND_NOUNS = {
     FaceKind.SPLIT: ("split quad", "split quads"),
     FaceKind.TRIANGLE: ("triangle", "triangles"),
     FaceKind.POLYGON: ("polygon", "polygons"),
+    FaceKind.STRIP: ("strip quad", "strip quads"),
 }
 
 # A mesh "matches" a design unless its vertices are farther than this from the design
@@ -88,6 +89,38 @@ def kind_counts(counts: Mapping[str, int]) -> str:
         one, many = KIND_NOUNS[FaceKind.from_label(label)]
         words.append(f"{n} {one if n == 1 else many}")
     return ", ".join(words) or "no faces"
+
+
+def _planarity(plan: np.ndarray, mesh: Mesh, tol: Tolerances) -> dict[str, Any]:
+    """Planarity figures; faces exact (to rounding) told apart from those within a tolerance."""
+    ptol = max(float(mesh.info.get("planarity_tolerance", tol.planarity)), tol.planarity)
+    exact = plan <= tol.planarity
+    within = ~exact & (plan <= ptol)
+    return {
+        **_stats(plan),
+        "tolerance": ptol,
+        "above_tolerance": int(np.count_nonzero(plan > ptol)),
+        "exact": int(np.count_nonzero(exact)),
+        "within_tolerance": int(np.count_nonzero(within)),
+        "max_exact": float(plan[exact].max()) if exact.any() else 0.0,
+        "max_within_tolerance": float(plan[within].max()) if within.any() else 0.0,
+    }
+
+
+def _quality(mesh: Mesh, tol: Tolerances) -> dict[str, Any]:
+    """What a fabricator reads first: area in quads, splinters, degenerate faces."""
+    shares = F.area_shares(mesh)
+    smallest = F.face_min_angles(mesh)
+    return {
+        "area_share": shares,
+        "face_min_angle_deg": {
+            "min": float(smallest.min()) if smallest.size else 0.0,
+            "p5": float(np.percentile(smallest, 5)) if smallest.size else 0.0,
+            "median": float(np.median(smallest)) if smallest.size else 0.0,
+        },
+        "faces_below_3deg": int(np.count_nonzero(smallest < 3.0)),
+        "degenerate_faces": int(np.count_nonzero(F.degenerate_faces(mesh, tol.degenerate))),
+    }
 
 
 def analyze(mesh: Mesh, reference=None, extras: Mapping[str, Any] | None = None,
@@ -163,15 +196,12 @@ def _figures(mesh: Mesh, tol: Tolerances) -> dict[str, Any]:
         "valences": {str(int(k)): int(c) for k, c in zip(*np.unique(mesh.valences, return_counts=True))},
         "finite": finite,
         "diagonal": diag,
-        "planarity": {
-            **_stats(plan),
-            "tolerance": tol.planarity,
-            "above_tolerance": int(np.count_nonzero(plan > tol.planarity)),
-        },
+        "planarity": _planarity(plan, mesh, tol),
         "non_convex": int(np.count_nonzero(~convex)),
         "area": {**_stats(areas), "total": float(areas.sum())},
         "edge_length": _stats(lengths),
         "min_angle_deg": float(angles.min()) if angles.size else 0.0,
+        "quality": _quality(mesh, tol),
         "euler_characteristic": mesh.euler_characteristic(len(edges)),
     }
     return report
@@ -216,9 +246,16 @@ def _warnings(mesh: Mesh, report: dict[str, Any], tol: Tolerances) -> list[str]:
         warnings.append("mesh has NaN or infinite coordinates")
     if report["non_convex"]:
         warnings.append(f"{report['non_convex']} faces are not convex")
+    share = report["quality"]["area_share"]
+    said = any("of the area is not in quads" in w for w in warnings)
+    if mesh.n_faces and 1.0 - share["quads"] > 0.3 and not said:
+        warnings.append(f"{1.0 - share['quads']:.0%} of the area is not in quads "
+                        f"(by kind: {_shares(share['by_kind'])})")
+    if report["quality"]["degenerate_faces"]:
+        warnings.append(f"{report['quality']['degenerate_faces']} faces have no area")
     if report["planarity"]["above_tolerance"]:
         warnings.append(f"{report['planarity']['above_tolerance']} faces are not planar to "
-                        f"{tol.planarity:g}")
+                        f"{report['planarity']['tolerance']:g}")
     if "closeness" in report:
         why = _design_mismatch(report)
         report["matches_design"] = not why
@@ -235,10 +272,22 @@ def _warnings(mesh: Mesh, report: dict[str, Any], tol: Tolerances) -> list[str]:
     return warnings
 
 
+def _shares(by_kind: Mapping[str, float]) -> str:
+    return ", ".join(f"{k} {v:.0%}" for k, v in sorted(by_kind.items(), key=lambda kv: -kv[1]))
+
+
 def format_summary(report: Mapping[str, Any]) -> str:
     """One line: faces by kind and the worst planarity."""
     text = (f"{report['faces']} faces ({kind_counts(report['kinds'])}), {report['vertices']} vertices, "
             f"max planarity {report['planarity']['max']:.2e}")
+    pl = report["planarity"]
+    if pl.get("within_tolerance"):
+        text += (f" ({pl['exact']} faces exact, {pl['within_tolerance']} within "
+                 f"{pl['tolerance']:g})")
+    q = report.get("quality")
+    if q:
+        text += (f", {q['area_share']['quads']:.0%} of the area in quads, smallest angle "
+                 f"{q['face_min_angle_deg']['min']:.2f} deg")
     if "coverage" in report:
         text += f", coverage {report['coverage']['ratio']:.4f}"
     return text

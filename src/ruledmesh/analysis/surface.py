@@ -43,8 +43,14 @@ class RuledReference:
             self._cache["tree"] = (cKDTree(pts), uu.ravel(), tt.ravel())
         return self._cache["tree"]
 
-    def closest(self, points: np.ndarray, iterations: int = 12) -> tuple[np.ndarray, np.ndarray]:
+    def closest(self, points: np.ndarray, iterations: int = 12,
+                seeds: int = 6) -> tuple[np.ndarray, np.ndarray]:
         """Parameters ``(u, t)`` of the nearest point of the patch to each point.
+
+        Gauss-Newton runs from the ``seeds`` nearest samples at once and the
+        best result is kept: where the surface passes close to itself (a
+        Pluecker conoid through its double line, a helicoid's turns) the single
+        nearest sample may lie on the other sheet.
 
         Parameters
         ----------
@@ -55,8 +61,18 @@ class RuledReference:
         u, t : (n,) float64
         """
         tree, us, ts = self._seed_tree()
-        _, k = tree.query(points)
-        u, t = us[k].copy(), ts[k].copy()
+        k = min(seeds, len(us))
+        _, nearest = tree.query(points, k=k)
+        nearest = np.asarray(nearest).reshape(len(points), k)
+        u, t = self._descend(np.repeat(points, k, axis=0), us[nearest].ravel(), ts[nearest].ravel(),
+                             iterations)
+        d = np.linalg.norm(self.surface.point(u, t) - np.repeat(points, k, axis=0), axis=1)
+        best = np.argmin(d.reshape(-1, k), axis=1) + k * np.arange(len(points))
+        return u[best], t[best]
+
+    def _descend(self, points: np.ndarray, u: np.ndarray, t: np.ndarray,
+                 iterations: int) -> tuple[np.ndarray, np.ndarray]:
+        """Gauss-Newton on ``|S(u, t) - p|^2`` from ``(u, t)``, clamped to the patch."""
         for _ in range(iterations):
             s = self.surface.point(u, t)
             su, st = self.surface.partials(u, t)

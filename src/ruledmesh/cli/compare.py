@@ -68,7 +68,7 @@ def compare(design, rows=None, divisions=None, midpoints=None) -> dict:
     from ..design import Design, build_design
     from ..errors import DesignError
     from ..hybrid import _MESH_KEYS as HYBRID_KEYS
-    from ..pq import _MESH_KEYS as PQ_KEYS
+    from ..pq import MESH_KEYS as PQ_KEYS
 
     if "rulings" not in design.data:
         raise DesignError("compare needs a design with a [rulings] table (generators), not a "

@@ -23,7 +23,7 @@ __all__ = ["dumpb", "LAYER_COLOURS", "APPID"]
 APPID = "RULEDMESH"
 # AutoCAD colour index per face kind.
 LAYER_COLOURS = {FaceKind.QUAD: 8, FaceKind.BORDER: 30, FaceKind.FILL: 5, FaceKind.SPLIT: 1,
-                 FaceKind.TRIANGLE: 3, FaceKind.POLYGON: 6}
+                 FaceKind.TRIANGLE: 3, FaceKind.POLYGON: 6, FaceKind.STRIP: 4}
 
 
 def layer_name(kind: FaceKind) -> str:

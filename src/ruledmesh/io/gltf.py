@@ -49,6 +49,7 @@ KIND_COLOURS = {
     FaceKind.SPLIT: (0.90, 0.30, 0.30, 1.0),
     FaceKind.TRIANGLE: (0.45, 0.80, 0.45, 1.0),
     FaceKind.POLYGON: (0.70, 0.55, 0.85, 1.0),
+    FaceKind.STRIP: (0.45, 0.72, 0.70, 1.0),
 }
 _FLOAT, _UINT = 5126, 5125
 _ARRAY_BUFFER, _ELEMENT_ARRAY_BUFFER = 34962, 34963

@@ -29,7 +29,8 @@ __all__ = ["dumpb", "RHINO_VERSION"]
 RHINO_VERSION = 7
 _LAYER_COLOURS = {FaceKind.QUAD: (200, 205, 215), FaceKind.BORDER: (240, 180, 80),
                   FaceKind.FILL: (90, 165, 240), FaceKind.SPLIT: (230, 80, 80),
-                  FaceKind.TRIANGLE: (115, 205, 115), FaceKind.POLYGON: (180, 140, 215)}
+                  FaceKind.TRIANGLE: (115, 205, 115), FaceKind.POLYGON: (180, 140, 215),
+                  FaceKind.STRIP: (114, 183, 178)}
 
 
 def _import_rhino3dm():

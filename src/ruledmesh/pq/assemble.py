@@ -1,0 +1,275 @@
+"""Assembly of the §4.3 mesh: join the runs, trim to the patch, close the strips.
+
+Every vertex stays on a generator.  Faces wholly on the patch are kept; a face
+whose generator diagonal reaches past the border takes the director point of
+its generator instead (the point lies on the diagonal, so the face stays in its
+plane: a *border quad*); what the faces leave open in each strip is closed by
+strip quads where the two generators are coplanar within the planarity
+tolerance and carry matched divisions, else by zipper triangles.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from ..mesh import FaceKind, Mesh
+from ..tolerances import Tolerances
+from .runs import Run
+from .strips import ON_BORDER, Gaps, chains, strip_paths, zippers
+
+__all__ = ["assemble", "to_mesh"]
+
+# A border quad's crossing must lie at least this share of its generator diagonal from either end.
+_MIN_CROSSING = 0.15
+
+
+def _join(parts: list[Run]):
+    """Concatenate the runs; vertices two runs share (same generator, same t) become one."""
+    V = np.concatenate([r.vertices for r in parts])
+    T = np.concatenate([r.t for r in parts])
+    G = np.concatenate([r.gen for r in parts])
+    FAR = np.concatenate([r.far for r in parts])
+    offs = np.cumsum([0] + [len(r.vertices) for r in parts])
+    L = np.concatenate([np.where(r.left >= 0, r.left + o, -1) for r, o in zip(parts, offs)])
+    R = np.concatenate([np.where(r.right >= 0, r.right + o, -1) for r, o in zip(parts, offs)])
+    POLE = np.concatenate([r.pole for r in parts])
+    CG = np.concatenate([r.centre_gen for r in parts])
+    order = np.lexsort((T, G))
+    same = (G[order][1:] == G[order][:-1]) & (T[order][1:] == T[order][:-1]) \
+        & ~FAR[order][1:] & ~FAR[order][:-1]
+    if same.any():
+        # Runs that meet on a generator share its division exactly (matched), so
+        # equal parameters mean the same point: keep the first of each group.
+        first = np.maximum.accumulate(np.where(np.r_[True, ~same], np.arange(len(order)), 0))
+        remap = np.arange(len(V))
+        remap[order] = order[first]
+        L = np.where(L >= 0, remap[np.maximum(L, 0)], -1)
+        R = np.where(R >= 0, remap[np.maximum(R, 0)], -1)
+        dup = np.zeros(len(V), bool)
+        dup[order[1:][same]] = True
+        FAR = FAR | dup          # never emitted, never in a chain
+    return V, T, G, FAR, L, R, POLE, CG
+
+
+def _crossing_t(V, T, L, R, lo, hi, both):
+    """Parameter on its generator where each face's hop diagonal crosses it (nan without both halves)."""
+    from ..analysis.faces import quad_diagonal_crossing
+
+    tc = np.full(len(L), np.nan)
+    f = np.flatnonzero(both)
+    if f.size:
+        _, tq, _ = quad_diagonal_crossing(V[np.stack([L[f, 0], lo[f], R[f, 1], hi[f]], axis=1)])
+        tc[f] = T[lo[f]] + tq * (T[hi[f]] - T[lo[f]])
+    return tc
+
+
+def _substitute_border(V, T, FAR, L, R, CG, good_v, bottom, top):
+    """Faces whose generator diagonal ends beyond the border end at the director point instead.
+
+    The director point of ``g_i`` lies on the face's generator diagonal, hence
+    in the face's plane: the face stays planar, and every vertex on a generator.
+    """
+    has_l, has_r = L[:, 0] >= 0, R[:, 0] >= 0
+    lo = np.where(has_r, R[:, 0], L[:, 1])
+    hi = np.where(has_r, R[:, 2], L[:, 2])
+    side_ok = np.where(has_l, good_v[np.maximum(L[:, 0], 0)], True) \
+        & np.where(has_r, good_v[np.maximum(R[:, 1], 0)], True)
+    valid = (has_l | has_r) & side_ok & ~FAR[lo] & ~FAR[hi]
+    below = valid & ~good_v[lo] & (T[lo] < 0.0) & (good_v[hi] | (T[hi] > 1.0))
+    above = valid & ~good_v[hi] & (T[hi] > 1.0) & (good_v[lo] | (T[lo] < 0.0))
+    # A whole face only where its crossing stays well inside the shortened
+    # diagonal (else it would be a needle or a bow-tie); halves of notches always.
+    tc = _crossing_t(V, T, L, R, lo, hi, has_l & has_r & (below | above))
+    top_t = np.where(above, 1.0, T[hi])
+    bot_t = np.where(below, 0.0, T[lo])
+    with np.errstate(invalid="ignore", divide="ignore"):
+        frac = (tc - bot_t) / (top_t - bot_t)
+        inside = ~(has_l & has_r) | ((frac > _MIN_CROSSING) & (frac < 1 - _MIN_CROSSING))
+    below &= inside
+    above &= inside
+    new_lo = np.where(below, bottom[CG], lo)
+    new_hi = np.where(above, top[CG], hi)
+    L = L.copy()
+    R = R.copy()
+    L[:, 1] = np.where(has_l, new_lo, L[:, 1])
+    L[:, 2] = np.where(has_l, new_hi, L[:, 2])
+    R[:, 0] = np.where(has_r, new_lo, R[:, 0])
+    R[:, 2] = np.where(has_r, new_hi, R[:, 2])
+    return L, R, below | above
+
+
+def _close_gaps(V, T, chain, gstart, gaps: Gaps, ptol: float):
+    """Strip quads where a gap is planar within ``ptol`` and evenly matched; zippers elsewhere."""
+    from ..analysis.faces import quad_diagonal_crossing, quad_planarity
+
+    even = (gaps.na == gaps.nb) & (gaps.na > 0)
+    ge = np.flatnonzero(even)
+    n = gaps.na[ge]
+    gid = np.repeat(np.arange(len(ge)), n)
+    q = np.arange(gid.size) - np.repeat(np.cumsum(n) - n, n)
+    s = gaps.strip[ge][gid]
+    ka = gstart[s] + gaps.k0[ge][gid] + q
+    lb = gstart[s + 1] + gaps.l0[ge][gid] + q
+    quads = np.stack([chain[ka], chain[ka + 1], chain[lb + 1], chain[lb]], axis=1)
+    ok_q = np.zeros(len(quads), bool)
+    if len(quads):
+        P = V[quads]
+        sq, tq, _ = quad_diagonal_crossing(P)
+        ok_q = (quad_planarity(P) <= ptol) & (sq > 0.02) & (sq < 0.98) & (tq > 0.02) & (tq < 0.98)
+    bad = np.bincount(gid[~ok_q], minlength=len(ge)) if len(ge) else np.zeros(0, np.int64)
+    use = np.zeros(len(gaps.strip), bool)
+    use[ge[bad == 0]] = True
+    strip_quads = quads[np.repeat(bad == 0, n)] if len(quads) else np.zeros((0, 4), np.int64)
+    z = ~use
+    fill = zippers(T, chain, gstart, gaps.strip[z], gaps.k0[z], gaps.l0[z], gaps.na[z], gaps.nb[z])
+    return fill, strip_quads
+
+
+def _notch_fans(chain, gstart, L, R, sel_l, sel_r, CG, jump_l, jump_r) -> np.ndarray:
+    """Notch halves whose base passes over vertices of another run, as fans of triangles.
+
+    The points passed over lie on the half's base (the generator), so the fan
+    from its apex covers exactly the half and the strips stay conforming.
+    """
+    if chain is None or not (sel_l.any() or sel_r.any()):
+        return np.zeros((0, 3), np.int64)
+    rank_of = np.full(int(chain.max()) + 1, -1, np.int64)
+    rank_of[chain] = np.arange(len(chain)) - np.repeat(gstart[:-1], np.diff(gstart))
+    out = []
+    for half, sel, jump, apex_col, lo_col in ((L, sel_l, jump_l, 0, 1), (R, sel_r, jump_r, 1, 0)):
+        f = np.flatnonzero(sel)
+        n = jump[f]
+        fid = np.repeat(f, n)
+        q = np.arange(fid.size) - np.repeat(np.cumsum(n) - n, n)
+        lo = gstart[CG[fid]] + rank_of[half[fid, lo_col]] + q
+        apex = half[fid, apex_col]
+        # Left halves run apex, lo, hi; right halves lo, apex, hi (the same orientation).
+        tri = np.stack([apex, chain[lo], chain[lo + 1]], axis=1) if apex_col == 0 else \
+            np.stack([chain[lo], apex, chain[lo + 1]], axis=1)
+        out.append(tri)
+    return np.concatenate(out)
+
+
+def assemble(parts: list[Run], a, d, trim: bool, tol: Tolerances, ptol: float,
+             warnings: list[str], scale: float, meet: np.ndarray | None = None) -> Mesh:
+    """Join the runs; keep convex quads and valid halves; close the strips; add members."""
+    from ..analysis.faces import quad_diagonal_crossing
+
+    m = len(a)
+    if not parts:
+        parts = [Run(np.zeros((0, 3)), np.zeros(0), np.zeros(0, np.int64), np.zeros(0, bool),
+                     np.zeros((0, 3), np.int64), np.zeros((0, 3), np.int64), np.zeros(0, bool),
+                     np.zeros(0, np.int64), np.zeros(m, np.int64), np.zeros(m, np.int64))]
+    V, T, G, FAR, L, R, POLE, CG = _join(parts)
+    # A vertex within rounding of the border counts as on it, so the decisions do
+    # not flip when the design is scaled or moved (t is scale-free up to rounding).
+    lo_t, hi_t = (-ON_BORDER, 1.0 + ON_BORDER) if trim else (-np.inf, np.inf)
+    good_v = ~FAR & (T >= lo_t) & (T <= hi_t)
+    strip_quads = np.zeros((0, 4), np.int64)
+    substituted = np.zeros(len(L), bool)
+    if trim:
+        n0 = len(V)
+        V, T, G, chain, gstart = chains(V, T, G, good_v, a, d, m, scale)
+        FAR = np.r_[FAR, np.zeros(len(V) - n0, bool)]
+        good_v = np.r_[good_v, np.ones(len(V) - n0, bool)]
+        L, R, substituted = _substitute_border(V, T, FAR, L, R, CG, good_v, chain[gstart[:-1]],
+                                               chain[gstart[1:] - 1])
+    cand_l = (L[:, 0] >= 0) & ~POLE & good_v[np.maximum(L, 0)].all(axis=1)
+    cand_r = (R[:, 0] >= 0) & ~POLE & good_v[np.maximum(R, 0)].all(axis=1)
+    if trim:
+        ok_l, ok_r, gaps, jump_l, jump_r = strip_paths(T, chain, gstart, m, L, R, cand_l, cand_r, CG)
+        fill, strip_quads = _close_gaps(V, T, chain, gstart, gaps, ptol)
+    else:
+        chain = gstart = None
+        jump_l = np.ones(len(L), np.int64)
+        jump_r = np.ones(len(R), np.int64)
+        # Untrimmed: rows must still increase along each generator inside a face.
+        ok_l = cand_l & (T[np.maximum(L[:, 2], 0)] > T[np.maximum(L[:, 1], 0)])
+        ok_r = cand_r & (T[np.maximum(R[:, 2], 0)] > T[np.maximum(R[:, 0], 0)])
+        fill = np.zeros((0, 3), np.int64)
+    both = ok_l & ok_r
+    quads = np.stack([L[both, 0], L[both, 1], R[both, 1], L[both, 2]], axis=1)
+    # Bow-ties: the diagonals must cross inside both; else keep the two halves.
+    sq, tq, _ = quad_diagonal_crossing(V[quads])
+    eps = tol.convexity
+    convex = (sq > eps) & (sq < 1 - eps) & (tq > eps) & (tq < 1 - eps)
+    whole = np.zeros(len(L), bool)
+    whole[np.flatnonzero(both)[convex]] = True
+    nsplit = int(np.count_nonzero(~convex))
+    interior = (L[:, 0] >= 0) & (R[:, 0] >= 0)
+    kind_half = np.where(interior, np.where(both, FaceKind.SPLIT, FaceKind.BORDER),
+                         FaceKind.FILL).astype(np.uint8)
+    half_l, half_r = ok_l & ~whole & (jump_l == 1), ok_r & ~whole & (jump_r == 1)
+    fans = _notch_fans(chain, gstart, L, R, ok_l & (jump_l > 1), ok_r & (jump_r > 1), CG,
+                       jump_l, jump_r)
+    quad_kind = np.where(substituted[np.flatnonzero(both)[convex]], FaceKind.BORDER, FaceKind.QUAD)
+    faces = [quads[convex], strip_quads, np.concatenate([L[half_l], R[half_r], fill, fans])]
+    kinds = [quad_kind.astype(np.uint8), np.full(len(strip_quads), FaceKind.STRIP, np.uint8),
+             np.concatenate([kind_half[half_l], kind_half[half_r],
+                             np.full(len(fill) + len(fans), FaceKind.FILL, np.uint8)])]
+    if nsplit:
+        warnings.append(f"{nsplit} quads were not convex (the two chains of §4.3 drifted apart) "
+                        "and were kept as two triangles split along their generator diagonal; "
+                        "sample the generators more finely there")
+    dropped = int(np.count_nonzero(cand_l & ~ok_l) + np.count_nonzero(cand_r & ~ok_r))
+    if dropped:
+        warnings.append(f"{dropped} half-faces ran against the order of their strip (rows reversing "
+                        "or overlapping) and were replaced by fill triangles")
+    return to_mesh(V, T, G, faces, kinds, warnings, chain, gstart, scale, meet)
+
+
+def to_mesh(V, T, G, faces, kinds, warnings, chain, gstart, scale, meet=None) -> Mesh:
+    """Mesh from fixed-valence face arrays; members along the generators.
+
+    ``meet`` (m,) bool marks generators that meet a neighbour (a coplanar pair):
+    their vertices may coincide with the neighbour's and are merged with them.
+    """
+    off = [np.zeros(1, np.int64)]
+    total = 0
+    for f in faces:
+        off.append(np.arange(1, len(f) + 1, dtype=np.int64) * f.shape[1] + total)
+        total += f.size
+    off = np.concatenate(off)
+    idx = np.concatenate([f.reshape(-1) for f in faces]).astype(np.int64)
+    kind = np.concatenate(kinds).astype(np.uint8)
+    # Generators that share an end point (a torsal pair meeting on a director
+    # curve) give coincident points at t = 0 or 1, and generators that meet
+    # inside the patch (a cone's apex) coincident points there: merge those,
+    # nothing else; faces that collapse go.
+    used0 = np.zeros(len(V), bool)
+    used0[idx] = True
+    near = (T <= 1e-12) | (T >= 1 - 1e-12)
+    if meet is not None and np.any(meet):
+        near |= np.asarray(meet)[np.clip(G, 0, len(meet) - 1)] & (G >= 0)
+    ends = np.flatnonzero(used0 & near)
+    if len(ends) > 1:
+        key = np.round(V[ends] / (1e-12 * scale)).astype(np.int64)
+        _, first, inv = np.unique(key, axis=0, return_index=True, return_inverse=True)
+        if len(first) < len(ends):
+            remap = np.arange(len(V))
+            remap[ends] = ends[first[inv.reshape(-1)]]
+            idx = remap[idx]
+            if chain is not None:
+                chain = remap[chain]
+    used = np.zeros(len(V), bool)
+    used[idx] = True
+    if chain is not None:
+        # Members: consecutive chain vertices of a generator, both used by faces.
+        gch = np.repeat(np.arange(len(gstart) - 1), np.diff(gstart))
+        pair = (gch[1:] == gch[:-1]) & used[chain[1:]] & used[chain[:-1]] & (chain[1:] != chain[:-1])
+        members = np.stack([chain[:-1][pair], chain[1:][pair]], axis=1)
+        member_id = gch[:-1][pair]
+    else:
+        ids = np.flatnonzero(used & (G >= 0))
+        order = ids[np.lexsort((T[ids], G[ids]))]
+        same = G[order[1:]] == G[order[:-1]]
+        members = np.stack([order[:-1][same], order[1:][same]], axis=1)
+        member_id = G[order[:-1][same]]
+    # Renumber to the used vertices only.
+    new = np.cumsum(used) - 1
+    mesh = Mesh(V[used], off, new[idx], kind, new[members].astype(np.int64),
+                member_id.astype(np.int64), {"t": T[used], "generator": G[used]},
+                {"construction": "pq (paper §4.3)", "warnings": warnings})
+    return mesh.drop_repeated_corners()
+
+

@@ -1,0 +1,147 @@
+"""Design-file builder for ``[mesh] method = "pq"``."""
+
+from __future__ import annotations
+
+from collections.abc import Mapping
+from typing import Any
+
+import numpy as np
+
+from .._validation import check_bool, check_float, check_int, check_keys, describe
+from ..errors import DesignError, GeometryError
+from ..registry import BuildContext, Built, mesh_method
+from .mesher import pq_mesh
+from .runs import MAX_GRID_POINTS
+
+__all__ = ["MESH_KEYS", "build_pq"]
+
+MESH_KEYS = ("method", "rows", "primary", "option", "extend", "trim", "max_extend",
+             "planarity_tolerance", "refine")
+
+
+@mesh_method("pq")
+def build_pq(rulings, table: Mapping[str, Any], ctx: BuildContext) -> Built:
+    """Design-file builder for ``[mesh] method = "pq"``."""
+    check_keys(table, MESH_KEYS, "mesh", err=DesignError)
+    rows = check_int(table.get("rows", 20), "mesh.rows", lo=1, hi=100_000, err=DesignError)
+    primary = table.get("primary", "middle")
+    m = len(rulings.a)
+    if isinstance(primary, str):
+        if primary != "middle":
+            raise DesignError(f'expected "middle" or an index, got {describe(primary)}', "mesh.primary")
+    else:
+        primary = check_int(primary, "mesh.primary", lo=-m, hi=m - 1, err=DesignError)
+    option = check_int(table.get("option", 0), "mesh.option", lo=0, hi=1, err=DesignError)
+    extend = table.get("extend", "auto")
+    if extend != "auto":
+        if isinstance(extend, str):
+            raise DesignError(f'expected "auto" or a number >= 0, got {describe(extend)}', "mesh.extend")
+        extend = check_float(extend, "mesh.extend", lo=0.0, hi=1e3, err=DesignError)
+    trim = check_bool(table.get("trim", True), "mesh.trim", err=DesignError)
+    max_extend = check_float(table.get("max_extend", 20.0), "mesh.max_extend", lo=0.0, hi=1e3,
+                             err=DesignError)
+    # Relative, the paper's measure (analysis.planarity); 1e-12 (the default) is exact.
+    ptol = check_float(table.get("planarity_tolerance", 1e-12), "mesh.planarity_tolerance",
+                       lo=0.0, hi=0.1, err=DesignError)
+    refine = check_bool(table.get("refine", True), "mesh.refine", err=DesignError)
+    options = {"rows": rows, "primary": primary, "option": option, "extend": extend,
+               "trim": trim, "max_extend": max_extend, "planarity_tolerance": ptol}
+    mesh = _mesh(rulings, options)
+    if refine:
+        rulings, mesh = _refined(rulings, mesh, options)
+    reference = None
+    if getattr(rulings, "surface", None) is not None:
+        from ..analysis.surface import RuledReference
+
+        reference = RuledReference(rulings.surface)
+    return Built(mesh.with_info(source=ctx.source), reference, rulings)
+
+
+def _mesh(rulings, options: dict):
+    return pq_mesh(rulings.a, rulings.b, creases=rulings.info.get("creases"),
+                   crease_generators=rulings.info.get("crease_generators"), **options)
+
+
+# Rounds of adding generators, and the share of a strip's area outside quads that asks for one.
+_REFINE_ROUNDS = 2
+_TROUBLE_SHARE = 0.3
+
+
+def _refined(rulings, mesh, options: dict):
+    """Add generators of the smooth surface in the strips the rows could not fill with quads.
+
+    The §4.3 chains drift apart in proportion to the generator spacing, most
+    near torsal generators; where the design gives director curves (not
+    explicit lines) the discrete generators are ours to choose, so the strips
+    whose area is mostly outside quads get one more generator each, at a node
+    of the distribution's exact samples.  The user's generators all stay; a
+    round is kept only if it puts more of the area in quads.
+    """
+    from dataclasses import replace
+
+    from ..analysis.faces import area_shares
+    from ..rulings import _dense_grid
+
+    surface = getattr(rulings, "surface", None)
+    if surface is None or rulings.info.get("distribution") == "lines":
+        return rulings, mesh
+    grid, _ = _dense_grid(len(rulings.u))
+    best = (area_shares(mesh)["quads"], rulings, mesh)
+    user = len(rulings.u) - int(rulings.info.get("inserted", 0))
+    for _ in range(_REFINE_ROUNDS):
+        cur_rulings, cur_mesh = best[1], best[2]
+        u = np.asarray(cur_rulings.u)
+        strips = _trouble_strips(cur_mesh, len(u))
+        if strips.size == 0 or best[0] >= 0.97:
+            break
+        lo = np.searchsorted(grid, u[strips], side="right")
+        hi = np.searchsorted(grid, u[strips + 1], side="left") - 1
+        ok = hi >= lo
+        mid = grid[(lo[ok] + hi[ok]) // 2]
+        if mid.size == 0 or (len(u) + mid.size) * (options["rows"] + 1) > MAX_GRID_POINTS // 4:
+            break
+        new_u = np.unique(np.concatenate([u, mid]))
+        creases = cur_rulings.info.get("crease_generators")
+        info = {**cur_rulings.info, "inserted": len(new_u) - user}
+        if creases:
+            info["crease_generators"] = np.searchsorted(new_u, u[np.asarray(creases)]).tolist()
+        candidate = replace(cur_rulings, a=surface.a(new_u), b=surface.b(new_u), u=new_u, info=info)
+        try:
+            cand_mesh = _mesh(candidate, options)
+        except GeometryError:
+            break
+        share = area_shares(cand_mesh)["quads"]
+        if share <= best[0] + 0.005:
+            break
+        best = (share, candidate, cand_mesh)
+    rulings, mesh = best[1], best[2]
+    added = len(rulings.u) - user - int(best[1].info.get("crease_generators") is not None
+                                        and len(best[1].info["crease_generators"]) or 0)
+    if mesh is not best[2] or added <= 0:
+        return rulings, mesh
+    note = (f"{added} generators of the smooth surface added where the rows needed them "
+            f"({len(rulings.u)} in all, {user} given)")
+    return rulings, mesh.with_info(warnings=list(mesh.info.get("warnings", [])) + [note])
+
+
+def _trouble_strips(mesh, m: int) -> np.ndarray:
+    """Strips (between generators i and i + 1) whose area is mostly outside quads."""
+    from ..analysis.faces import face_normals
+
+    gen = np.asarray(mesh.vertex_data["generator"])
+    if mesh.n_faces == 0 or m < 2:
+        return np.zeros(0, np.int64)
+    _, area = face_normals(mesh)
+    g = gen[mesh.face_indices]
+    g0 = np.minimum.reduceat(g, mesh.face_offsets[:-1])
+    g1 = np.maximum.reduceat(g, mesh.face_offsets[:-1])
+    span = np.maximum(g1 - g0, 1)
+    total = np.zeros(m - 1)
+    other = np.zeros(m - 1)
+    off = mesh.valences != 4
+    for k in range(int(span.max())):        # faces span one or two strips
+        sel = k < span
+        s = np.clip(g0[sel] + k, 0, m - 2)
+        np.add.at(total, s, area[sel] / span[sel])
+        np.add.at(other, s, np.where(off[sel], area[sel] / span[sel], 0.0))
+    return np.flatnonzero(other > _TROUBLE_SHARE * np.maximum(total, 1e-300))

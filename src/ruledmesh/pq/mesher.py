@@ -1,0 +1,418 @@
+"""The §4.3 PQ mesher: generators in, a trimmed PQ mesh out."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from .._validation import check_bool, check_float, check_int, check_points, describe
+from ..errors import GeometryError, ParameterError
+from ..hop import coplanarity
+from ..mesh import Mesh
+from ..tolerances import DEFAULT, Tolerances
+from .assemble import assemble
+from .runs import (
+    BYTES_PER_GRID_POINT,
+    MAX_GRID_POINTS,
+    Division,
+    Run,
+    carrier,
+    mesh_run,
+)
+
+__all__ = ["pq_mesh"]
+
+# A run restarts on a generator where this share of its faces on the patch (and
+# at least two) would not be convex; the shared generator costs one strip of
+# well-shaped triangles, a bow-tie split costs two splinters per face.
+_RESTART_SHARE = 0.05
+# Runs shorter than this are not cut further (each cut costs a strip of triangles).
+_MIN_RUN = 4
+# A run most of whose faces on the patch would not be convex is not meshed as a run.
+_HOPELESS_SHARE = 0.3
+# A build with more than this share of its area outside quads says why.
+_WARN_SHARE = 0.3
+
+
+@dataclass(frozen=True)
+class _Segment:
+    """Generators ``lo..hi`` (inclusive) meshed without crossing a torsal generator."""
+
+    lo: int
+    hi: int
+    shared_lo: bool      # lo is shared with the previous segment (else a gap strip lo-1)
+    shared_hi: bool
+
+
+def _segments(m: int, shared: np.ndarray, gaps: np.ndarray) -> list[_Segment]:
+    """Cut 0..m-1 at shared generators and at gap strips."""
+    events = sorted([(int(k), 0) for k in shared] + [(int(s), 1) for s in gaps])
+    out: list[_Segment] = []
+    lo, lo_shared = 0, False
+    for pos, kind in events:
+        if kind == 0 and lo < pos:
+            out.append(_Segment(lo, pos, lo_shared, True))
+            lo, lo_shared = pos, True
+        elif kind == 1 and lo <= pos:
+            out.append(_Segment(lo, pos, lo_shared, False))
+            lo, lo_shared = pos + 1, False
+    if lo <= m - 1:
+        out.append(_Segment(lo, m - 1, lo_shared, False))
+    return out
+
+
+@dataclass(frozen=True)
+class _Plan:
+    """Everything a segment build needs besides its range."""
+
+    a: np.ndarray
+    d: np.ndarray
+    tol: Tolerances
+    scale: float
+    warnings: list
+    crease_generators: frozenset = frozenset()
+
+
+def _cut_at(run: Run, primary: int, m: int) -> tuple[int | None, int | None]:
+    """Run-local generators where the run must restart (right of, left of the primary)."""
+    bad = (run.failing >= 2) & (run.failing >= _RESTART_SHARE * np.maximum(run.on_patch, 1))
+    right = [k for k in np.flatnonzero(bad) if k >= primary + 3 and m - k >= 3]
+    left = [k for k in np.flatnonzero(bad) if k <= primary - 3 and k >= 2]
+    return (right[0] if right else None), (left[-1] if left else None)
+
+
+def _uniform_t(rows: int) -> np.ndarray:
+    return np.linspace(0.0, 1.0, max(rows // 2, 1) + 1)
+
+
+def _hopeless(run: Run) -> bool:
+    """Most of the run's faces on the patch would be bow-ties: rows bunch (K near 0)."""
+    return bool(run.failing.sum() > _HOPELESS_SHARE * max(run.on_patch.sum(), 1))
+
+
+def _bad_generators(run: Run) -> np.ndarray:
+    """Run-local generators where too many faces on the patch would not be convex."""
+    return np.flatnonzero((run.failing >= 2)
+                          & (run.failing >= _RESTART_SHARE * np.maximum(run.on_patch, 1)))
+
+
+def _even(plan: _Plan, lo: int, hi: int, rows: int) -> list[Run]:
+    """Generators lo..hi carrying an even division (no hops)."""
+    if hi < lo:
+        return []
+    return [carrier(plan.a[lo:hi + 1], plan.d[lo:hi + 1], lo, _uniform_t(rows))]
+
+
+def _build_segment(plan: _Plan, lo: int, hi: int, primary: int, div: Division,
+                   budget: list[int], shared: int | None = None) -> list[Run]:
+    """Runs covering generators lo..hi, restarted where the chains drift apart.
+
+    ``shared`` is the end generator (lo or hi) that the run this one continues
+    already carries, or None.  Where restarting does not help (the rows bunch
+    along the generators, as they do near a torsal generator), the generators
+    carry an even division instead and their strips are closed by strip quads
+    or triangles of good shape.
+    """
+    a, d = plan.a, plan.d
+    if hi - lo + 1 < 3:
+        t = div.matched if div.matched is not None and len(div.matched) else _uniform_t(div.rows)
+        return [carrier(a[lo:hi + 1], d[lo:hi + 1], lo, t)]
+    run = mesh_run(a[lo:hi + 1], d[lo:hi + 1], lo, primary, div, plan.tol, plan.scale, plan.warnings)
+    m = hi - lo + 1
+    if shared is not None and _hopeless(run):
+        # Keep the part next to the shared generator where the faces are still convex.
+        bad = _bad_generators(run)
+        outward = 1 if shared == lo else -1
+        dist = (bad - primary) * outward
+        dist = dist[dist > 0]
+        reach = int(dist.min()) if dist.size else m
+        if reach < 3:
+            return _even(plan, lo + 1, hi, div.rows) if shared == lo else _even(plan, lo, hi - 1, div.rows)
+        k = primary + outward * reach
+        r0, r1 = (lo, lo + k) if shared == lo else (lo + k, hi)
+        run = mesh_run(a[r0:r1 + 1], d[r0:r1 + 1], r0, primary - (r0 - lo), div, plan.tol, plan.scale,
+                       plan.warnings)
+        rest = _even(plan, r1 + 1, hi, div.rows) if shared == lo else _even(plan, lo, r0 - 1, div.rows)
+        return [run] + rest
+    right, left = _cut_at(run, primary, m) if budget[0] > 0 and m >= 2 * _MIN_RUN else (None, None)
+    if right is None and left is None:
+        return [run]
+    budget[0] -= (right is not None) + (left is not None)
+    new_lo = lo + (left if left is not None else 0)
+    new_hi = lo + (right if right is not None else m - 1)
+    run = mesh_run(a[new_lo:new_hi + 1], d[new_lo:new_hi + 1], new_lo, primary - (new_lo - lo), div,
+                   plan.tol, plan.scale, plan.warnings)
+    runs = [run]
+    if right is not None:
+        matched = Division(div.rows, div.option, "auto", div.max_extend, run.inside_t(new_hi))
+        runs += _build_segment(plan, new_hi, hi, 0, matched, budget, shared=new_hi)
+    if left is not None:
+        matched = Division(div.rows, div.option, "auto", div.max_extend, run.inside_t(new_lo))
+        runs += _build_segment(plan, lo, new_lo, new_lo - lo, matched, budget, shared=new_lo)
+    return runs
+
+
+def _torsal_cuts(a, d, scale, tol, creases, m):
+    """Shared generators (the twist changes sign) and gap strips (coplanar pairs, creases)."""
+    twist = coplanarity(a, d, scale)
+    flat = np.abs(twist) <= tol.degenerate
+    sign = np.sign(np.where(flat, 0.0, twist))
+    # Carry the last non-zero sign forward so a flat pair does not hide a change.
+    idx = np.where(sign != 0, np.arange(len(sign)), 0)
+    np.maximum.accumulate(idx, out=idx)
+    carried = sign[idx]
+    change = np.zeros(len(sign), bool)
+    change[1:] = (carried[1:] != carried[:-1]) & (carried[:-1] != 0) & (sign[1:] != 0)
+    crease = np.zeros(len(sign), bool)
+    if creases is not None:
+        cr = np.asarray(creases, dtype=np.int64).reshape(-1)
+        if cr.size and (cr.min() < 0 or cr.max() >= m - 1):
+            raise ParameterError(f"expected pair indices in [0, {m - 2}], got {cr.tolist()}", "creases")
+        crease[cr] = True
+    return flat, change, crease
+
+
+def _listed(ks: np.ndarray) -> str:
+    return ", ".join(f"{k}-{k + 1}" for k in ks[:8].tolist()) + (" ..." if ks.size > 8 else "")
+
+
+def pq_mesh(a, b, rows: int = 20, primary: int | str = "middle", option: int = 0,
+            extend: float | str = "auto", trim: bool = True, *, max_extend: float = 20.0,
+            creases=None, crease_generators=None, planarity_tolerance: float | None = None,
+            tol: Tolerances = DEFAULT) -> Mesh:
+    """The §4.3 PQ mesh of the ruled surface through generators ``a_i b_i``.
+
+    Parameters
+    ----------
+    a, b : (m, 3) array_like
+        Generator end points; ``t = 0`` at ``a`` (director curve c1), ``t = 1``
+        at ``b`` (c2).  ``m >= 3``.
+    rows : int
+        Divisions of the primary generator between ``t = 0`` and ``t = 1``.
+    primary : int or "middle"
+        Index of the primary generator (negative indices count from the end).
+    option : {0, 1}
+        Which colour of the checkerboard carries the vertices (the paper's two options).
+    extend : "auto" or float
+        How far the division of the primary generator continues beyond
+        ``[0, 1]`` (in primary-generator lengths); ``"auto"`` takes just what
+        covers the patch on every generator, found from the row maps.
+    trim : bool
+        Trim the faces to the patch ``0 <= t <= 1``, keeping every vertex on a
+        generator.
+    max_extend : float
+        Cap of the automatic extension.
+    creases : (k,) int, optional
+        Strips ``i`` (between generators ``i`` and ``i + 1``) across which the
+        surface has a crease (a kink of a director curve inside the strip); the
+        rows restart there and the strip is closed by triangles.  (Design files
+        put a generator through every kink instead, see :mod:`ruledmesh.design`.)
+    crease_generators : (k,) int, optional
+        Generators along which the surface has a crease (through a kink of a
+        director curve): the rows restart there with a matched division.
+    planarity_tolerance : float, optional
+        Relative planarity (the paper's measure, as :func:`ruledmesh.analysis.planarity`)
+        that strip quads between nearly coplanar generators may have; default
+        ``tol.planarity`` (exact to rounding).
+    tol : Tolerances
+
+    Returns
+    -------
+    Mesh
+        Faces of kind QUAD (interior), BORDER (reaching a director curve),
+        STRIP (quads between coplanar generators), FILL (notch, torsal and
+        border triangles) and SPLIT (quads that were not convex, split along
+        their generator diagonal); members are the generator segments between
+        consecutive vertices; ``vertex_data`` holds ``t`` and ``generator``;
+        ``info["warnings"]`` says what was replaced or could not be covered,
+        ``info["runs"]`` how many runs the generators were meshed in.
+
+    Raises
+    ------
+    ParameterError
+        For bad arguments.
+    GeometryError
+        For zero-length generators or a grid too large to build.
+
+    Examples
+    --------
+    Generators of one regulus of the hyperboloid x^2 + y^2 - z^2 = 1:
+
+    >>> import numpy as np
+    >>> phi = np.linspace(0, np.pi, 12)
+    >>> a = np.stack([np.cos(phi) - np.sin(phi), np.sin(phi) + np.cos(phi), -np.ones(12)], 1)
+    >>> b = np.stack([np.cos(phi) + np.sin(phi), np.sin(phi) - np.cos(phi), np.ones(12)], 1)
+    >>> mesh = pq_mesh(a, b, rows=10)
+    >>> v = mesh.vertices
+    >>> bool(np.abs(v[:, 0]**2 + v[:, 1]**2 - v[:, 2]**2 - 1).max() < 1e-12)
+    True
+    """
+    a = check_points(a, "a", min_count=3)
+    b = check_points(b, "b", min_count=3)
+    if a.shape != b.shape:
+        raise ParameterError(f"expected the shape of a {a.shape}, got {b.shape}", "b")
+    m = len(a)
+    rows = check_int(rows, "rows", lo=1)
+    option = check_int(option, "option", lo=0, hi=1)
+    trim = check_bool(trim, "trim")
+    middle = isinstance(primary, str)
+    if middle:
+        if primary != "middle":
+            raise ParameterError(f'expected "middle" or an index, got {describe(primary)}', "primary")
+        p = m // 2
+    else:
+        p = check_int(primary, "primary", lo=-m, hi=m - 1) % m
+    if not (isinstance(extend, str) and extend == "auto"):
+        if isinstance(extend, str):
+            raise ParameterError(f'expected "auto" or a number >= 0, got {describe(extend)}', "extend")
+        extend = check_float(extend, "extend", lo=0.0, hi=1e3)
+    max_extend = check_float(max_extend, "max_extend", lo=0.0, hi=1e3)
+    ptol = tol.planarity if planarity_tolerance is None else check_float(
+        planarity_tolerance, "planarity_tolerance", lo=0.0, hi=0.1)
+    ptol = max(ptol, tol.planarity)
+    if m * (rows + 1) > MAX_GRID_POINTS:
+        need = m * (rows + 1) * BYTES_PER_GRID_POINT / 2**30
+        raise GeometryError(f"{m} generators x {rows + 1} rows would need at least "
+                            f"{need:.1f} GiB; reduce the generator count or the rows")
+    d = b - a
+    lo, hi = np.minimum(a.min(0), b.min(0)), np.maximum(a.max(0), b.max(0))
+    scale = float(np.linalg.norm(hi - lo))
+    if scale == 0.0:
+        raise GeometryError("all generator end points coincide")
+    glen = np.linalg.norm(d, axis=1)
+    short = np.flatnonzero(glen <= tol.degenerate * scale)
+    if short.size:
+        raise GeometryError(f"generator {int(short[0])} has zero length (its end points coincide)"
+                            + (f", and {short.size - 1} more" if short.size > 1 else ""))
+    warnings: list[str] = []
+    # Torsal generators cut the generators into segments: where the twist changes
+    # sign the two segments share the generator (hops across it would reverse the
+    # rows); a coplanar pair, or a crease inside a strip, leaves that strip to be
+    # closed by strip quads (planar for a coplanar pair) or triangles (§4.3).
+    flat, change, crease = _torsal_cuts(a, d, scale, tol, creases, m)
+    if ptol > tol.planarity:
+        flat = flat | _nearly_flat(a, d, rows, ptol)
+    torsal = np.flatnonzero(flat | change)
+    kinks = np.flatnonzero(crease & ~(flat | change))
+    if torsal.size:
+        warnings.append(f"{torsal.size} torsal strips (generators {_listed(torsal)}: consecutive "
+                        "generators coplanar, or the twist changes sign): rows restarted there")
+    if kinks.size:
+        warnings.append(f"{kinks.size} crease strips (generators {_listed(kinks)}: a director curve "
+                        "has a corner there): rows restarted, strips filled with triangles")
+    cg = np.zeros(0, np.int64) if crease_generators is None else \
+        np.asarray(crease_generators, dtype=np.int64).reshape(-1)
+    if cg.size and (cg.min() < 1 or cg.max() > m - 2):
+        raise ParameterError(f"expected generator indices in [1, {m - 2}], got {cg.tolist()}",
+                             "crease_generators")
+    segs = _segments(m, np.union1d(np.flatnonzero(change & ~flat & ~crease), cg),
+                     np.flatnonzero(flat | crease))
+    plan = _Plan(a, d, tol, scale, warnings, frozenset(cg.tolist()))
+    parts = _build_all(plan, segs, p, middle,
+                       Division(rows, option, extend, max_extend), m)
+    restarts = len([r for r in parts if len(r.left)]) - len([s for s in segs if s.hi - s.lo >= 2])
+    even = _even_ranges(parts, segs)
+    if even:
+        warnings.append(f"generators {', '.join(even[:8])}{' ...' if len(even) > 8 else ''} carry no "
+                        "§4.3 rows (the rows bunch along the generators there: nearly developable, "
+                        "or next to a torsal generator) and are closed by strip quads or triangles; "
+                        "planarity_tolerance = 1e-3 admits nearly planar strip quads there")
+    meet = np.zeros(m, bool)
+    meet[:-1] |= flat
+    meet[1:] |= flat
+    mesh = assemble(parts, a, d, trim, tol, ptol, warnings, scale, meet)
+    _warn_share(mesh, warnings, torsal.size, even, max(restarts, 0), m, rows)
+    return mesh.with_info(runs=len(parts), restarts=max(restarts, 0), planarity_tolerance=ptol)
+
+
+def _even_ranges(parts: list[Run], segs: list[_Segment]) -> list[str]:
+    """Generator ranges that carry an even division without hops (not the short segments)."""
+    short = {(s.lo, s.hi) for s in segs if s.hi - s.lo < 2}
+    out = []
+    for r in parts:
+        if len(r.left) == 0 and r.gen.size:
+            lo, hi = int(r.gen.min()), int(r.gen.max())
+            if (lo, hi) not in short:
+                out.append(f"{lo}-{hi}" if hi > lo else f"{lo}")
+    return out
+
+
+def _warn_share(mesh: Mesh, warnings: list[str], torsal: int, even: list[str], restarts: int,
+                m: int, rows: int) -> None:
+    """Say so when much of the area is not in quads, with the causes and what to change."""
+    from ..analysis.faces import area_shares
+
+    if mesh.n_faces == 0:
+        return
+    share = 1.0 - area_shares(mesh)["quads"]
+    if share <= _WARN_SHARE:
+        return
+    causes = []
+    if torsal:
+        causes.append(f"{torsal} torsal generators")
+    if even:
+        causes.append(f"no rows on generators {', '.join(even[:4])}")
+    if restarts:
+        causes.append(f"the two chains drifted apart ({restarts} restarts)")
+    if m < 2 * rows:
+        causes.append(f"few generators for {rows} rows")
+    warnings.append(f"{share:.0%} of the area is not in quads ({'; '.join(causes) or 'border'}): "
+                    "more generators (rulings.count), fewer rows, [mesh] planarity_tolerance = 1e-3 "
+                    "for nearly developable parts, or method = \"hybrid\"")
+
+
+def _nearly_flat(a: np.ndarray, d: np.ndarray, rows: int, ptol: float) -> np.ndarray:
+    """Strips whose strip quads (a uniform division) are planar within ``ptol``."""
+    from ..analysis.faces import quad_planarity
+
+    t = np.linspace(0.0, 1.0, max(rows // 2, 1) + 1)
+    P0 = a[:-1, None, :] + t[None, :, None] * d[:-1, None, :]
+    P1 = a[1:, None, :] + t[None, :, None] * d[1:, None, :]
+    Q = np.stack([P0[:, :-1], P0[:, 1:], P1[:, 1:], P1[:, :-1]], axis=2)     # (m-1, k, 4, 3)
+    pl = quad_planarity(Q.reshape(-1, 4, 3)).reshape(Q.shape[0], -1)
+    # Half the tolerance: the matched divisions are not uniform.
+    return pl.max(axis=1) <= 0.5 * ptol
+
+
+def _build_all(plan: _Plan, segs: list[_Segment], p: int, middle: bool, div: Division,
+               m: int) -> list[Run]:
+    """Build the segment holding the primary, then its neighbours outwards, matched."""
+    home = next(k for k, s in enumerate(segs) if s.lo <= p <= s.hi)
+    budget = [max(4, m // 4)]
+    built: dict[int, list[Run]] = {}
+    s = segs[home]
+    pr = (p - s.lo) if not middle else (s.hi - s.lo) // 2
+    built[home] = _build_segment(plan, s.lo, s.hi, pr, div, budget)
+    for step in (1, -1):
+        k = home + step
+        while 0 <= k < len(segs):
+            s = segs[k]
+            if step > 0:
+                src = s.lo if s.shared_lo else s.lo - 1
+                primary = 0
+            else:
+                src = s.hi if s.shared_hi else s.hi + 1
+                primary = s.hi - s.lo
+            crease = src in plan.crease_generators
+            if s.hi - s.lo >= 2 and not crease:
+                # Rows started on a torsal generator (K = 0 there) bunch and fan out:
+                # each segment takes its own division from its middle; the two meet
+                # on the torsal generator in a zipper.
+                built[k] = _build_segment(plan, s.lo, s.hi, (s.hi - s.lo) // 2, div, budget)
+            else:
+                t = _boundary_t(built[k - step], src)
+                sub = Division(div.rows, div.option, "auto", div.max_extend, t if t.size else None)
+                built[k] = _build_segment(plan, s.lo, s.hi, primary, sub, budget,
+                                          shared=src if crease else None)
+            k += step
+    return [r for k in sorted(built) for r in built[k]]
+
+
+def _boundary_t(runs: list[Run], g: int) -> np.ndarray:
+    """Parameters of the vertices some run left on generator ``g`` inside the patch."""
+    for r in runs:
+        t = r.inside_t(g)
+        if t.size:
+            return t
+    return np.zeros(0)

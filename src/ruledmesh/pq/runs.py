@@ -1,0 +1,303 @@
+"""Runs of the §4.3 mesher: checkerboard grids on consecutive generators.
+
+A *run* is a range of generators meshed by one pair of chains.  Runs end at
+torsal generators (the twist changes sign, hops across would reverse the rows)
+and where the two chains have drifted too far apart for convex quads.  A run
+that starts where another ends takes that run's vertices on the shared
+generator as the division of its primary (a *matched division*), so the two
+runs meet in well-shaped triangles along one generator instead of a band of
+splinters, and the rows carry on across it.
+
+Chain *b*'s rows are free to start anywhere between chain *a*'s: each row is
+rooted in the middle of the interval of root parameters that keeps every face
+of the row convex on every generator it reaches (constructions.md §7).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from ..errors import GeometryError
+from ..hop import crossing_maps
+from ..tolerances import Tolerances
+from .maps import (
+    ChainMaps,
+    apply,
+    chain_maps,
+    compose,
+    drift_maps,
+    inverse,
+    patch_preimage,
+    propagate,
+)
+
+__all__ = ["MAX_GRID_POINTS", "Division", "Run", "carrier", "mesh_run"]
+
+# Grid points (generators x rows) above which a build is refused up front, with
+# the memory it would need, instead of running out of memory half-way.
+MAX_GRID_POINTS = 60_000_000
+BYTES_PER_GRID_POINT = 96
+
+
+@dataclass(frozen=True)
+class Division:
+    """How the primary generator of a run is divided.
+
+    Either uniform (``rows`` steps over [0, 1], extended automatically or by
+    ``extend``, checkerboard colour ``option``), or *matched*: the given
+    parameters ``matched`` (increasing, the vertices another run left on this
+    generator), extended by their end spacings as far as the run needs.
+    """
+
+    rows: int
+    option: int = 0
+    extend: float | str = "auto"
+    max_extend: float = 20.0
+    matched: np.ndarray | None = None
+
+
+@dataclass
+class Run:
+    """The checkerboard grid of one run of generators (before trimming).
+
+    Half-faces are triangles of the zigzag strips between consecutive
+    generators: the face centred at (i, r) is the union of its left half
+    [X[i-1,r], X[i,r-1], X[i,r+1]] and right half [X[i,r-1], X[i+1,r], X[i,r+1]],
+    coplanar because the face is planar.  The halves of centres on the first and
+    last generator are the notch triangles of paper §4.3.
+    """
+
+    vertices: np.ndarray      # (V, 3)
+    t: np.ndarray             # (V,) parameter on its generator
+    gen: np.ndarray           # (V,) generator index (global)
+    far: np.ndarray           # (V,) beyond the 'far' bound: never emitted
+    left: np.ndarray          # (F, 3) left halves (-1 row where absent)
+    right: np.ndarray         # (F, 3) right halves
+    pole: np.ndarray          # (F,) a row passes through infinity inside the face
+    centre_gen: np.ndarray    # (F,) generator index of each centre (global)
+    failing: np.ndarray       # (m,) faces on the patch that are not convex, per generator
+    on_patch: np.ndarray      # (m,) faces on the patch, per generator
+
+    def inside_t(self, g: int) -> np.ndarray:
+        """Increasing parameters of this run's vertices on global generator ``g`` in [0, 1]."""
+        sel = (self.gen == g) & ~self.far & (self.t >= 0.0) & (self.t <= 1.0)
+        return np.sort(self.t[sel])
+
+
+def _uniform_rows(M: np.ndarray, div: Division, primary_global: int, tol: Tolerances,
+                  warnings: list[str]) -> np.ndarray:
+    """Root parameters of all rows, uniform in ``1 / rows``; even entries on the primary."""
+    rows = div.rows
+    if div.extend == "auto":
+        lo, hi, bounded = patch_preimage(M, tol.degenerate)
+        if not np.all(bounded):
+            warnings.append(f"{int((~bounded).sum())} generators cannot be covered by a finite "
+                            f"division of the primary generator; extension capped at "
+                            f"{div.max_extend:g} generator lengths")
+        lo_v = lo[bounded].min() if bounded.any() else 0.0
+        hi_v = hi[bounded].max() if bounded.any() else 1.0
+        lo_v = max(min(lo_v, 0.0), -div.max_extend)
+        hi_v = min(max(hi_v, 1.0), 1.0 + div.max_extend)
+        # Two rows of margin on each side: a face spans two row steps.
+        j0 = math.floor(lo_v * rows) - 2
+        j1 = math.ceil(hi_v * rows) + 2
+    else:
+        e = float(div.extend)
+        j0 = -math.ceil(e * rows)
+        j1 = rows + math.ceil(e * rows)
+    # The primary carries the rows of the colour `option` (global i + j parity).
+    if (primary_global + j0 - div.option) % 2:
+        j0 -= 1
+    count = j1 - j0 + 1
+    count += count % 2
+    return (j0 + np.arange(count)) / rows
+
+
+def _matched_rows(M: np.ndarray, div: Division, primary: int, tol: Tolerances) -> np.ndarray:
+    """Root parameters from a matched division, extended by the end spacings."""
+    given = np.asarray(div.matched, dtype=np.float64)
+    lo, hi, bounded = patch_preimage(M, tol.degenerate)
+    lo_v = max(lo[bounded].min() if bounded.any() else 0.0, -div.max_extend)
+    hi_v = min(hi[bounded].max() if bounded.any() else 1.0, 1.0 + div.max_extend)
+    if given.size == 1:
+        step = 2.0 / div.rows
+        s0 = s1 = step
+    else:
+        floor = 1e-6 / div.rows
+        s0, s1 = max(given[1] - given[0], floor), max(given[-1] - given[-2], floor)
+    # Two A-row steps of margin beyond what covers the patch (a face spans two steps).
+    n0 = max(math.ceil((given[0] - lo_v) / s0) + 2, 2)
+    n1 = max(math.ceil((hi_v - given[-1]) / s1) + 2, 2)
+    n0, n1 = min(n0, 100_000), min(n1, 100_000)
+    a_rows = np.concatenate([given[0] - s0 * np.arange(n0, 0, -1), given,
+                             given[-1] + s1 * np.arange(1, n1 + 1)])
+    mid = 0.5 * (a_rows[1:] + a_rows[:-1])
+    out = np.empty(2 * len(a_rows))
+    out[0::2] = a_rows
+    out[1:-1:2] = mid
+    out[-1] = a_rows[-1] + 0.5 * s1
+    return out
+
+
+def _root_b_rows(M: np.ndarray, N: np.ndarray, tau: np.ndarray, primary: int,
+                 parity: np.ndarray) -> np.ndarray:
+    """Chain *b*'s roots, each in the middle of the interval that keeps its faces convex.
+
+    For b-row ``h`` between a-rows ``tau[2h]`` and ``tau[2h+2]`` every face it
+    takes part in gives an interval of admissible roots (constructions.md §7):
+    ``N_i^-1`` of the a-rows on a-generators, ``N_i`` of them on b-generators.
+    The intervals are intersected from the primary outwards, as far as the
+    intersection stays non-empty; the root is its middle.
+    """
+    m = len(M)
+    a_lo, a_hi, sigma0 = tau[0:-2:2], tau[2::2], tau[1:-1:2]
+    H = len(a_lo)
+    if m < 3 or H == 0:
+        return tau
+    inner = np.arange(1, m - 1)
+    Ni = N[inner]
+    maps = np.where((parity[inner] == 0)[:, None, None], inverse(Ni), Ni)
+    lo = apply(maps, np.broadcast_to(a_lo, (len(inner), H)).copy())
+    hi = apply(maps, np.broadcast_to(a_hi, (len(inner), H)).copy())
+    lo, hi = np.minimum(lo, hi), np.maximum(lo, hi)
+    # Only faces on the patch constrain a row.
+    t_mid = apply(M[inner], np.broadcast_to(sigma0, (len(inner), H)).copy())
+    relevant = np.isfinite(lo) & np.isfinite(hi) & (t_mid > -0.05) & (t_mid < 1.05)
+    lo = np.where(relevant, lo, -np.inf)
+    hi = np.where(relevant, hi, np.inf)
+    order = np.argsort(np.abs(inner - primary - 0.5), kind="stable")
+    cum_lo = np.maximum.accumulate(lo[order], axis=0)
+    cum_hi = np.minimum.accumulate(hi[order], axis=0)
+    ok = cum_lo < cum_hi
+    # Last feasible prefix per row (rows infeasible from the start keep their default).
+    reach = np.where(ok.all(axis=0), len(order), np.argmin(ok, axis=0))
+    has = reach > 0
+    k = np.maximum(reach - 1, 0)
+    L = cum_lo[k, np.arange(H)]
+    U = cum_hi[k, np.arange(H)]
+    bounded = has & np.isfinite(L) & np.isfinite(U)
+    Lf, Uf = np.where(np.isfinite(L), L, a_lo), np.where(np.isfinite(U), U, a_hi)
+    sigma = np.where(bounded, 0.5 * (Lf + Uf), sigma0)
+    # One-sided intervals: keep the default where it is inside, else move just inside.
+    sigma = np.where(has & ~bounded & np.isfinite(L) & (sigma0 <= Lf), Lf + 0.5 * (a_hi - Lf), sigma)
+    sigma = np.where(has & ~bounded & np.isfinite(U) & (sigma0 >= Uf), Uf - 0.5 * (Uf - a_lo), sigma)
+    # Never leave the a-rows' bracket on the primary, and keep the rows in order.
+    sigma = np.clip(sigma, a_lo + 1e-6 * (a_hi - a_lo), a_hi - 1e-6 * (a_hi - a_lo))
+    out = tau.copy()
+    out[1:-1:2] = sigma
+    return out
+
+
+def mesh_run(a: np.ndarray, d: np.ndarray, first: int, primary: int, div: Division,
+             tol: Tolerances, scale: float, warnings: list[str]) -> Run:
+    """Checkerboard PQ grid on generators a, d (a run), before trimming.
+
+    Parameters
+    ----------
+    a, d : (m, 3) float64
+        The run's generators, ``m >= 3``.
+    first : int
+        Global index of the run's first generator.
+    primary : int
+        Run-local index of the primary generator.
+    div : Division
+    tol : Tolerances
+    scale : float
+        Patch diagonal.
+    warnings : list of str
+        Appended to.
+    """
+    m = len(a)
+    maps = chain_maps(a, d, primary)
+    primary = maps.primary
+    M = compose(maps, m)
+    if div.matched is not None and len(div.matched):
+        tau = _matched_rows(M, div, primary, tol)
+    else:
+        tau = _uniform_rows(M, div, first + primary, tol, warnings)
+    H = len(tau) // 2
+    if m * 2 * H > MAX_GRID_POINTS:
+        need = m * 2 * H * BYTES_PER_GRID_POINT / 2**30
+        raise GeometryError(f"the grid would have {m} x {2 * H} points (about {need:.1f} GiB); "
+                            f"reduce the generator count, the rows or the extension")
+    parity = (np.arange(m) - primary) % 2                     # 0: chain a, 1: chain b
+    N = drift_maps(a, d, M)
+    tau = _root_b_rows(M, N, tau, primary, parity)
+    return _grid(a, d, first, maps, tau, parity, tol, scale)
+
+
+def _grid(a: np.ndarray, d: np.ndarray, first: int, maps: ChainMaps, tau: np.ndarray,
+          parity: np.ndarray, tol: Tolerances, scale: float) -> Run:
+    """Vertices and half-faces of a run from its rows' root parameters."""
+    m = len(a)
+    H = len(tau) // 2
+    roots = tau[parity[:, None] + 2 * np.arange(H)[None, :]]          # (m, H)
+    num, den = propagate(maps, roots)
+    glen = np.linalg.norm(d, axis=1)
+    tmax = tol.far * scale / np.maximum(glen, 1e-300)
+    far = ~(np.abs(num) < tmax[:, None] * np.abs(den))
+    t = np.where(far, 0.0, num / np.where(far, 1.0, den))
+    X = a[:, None, :] + t[..., None] * d[:, None, :]
+    vid = np.arange(m * H).reshape(m, H)
+    # Faces centred on g_i at the rows of the other colour: c = 0..H-1, with the
+    # vertices h_lo = c - parity, h_lo + 1 on g_i and h = c on g_i-1 and g_i+1.
+    cc = np.broadcast_to(np.arange(H)[None, :], (m, H))
+    h_lo = cc - parity[:, None]
+    ok = (h_lo >= 0) & (h_lo + 1 < H)
+    i_idx = np.arange(m)
+    ic = np.broadcast_to(i_idx[:, None], (m, H))[ok]
+    hl = h_lo[ok]
+    hc = cc[ok]
+    lo_v, hi_v = vid[ic, hl], vid[ic, hl + 1]
+    has_l, has_r = ic > 0, ic < m - 1
+    left = np.where(has_l[:, None],
+                    np.stack([vid[np.maximum(ic - 1, 0), hc], lo_v, hi_v], axis=1), -1)
+    right = np.where(has_r[:, None],
+                     np.stack([lo_v, vid[np.minimum(ic + 1, m - 1), hc], hi_v], axis=1), -1)
+    # A row passes through infinity inside a face when the homogeneous denominator
+    # changes sign between the face's two rows on its generator g_i.  (Signs on
+    # different generators are not comparable: M and -M are the same map.)
+    sg = np.signbit(den)
+    pole = sg[ic, hl] != sg[ic, hl + 1]
+    failing, on_patch = _failing_faces(a, d, t, far, ic, hl, hc, pole, m)
+    gen = np.repeat(np.arange(first, first + m), H)
+    return Run(X.reshape(-1, 3), t.reshape(-1), gen, far.reshape(-1), left, right, pole,
+               ic + first, failing, on_patch)
+
+
+def _failing_faces(a, d, t, far, ic, hl, hc, pole, m) -> tuple[np.ndarray, np.ndarray]:
+    """Per generator: faces centred on it on the patch whose crossing misses its diagonal, and all on the patch."""
+    inner = (ic > 0) & (ic < m - 1)
+    failing = np.zeros(m, np.int64)
+    counted = np.zeros(m, np.int64)
+    if m < 3 or not inner.any():
+        return failing, counted
+    X = crossing_maps(a[:-2], d[:-2], a[1:-1], d[1:-1], a[2:], d[2:])
+    i, lo, c = ic[inner], hl[inner], hc[inner]
+    ts = t[i - 1, c]
+    k = i - 1
+    num = X[k, 0, 0] * ts + X[k, 0, 1]
+    den = X[k, 1, 0] * ts + X[k, 1, 1]
+    with np.errstate(divide="ignore", invalid="ignore"):
+        tc = num / den
+    t0, t1 = t[i, lo], t[i, lo + 1]
+    on_patch = np.isfinite(tc) & (tc > 0.0) & (tc < 1.0) & ~pole[inner] \
+        & ~far[i, lo] & ~far[i, lo + 1] & ~far[i - 1, c] & ~far[i + 1, c]
+    between = (tc - t0) * (tc - t1) < 0
+    np.add.at(failing, i[on_patch & ~between], 1)
+    np.add.at(counted, i[on_patch], 1)
+    return failing, counted
+
+
+def carrier(a: np.ndarray, d: np.ndarray, first: int, t: np.ndarray) -> Run:
+    """Vertices at parameters ``t`` on each of a few generators, no faces (too few to hop)."""
+    m = len(a)
+    tt = np.tile(np.asarray(t, dtype=np.float64), m)
+    gen = np.repeat(np.arange(first, first + m), len(t))
+    X = a[gen - first] + tt[:, None] * d[gen - first]
+    none = np.zeros((0, 3), np.int64)
+    return Run(X, tt, gen, np.zeros(len(tt), bool), none, none, np.zeros(0, bool),
+               np.zeros(0, np.int64), np.zeros(m, np.int64), np.zeros(m, np.int64))
