@@ -110,3 +110,70 @@ def test_cli_render(tmp_path, capsys):
                  "--color", "closeness"]) == 2
     assert "design" in capsys.readouterr().err
     assert not (tmp_path / "c.png").exists()
+
+
+def _share(img, hex_colour, tol=0.08):
+    rgb = np.asarray(colors.to_rgb(hex_colour))
+    return float(np.all(np.abs(img[..., :3] - rgb) < tol, axis=-1).mean())
+
+
+def test_large_mesh_shows_coloured_faces_not_black():
+    """Regression: a 1000 x 1000 render was solid black (outlines and generators over every face).
+
+    90 000 faces with 300 generators at 1600 x 1200: by default the outlines are dropped
+    and the generators thinned, so most of the mesh shows its face colour; forcing both
+    on paints it over (which this test would catch if "auto" stopped working).
+    """
+    import io
+
+    mesh = translational_mesh(301, 301)
+    auto = mpimg.imread(io.BytesIO(render(mesh, color="kind", size=(1600, 1200))))
+    from ruledmesh.render import _KIND_COLORS
+
+    quad = _KIND_COLORS[FaceKind.QUAD]
+    dark = float(np.all(auto[..., :3] < 0.25, axis=-1).mean())
+    assert _share(auto, quad) > 0.15 and dark < 0.02
+    forced = mpimg.imread(io.BytesIO(render(mesh, color="kind", size=(1600, 1200),
+                                            edges="on", generators="on")))
+    assert _share(forced, quad) < 0.5 * _share(auto, quad)
+
+
+def test_title_is_drawn_inside_the_image():
+    """Regression: --title was placed above the canvas and never seen."""
+    import io
+
+    mesh = translational_mesh()
+    plain = mpimg.imread(io.BytesIO(render(mesh, size=(640, 480))))
+    titled = mpimg.imread(io.BytesIO(render(mesh, size=(640, 480), title="Translational")))
+    band = slice(0, int(0.07 * 480))
+    assert np.all(plain[band, :, :3] > 0.95)                 # nothing at the top without a title
+    assert np.any(titled[band, :, :3] < 0.3)                 # dark title text there with one
+
+
+def test_generator_and_edge_switches():
+    from ruledmesh.render import MIN_GENERATOR_SPACING, _generator_subset, _switch
+
+    mesh = translational_mesh(401, 3)                        # 401 generators
+    width = 800
+    auto = _generator_subset(mesh, "auto", width)
+    room = width * 0.8 / MIN_GENERATOR_SPACING
+    drawn = np.unique(mesh.member_id[np.isin(mesh.members, auto).all(axis=1)])
+    assert 0 < len(drawn) <= room + 1 and len(auto) < len(mesh.members)
+    assert len(_generator_subset(mesh, "on", width)) == len(mesh.members)
+    assert len(_generator_subset(mesh, True, width)) == len(mesh.members)
+    assert len(_generator_subset(mesh, "off", width)) == 0
+    assert len(_generator_subset(translational_mesh(), "auto", width)) == \
+        len(translational_mesh().members)                    # few generators: all drawn
+    assert _switch("auto", "edges", True) and not _switch("off", "edges", True)
+    with pytest.raises(ParameterError, match="edges"):
+        render(mesh, edges="maybe")
+
+
+def test_cli_render_edges_and_generators_options(tmp_path):
+    save(tmp_path / "m.obj", translational_mesh())
+    for extra in (["--edges", "off"], ["--edges", "on", "--generators", "off"], ["--no-generators"],
+                  ["--title", "A title"]):
+        out = tmp_path / "x.png"
+        assert main(["render", str(tmp_path / "m.obj"), "-o", str(out), "-q",
+                     "--size", "320x240", *extra]) == 0
+        assert mpimg.imread(out).shape[:2] == (240, 320)

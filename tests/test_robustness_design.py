@@ -10,6 +10,7 @@ suggestion.
 from __future__ import annotations
 
 import copy
+import os
 import shutil
 import tomllib
 from pathlib import Path
@@ -33,7 +34,13 @@ def run_bad(tmp_path: Path, capsys, text: str | bytes, name: str = "bad.toml") -
     for csv in (ROOT / "examples").glob("*.csv"):
         shutil.copy(csv, tmp_path)
     target = tmp_path / "out.obj"
-    code = main(["build", str(design), "-o", str(target)])
+    # Run from the folder with the name as a user types it: errors quote the path as typed.
+    cwd = os.getcwd()
+    os.chdir(tmp_path)
+    try:
+        code = main(["build", name, "-o", "out.obj"])
+    finally:
+        os.chdir(cwd)
     captured = capsys.readouterr()
     err = captured.err.strip()
     assert code == 2, (code, err)

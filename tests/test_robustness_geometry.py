@@ -10,6 +10,7 @@ file and the problem, exit code 2, and no file written.
 from __future__ import annotations
 
 import json
+import os
 import re
 from pathlib import Path
 
@@ -38,7 +39,13 @@ def build(tmp_path: Path, capsys, text: str, name: str = "case.toml", out: str =
     design = tmp_path / name
     design.write_text(text)
     target = tmp_path / out
-    code = main(["build", str(design), "-o", str(target), "--json"])
+    # Run from the folder with the name as a user types it: errors quote the path as typed.
+    cwd = os.getcwd()
+    os.chdir(tmp_path)
+    try:
+        code = main(["build", name, "-o", out, "--json"])
+    finally:
+        os.chdir(cwd)
     captured = capsys.readouterr()
     report = json.loads(captured.out) if code == 0 else None
     return code, report, captured.err, design, target

@@ -19,6 +19,7 @@ import numpy as np
 
 from ._validation import check_keys, describe, near_miss
 from .errors import DesignError, RuledMeshError
+from .progress import SILENT, Progress, Task, stages
 from .registry import (MESH_METHODS, SURFACE_KINDS, TRANSFORMS, BuildContext, Built,
                        load_plugins)
 
@@ -97,14 +98,32 @@ def _table(data: Mapping, key: str, required: bool = False) -> Mapping:
     return value
 
 
-def _build(design: Design) -> Built:
+def _build(design: Design, progress: Progress) -> Built:
     data = design.data
-    ctx = design.context
     from .units import unit_of
 
     units = unit_of(data.get("units"), "units", err=DesignError)
     load_plugins()
     mesh_table = _table(data, "mesh")
+    transforms = data.get("transform", [])
+    if not isinstance(transforms, list):
+        raise DesignError("expected [[transform]] tables (an array of tables)", "transform")
+    names = ([] if "surface" in data else ["generators"]) + ["mesh"] + ["transforms"] * bool(transforms)
+    with stages(progress, "build", names) as task:
+        built = _build_surface(design, mesh_table, task)
+        task.advance(note="transforms" if transforms else None)
+        built = _apply_transforms(built, transforms)
+        if transforms:
+            task.advance()
+    from dataclasses import replace
+
+    return replace(built, mesh=built.mesh.with_info(units=units.value))
+
+
+def _build_surface(design: Design, mesh_table: Mapping, task: Task) -> Built:
+    """The mesh of the [surface] or [rulings] tables, before any transform."""
+    data = design.data
+    ctx = design.context
     if "surface" in data:
         if "rulings" in data:
             raise DesignError("give either [surface] or [rulings], not both", "rulings")
@@ -128,15 +147,17 @@ def _build(design: Design) -> Built:
         rulings_table = _table(data, "rulings")
         rulings = rulings_from_spec(rulings_table, curves, path="rulings", base_dir=design.base_dir)
         rulings = _with_creases(rulings, rulings_table, curves)
+        task.advance(note="mesh")
         method = mesh_table.get("method", "pq")
         if not isinstance(method, str) or method not in MESH_METHODS:
             raise _unknown("mesh.method", method, MESH_METHODS)
         if method == "pq":
             _check_budget(len(rulings), mesh_table.get("rows", 20))
         built = MESH_METHODS[method](rulings, mesh_table, ctx)
-    transforms = data.get("transform", [])
-    if not isinstance(transforms, list):
-        raise DesignError("expected [[transform]] tables (an array of tables)", "transform")
+    return built
+
+
+def _apply_transforms(built: Built, transforms: list) -> Built:
     for k, table in enumerate(transforms):
         path = f"transform[{k}]"
         if not isinstance(table, Mapping):
@@ -145,9 +166,7 @@ def _build(design: Design) -> Built:
         if not isinstance(kind, str) or kind not in TRANSFORMS:
             raise _unknown(f"{path}.type", kind, TRANSFORMS)
         built = TRANSFORMS[kind](built, table, path)
-    from dataclasses import replace
-
-    return replace(built, mesh=built.mesh.with_info(units=units.value))
+    return built
 
 
 # Refuse builds whose estimated peak memory exceeds this, before allocating anything.
@@ -273,8 +292,15 @@ def _unknown(path: str, value: Any, table: Mapping) -> DesignError:
     return DesignError(f"expected one of {listed}, got {got}{near_miss(value, names)}", path)
 
 
-def build_design(design: Design) -> Built:
+def build_design(design: Design, progress: Progress | None = None) -> Built:
     """Build the mesh a design describes.
+
+    Parameters
+    ----------
+    design : Design
+    progress : Progress, optional
+        Told the build stages as they run (generators, mesh, transforms);
+        see :mod:`ruledmesh.progress`.  Default: silent.
 
     Returns
     -------
@@ -289,7 +315,7 @@ def build_design(design: Design) -> Built:
         When the geometry cannot be meshed as asked.
     """
     try:
-        built = _build(design)
+        built = _build(design, progress or SILENT)
     except DesignError as exc:
         raise (exc if exc.source else exc.with_source(design.source)) from None
     except RuledMeshError as exc:
@@ -297,6 +323,6 @@ def build_design(design: Design) -> Built:
     return built
 
 
-def build_file(path: str | os.PathLike) -> Built:
+def build_file(path: str | os.PathLike, progress: Progress | None = None) -> Built:
     """:func:`build_design` of :func:`load_design` (``path``)."""
-    return build_design(load_design(path))
+    return build_design(load_design(path), progress)

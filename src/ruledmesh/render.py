@@ -23,7 +23,8 @@ from .errors import ExportError, ParameterError
 from .mesh import FaceKind, Mesh
 from .tolerances import DEFAULT
 
-__all__ = ["ColorBy", "face_values", "render", "save_render", "FORMATS"]
+__all__ = ["FORMATS", "MIN_FACE_PIXELS", "MIN_GENERATOR_SPACING", "ColorBy", "Switch", "face_values",
+           "render", "save_render"]
 
 # File types the Agg-based figure can write, by extension.
 FORMATS = {".png": "png", ".svg": "svg", ".pdf": "pdf"}
@@ -41,6 +42,14 @@ _KIND_COLORS = {
     FaceKind.POLYGON: "#9d755d",
     FaceKind.STRIP: "#72b7b2",
 }
+
+
+class Switch(str, Enum):
+    """Whether to draw edges or generators: always, never, or by the face count."""
+
+    ON = "on"
+    OFF = "off"
+    AUTO = "auto"
 
 
 class ColorBy(str, Enum):
@@ -120,9 +129,59 @@ def _colouring(values: np.ndarray, color: ColorBy):
         "closeness (centroid distance / bounding-box diagonal)", None
 
 
+# Share of the canvas the mesh covers, roughly (the colour bar and margins take the rest).
+_MESH_SHARE = 0.5
+
+# ``edges="auto"`` outlines faces while each covers at least this many pixels on average.
+MIN_FACE_PIXELS = 60.0
+
+# ``generators="auto"`` keeps generators at least this many pixels apart on average.
+MIN_GENERATOR_SPACING = 8.0
+
+
+def _switch(value: bool | str, name: str, auto: bool) -> bool:
+    """``True``/``"on"``, ``False``/``"off"``, or ``"auto"`` (then ``auto``)."""
+    if isinstance(value, bool):
+        return value
+    choice = check_choice(value, Switch, name)
+    return auto if choice is Switch.AUTO else choice is Switch.ON
+
+
+def _edge_width(face_pixels: float) -> float:
+    """Outline width in points: thinner as faces get smaller."""
+    return float(np.clip(0.3 * np.sqrt(face_pixels / 400.0), 0.1, 0.4))
+
+
+def _generator_subset(mesh: Mesh, generators: bool | str, width: int) -> np.ndarray:
+    """(E', 2) member segments to draw: all, none, or every k-th generator ("auto")."""
+    if not len(mesh.members):
+        return mesh.members
+    ids, index = np.unique(mesh.member_id, return_inverse=True)
+    room = max(int(width * 0.8 / MIN_GENERATOR_SPACING), 1)
+    if not _switch(generators, "generators", True):
+        return mesh.members[:0]
+    if isinstance(generators, bool) or Switch(generators) is Switch.ON or len(ids) <= room:
+        return mesh.members
+    step = int(np.ceil(len(ids) / room))
+    return mesh.members[index % step == 0]
+
+
+def _frame(ax, mesh: Mesh, elev: float, azim: float) -> None:
+    """Axis limits around the mesh at equal scale, the camera, no axes drawn."""
+    lo, hi = mesh.bounding_box()
+    span = np.maximum(hi - lo, 1e-9 * max(float(np.max(hi - lo)), 1.0))
+    ax.set_xlim(lo[0], lo[0] + span[0])
+    ax.set_ylim(lo[1], lo[1] + span[1])
+    ax.set_zlim(lo[2], lo[2] + span[2])
+    # Equal scale on the three axes: a flat-looking panel must look flat.
+    ax.set_box_aspect(tuple(np.maximum(span / span.max(), 0.02)), zoom=0.9)
+    ax.view_init(elev=elev, azim=azim)
+    ax.set_axis_off()
+
+
 def render(mesh: Mesh, *, color: ColorBy | str = ColorBy.PLANARITY, reference=None,
            view: tuple[float, float] = (25.0, -60.0), size: tuple[int, int] = (1000, 800),
-           dpi: int = 100, generators: bool = True, edges: bool = True,
+           dpi: int = 100, generators: bool | str = "auto", edges: bool | str = "auto",
            title: str | None = None, fmt: str = "png") -> bytes:
     """The picture of ``mesh`` as image bytes.
 
@@ -139,10 +198,15 @@ def render(mesh: Mesh, *, color: ColorBy | str = ColorBy.PLANARITY, reference=No
     size : (width, height) in pixels
         The image size (exact for raster formats).
     dpi : int
-    generators : bool
-        Draw the members (generator segments) as dark lines.
-    edges : bool
-        Outline the faces.
+    generators : bool or {"on", "off", "auto"}
+        Draw the members (generator segments) as dark lines.  ``"auto"``
+        draws every generator while they are at least
+        :data:`MIN_GENERATOR_SPACING` pixels apart on average, and an evenly
+        spaced subset of them beyond that (so the faces stay visible).
+    edges : bool or {"on", "off", "auto"}
+        Outline the faces.  ``"auto"`` outlines them while a face covers at
+        least :data:`MIN_FACE_PIXELS` pixels on average and drops the outlines
+        beyond (a million outlined faces would paint the picture black).
     title : str, optional
     fmt : {"png", "svg", "pdf"}
 
@@ -172,36 +236,37 @@ def render(mesh: Mesh, *, color: ColorBy | str = ColorBy.PLANARITY, reference=No
 
     values = face_values(mesh, color, reference)
     cmap, norm, label, ticks = _colouring(values, color)
+    pixels = width * height * _MESH_SHARE
+    draw_edges = _switch(edges, "edges", pixels / mesh.n_faces >= MIN_FACE_PIXELS)
+    members = _generator_subset(mesh, generators, width)
 
     fig = Figure(figsize=(width / dpi, height / dpi), dpi=dpi)
     FigureCanvasAgg(fig)
     # The 3-D axes reserve wide empty margins; most of the canvas goes to the mesh.
-    ax = fig.add_axes((-0.02, -0.05, 0.88, 1.1), projection="3d", computed_zorder=False)
+    # A title gets its own band at the top, inside the canvas.
+    top = 1.1 if not title else 1.0
+    ax = fig.add_axes((-0.02, -0.05, 0.88, top), projection="3d", computed_zorder=False)
+    # Without outlines, antialiased neighbours leave light seams between sub-pixel faces.
     polys = Poly3DCollection(_face_polygons(mesh), cmap=cmap, norm=norm,
-                             edgecolors="#20202080" if edges else "none",
-                             linewidths=0.3 if edges else 0.0)
+                             edgecolors="#20202080" if draw_edges else "none",
+                             linewidths=_edge_width(pixels / mesh.n_faces) if draw_edges else 0.0,
+                             antialiased=draw_edges)
     polys.set_array(values if color is not ColorBy.PLANARITY
                     else np.maximum(values, _PLANARITY_FLOOR))
     ax.add_collection3d(polys)
-    if generators and len(mesh.members):
-        segs = mesh.vertices[mesh.members]
-        ax.add_collection3d(Line3DCollection(segs, colors="#111111", linewidths=0.8, zorder=3))
+    if len(members):
+        segs = mesh.vertices[members]
+        thinned = len(members) < len(mesh.members)
+        ax.add_collection3d(Line3DCollection(segs, colors="#111111", zorder=3,
+                                             linewidths=0.5 if thinned else 0.8))
 
-    lo, hi = mesh.bounding_box()
-    span = np.maximum(hi - lo, 1e-9 * max(float(np.max(hi - lo)), 1.0))
-    ax.set_xlim(lo[0], lo[0] + span[0])
-    ax.set_ylim(lo[1], lo[1] + span[1])
-    ax.set_zlim(lo[2], lo[2] + span[2])
-    # Equal scale on the three axes: a flat-looking panel must look flat.
-    ax.set_box_aspect(tuple(np.maximum(span / span.max(), 0.02)), zoom=0.9)
-    ax.view_init(elev=elev, azim=azim)
-    ax.set_axis_off()
+    _frame(ax, mesh, elev, azim)
     bar = fig.colorbar(polys, cax=fig.add_axes((0.88, 0.2, 0.025, 0.6)))
     bar.set_label(label)
     if ticks is not None:
         bar.set_ticks(ticks[0], labels=ticks[1])
     if title:
-        ax.set_title(title)
+        fig.text(0.43, 0.985, title, ha="center", va="top", fontsize=max(8.0, min(16.0, height / 50)))
     buf = io.BytesIO()
     fig.savefig(buf, format=fmt, dpi=dpi)
     return buf.getvalue()

@@ -387,9 +387,32 @@ def transform_built(built: Built, kind: str, **params) -> Built:
         notes.append(f"{kind}: rulings dropped (the mesh's members carry the transformed lines)")
     if notes:
         extras["transform_notes"] = notes
-    if kind == "inversion" and "guarantee" in extras:
-        extras["guarantee"] = "circular (inversion of a circular mesh)"
+    if "guarantee" in extras:
+        extras["guarantee"] = _guarantee_after(str(extras["guarantee"]), kind, similarity)
     return Built(new, ref, None, extras)
+
+
+def _guarantee_after(guarantee: str, kind: str, similarity: float | None) -> str:
+    """What a construction's guarantee still promises after the map ``kind``.
+
+    Similarities keep everything; other affine maps keep parallel edges but not
+    lengths or circles; projective maps keep only planarity; inversion keeps
+    circles (and hence planarity) but not straight edges.
+    """
+    if kind == "inversion":
+        return "circular (inversion of a circular mesh)"
+    if similarity is not None:
+        return guarantee
+    if kind == "projective":
+        return "planar (projective image)"
+    kept = []
+    for clause in guarantee.split(";"):
+        parts = [p.strip().replace("isosceles trapezoids", "trapezoids") for p in clause.split(",")]
+        parts = [p for p in parts if p and not p.startswith("circular")]
+        if parts:
+            kept.append(", ".join(parts))
+    return "; ".join(kept) + f" (after a non-similar {kind} map)" if kept else \
+        f"planar (after a non-similar {kind} map)"
 
 
 def _fit_affine(before: np.ndarray, after: np.ndarray, fn, params) -> tuple[np.ndarray, np.ndarray]:

@@ -8,7 +8,15 @@ Figures (relative ones are divided by the bounding-box diagonal):
 * ``area``, ``edge_length``, ``min_angle``;
 * ``closeness`` (with a reference surface): distance of face centroids and
   vertices from the smooth patch, relative to the diagonal;
-* ``coverage`` (with a reference surface): mesh area / smooth patch area.
+* ``coverage`` (with a reference surface): mesh area / smooth patch area;
+* ``guarantee_check`` (when a construction states a ``guarantee``): each
+  promised property measured (:mod:`.guarantees`); a promise the figures do
+  not confirm becomes a warning;
+* ``matches_design`` (with a reference surface): False, with a warning, when
+  closeness or coverage is far off (the mesh is not one of that design).
+
+A mesh without faces is refused (:class:`~ruledmesh.errors.GeometryError`):
+there is nothing to measure, and a table of zeros would read as a result.
 """
 
 from __future__ import annotations
@@ -18,11 +26,32 @@ from typing import Any, Mapping
 
 import numpy as np
 
-from ..mesh import Mesh
+from ..errors import GeometryError
+from ..mesh import FaceKind, Mesh
+from ..progress import Progress, stages
 from ..tolerances import DEFAULT, Tolerances
 from . import faces as F
 
-__all__ = ["analyze", "format_table", "format_summary", "METRIC_HOOKS"]
+__all__ = ["KIND_NOUNS", "METRIC_HOOKS", "MISMATCH", "analyze", "format_summary", "format_table",
+           "kind_counts"]
+
+# The words every report, the command line and the docs use for face counts.
+KIND_NOUNS = {
+    FaceKind.QUAD: ("quad", "quads"),
+    FaceKind.BORDER: ("border face", "border faces"),
+    FaceKind.FILL: ("fill triangle", "fill triangles"),
+    FaceKind.SPLIT: ("split quad", "split quads"),
+    FaceKind.TRIANGLE: ("triangle", "triangles"),
+    FaceKind.POLYGON: ("polygon", "polygons"),
+    FaceKind.STRIP: ("strip quad", "strip quads"),
+}
+
+# A mesh "matches" a design unless its vertices are farther than this from the design
+# surface (relative to the diagonal) or its area is outside this ratio of the patch's.
+# Deliberately loose, "far off" only: meshes of the bundled designs reach 0.04 (hybrid
+# meshes near torsal lines) and coverage 0.73 (compounds covering part of the patch); a
+# skew mesh measured against the torus design gives 0.62 and 0.43.
+MISMATCH: dict[str, Any] = {"closeness": 0.1, "coverage": (0.5, 2.0)}
 
 # Extra figures from other modules: name -> fn(mesh) -> dict or None (None: not applicable).
 # Modules in _HOOK_MODULES register themselves here when imported.
@@ -45,6 +74,21 @@ def _stats(values: np.ndarray) -> dict[str, float]:
     if values.size == 0:
         return {"min": 0.0, "max": 0.0, "mean": 0.0}
     return {"min": float(values.min()), "max": float(values.max()), "mean": float(values.mean())}
+
+
+def kind_counts(counts: Mapping[str, int]) -> str:
+    """Face counts by kind in words: ``"633 quads, 9 border faces, 306 fill triangles"``.
+
+    Parameters
+    ----------
+    counts : mapping of kind label to count
+        As from :meth:`Mesh.count_kinds`.
+    """
+    words = []
+    for label, n in counts.items():
+        one, many = KIND_NOUNS[FaceKind.from_label(label)]
+        words.append(f"{n} {one if n == 1 else many}")
+    return ", ".join(words) or "no faces"
 
 
 def _planarity(plan: np.ndarray, mesh: Mesh, tol: Tolerances) -> dict[str, Any]:
@@ -80,7 +124,8 @@ def _quality(mesh: Mesh, tol: Tolerances) -> dict[str, Any]:
 
 
 def analyze(mesh: Mesh, reference=None, extras: Mapping[str, Any] | None = None,
-            tol: Tolerances = DEFAULT, compare: bool = False) -> dict[str, Any]:
+            tol: Tolerances = DEFAULT, compare: bool = False,
+            progress: Progress | None = None) -> dict[str, Any]:
     """Measure ``mesh``.
 
     Parameters
@@ -95,12 +140,46 @@ def analyze(mesh: Mesh, reference=None, extras: Mapping[str, Any] | None = None,
         Also let hooks that compare with the smooth surface run (e.g. the
         triangulation against the parameter-grid and OCCT tessellations of
         the same surface); slow, so off by default.
+    progress : Progress, optional
+        Told the figures as they are computed (see :mod:`ruledmesh.progress`).
 
     Returns
     -------
     dict
         JSON-serialisable figures (see the module docstring).
+
+    Raises
+    ------
+    GeometryError
+        If the mesh has no faces.
     """
+    if mesh.n_faces == 0:
+        raise GeometryError(f"the mesh has no faces ({mesh.n_vertices} vertices); "
+                            "nothing to analyse")
+    _load_hooks()
+    names = ["faces"] + ["closeness"] * (reference is not None) + list(METRIC_HOOKS)
+    with stages(progress, "analyse", names) as task:
+        report = _figures(mesh, tol)
+        task.advance(note=names[1] if len(names) > 1 else None)
+        if reference is not None:
+            report.update(_closeness(mesh, reference, report["area"]["total"]))
+            task.advance(note=names[2] if len(names) > 2 else None)
+        for k, (name, hook) in enumerate(METRIC_HOOKS.items()):
+            # Hooks that compare with the smooth surface take it as ``reference``,
+            # only when a comparison was asked for (it tessellates the surface anew).
+            takes_ref = compare and "reference" in inspect.signature(hook).parameters
+            value = hook(mesh, reference=reference) if takes_ref else hook(mesh)
+            if value is not None:
+                report[name] = value
+            task.advance(note=(list(METRIC_HOOKS) + [None])[k + 1])
+    if extras:
+        report.update(dict(extras))
+    report["warnings"] = _warnings(mesh, report, tol)
+    return report
+
+
+def _figures(mesh: Mesh, tol: Tolerances) -> dict[str, Any]:
+    """The figures every mesh has: counts, planarity, convexity, sizes, angles."""
     diag = mesh.diagonal() or 1.0
     plan = F.planarity(mesh)
     convex = F.convexity(mesh, tol.convexity)
@@ -125,35 +204,45 @@ def analyze(mesh: Mesh, reference=None, extras: Mapping[str, Any] | None = None,
         "quality": _quality(mesh, tol),
         "euler_characteristic": mesh.euler_characteristic(len(edges)),
     }
-    if reference is not None:
-        cent = F.face_centroids(mesh)
-        dc = reference.distance(cent) / diag
-        dv = reference.distance(mesh.vertices[np.unique(mesh.face_indices)]) / diag
-        report["closeness"] = {
-            "vertices_max": float(dv.max()) if dv.size else 0.0,
-            "centroids_max": float(dc.max()) if dc.size else 0.0,
-            "centroids_mean": float(dc.mean()) if dc.size else 0.0,
-            "relative_to": "bounding-box diagonal",
-        }
-        patch = reference.area()
-        if patch:
-            report["coverage"] = {
-                "mesh_area": float(areas.sum()),
-                "patch_area": float(patch),
-                "ratio": float(areas.sum() / patch),
-            }
-    _load_hooks()
-    for name, hook in METRIC_HOOKS.items():
-        # Hooks that compare with the smooth surface take it as ``reference``,
-        # only when a comparison was asked for (it tessellates the surface anew).
-        takes_ref = compare and "reference" in inspect.signature(hook).parameters
-        value = hook(mesh, reference=reference) if takes_ref else hook(mesh)
-        if value is not None:
-            report[name] = value
-    if extras:
-        report.update(dict(extras))
+    return report
+
+
+def _closeness(mesh: Mesh, reference, mesh_area: float) -> dict[str, Any]:
+    """Closeness to the smooth patch and coverage of it (relative to the diagonal)."""
+    diag = mesh.diagonal() or 1.0
+    dc = reference.distance(F.face_centroids(mesh)) / diag
+    dv = reference.distance(mesh.vertices[np.unique(mesh.face_indices)]) / diag
+    out: dict[str, Any] = {"closeness": {
+        "vertices_max": float(dv.max()) if dv.size else 0.0,
+        "centroids_max": float(dc.max()) if dc.size else 0.0,
+        "centroids_mean": float(dc.mean()) if dc.size else 0.0,
+        "relative_to": "bounding-box diagonal",
+    }}
+    patch = reference.area()
+    if patch:
+        out["coverage"] = {"mesh_area": mesh_area, "patch_area": float(patch),
+                           "ratio": float(mesh_area / patch)}
+    return out
+
+
+def _design_mismatch(report: Mapping[str, Any]) -> list[str]:
+    """Why the mesh is not one of the design it is measured against (empty: it is)."""
+    why = []
+    close = report["closeness"]["vertices_max"]
+    if not close <= MISMATCH["closeness"]:
+        why.append(f"closeness {close:.3g} > {MISMATCH['closeness']:g}")
+    lo, hi = MISMATCH["coverage"]
+    if "coverage" in report and not lo <= report["coverage"]["ratio"] <= hi:
+        why.append(f"coverage {report['coverage']['ratio']:.3g} outside {lo:g}..{hi:g}")
+    return why
+
+
+def _warnings(mesh: Mesh, report: dict[str, Any], tol: Tolerances) -> list[str]:
+    """Warnings from the figures; adds ``guarantee_check`` and ``matches_design``."""
+    from .guarantees import check_guarantee, format_guarantee
+
     warnings = list(mesh.info.get("warnings", []))
-    if not finite:
+    if not report["finite"]:
         warnings.append("mesh has NaN or infinite coordinates")
     if report["non_convex"]:
         warnings.append(f"{report['non_convex']} faces are not convex")
@@ -167,8 +256,20 @@ def analyze(mesh: Mesh, reference=None, extras: Mapping[str, Any] | None = None,
     if report["planarity"]["above_tolerance"]:
         warnings.append(f"{report['planarity']['above_tolerance']} faces are not planar to "
                         f"{report['planarity']['tolerance']:g}")
-    report["warnings"] = warnings
-    return report
+    if "closeness" in report:
+        why = _design_mismatch(report)
+        report["matches_design"] = not why
+        if why:
+            warnings.append("the mesh does not match the design: " + ", ".join(why)
+                            + " (is --design the file this mesh was built from?)")
+    if isinstance(report.get("guarantee"), str):
+        check = check_guarantee(report["guarantee"], mesh, tol)
+        report["guarantee_check"] = check
+        if not check["met"]:
+            unmet = {**check, "properties": [r for r in check["properties"]
+                                             if r["status"] == "not met"]}
+            warnings.append(f"guarantee: {format_guarantee(unmet)}")
+    return warnings
 
 
 def _shares(by_kind: Mapping[str, float]) -> str:
@@ -177,8 +278,7 @@ def _shares(by_kind: Mapping[str, float]) -> str:
 
 def format_summary(report: Mapping[str, Any]) -> str:
     """One line: faces by kind and the worst planarity."""
-    kinds = ", ".join(f"{c} {k}" for k, c in report["kinds"].items())
-    text = (f"{report['faces']} faces ({kinds}), {report['vertices']} vertices, "
+    text = (f"{report['faces']} faces ({kind_counts(report['kinds'])}), {report['vertices']} vertices, "
             f"max planarity {report['planarity']['max']:.2e}")
     pl = report["planarity"]
     if pl.get("within_tolerance"):
@@ -205,7 +305,15 @@ def _fmt(value: Any) -> str:
 
 def format_table(report: Mapping[str, Any]) -> str:
     """The report as an aligned two-column text table."""
-    rows = [(k, _fmt(v)) for k, v in report.items() if k != "warnings"]
+    from .guarantees import format_guarantee
+
+    shown = {"kinds": kind_counts,
+             "guarantee": lambda g: format_guarantee(report["guarantee_check"])
+             if "guarantee_check" in report else str(g)}
+    # "triangles" are the export triangulation's, not faces: the row says so.
+    names = {"triangles": "triangulation"}
+    rows = [(names.get(k, k), shown.get(k, _fmt)(v)) for k, v in report.items()
+            if k not in ("warnings", "guarantee_check")]
     width = max(len(k) for k, _ in rows)
     lines = [f"{k.ljust(width)}  {v}" for k, v in rows]
     for w in report.get("warnings", []):

@@ -50,7 +50,36 @@ def build_parser() -> argparse.ArgumentParser:
                 raise
             continue
         module.add_parser(sub)
+    from ._common import HelpFormatter
+
+    # One formatter for every subcommand: prose wrapped, examples one per line.
+    for child in sub.choices.values():
+        child.formatter_class = HelpFormatter
     return parser
+
+
+def _published_name(filename) -> str:
+    """The file the user asked for, not the hidden ``.NAME.*.part`` temporary it is written as."""
+    import re
+    from pathlib import Path
+
+    path = Path(str(filename))
+    # ruledmesh.io.write_atomic's two temporary names: .NAME.PID.FD.HEX8.part, .NAME.XXXXXXXX.part
+    m = (re.fullmatch(r"\.(.+)\.\d+\.\d+\.[0-9a-f]{8}\.part", path.name)
+         or re.fullmatch(r"\.(.+)\.[A-Za-z0-9_]{8}\.part", path.name))
+    if not m:
+        return str(filename)
+    return str(path.with_name(m.group(1)))
+
+
+def _run(args: argparse.Namespace) -> int:
+    """The subcommand; progress bars it leaves open are closed before any message."""
+    try:
+        return int(args.run(args) or 0)
+    finally:
+        progress = getattr(args, "progress", None)
+        if progress is not None:
+            progress.close()
 
 
 def main(argv: Sequence[str] | None = None) -> int:
@@ -66,7 +95,7 @@ def main(argv: Sequence[str] | None = None) -> int:
         parser.print_help()
         return 2
     try:
-        return int(args.run(args) or 0)
+        return _run(args)
     except RuledMeshError as exc:
         if args.debug:
             raise
@@ -75,7 +104,7 @@ def main(argv: Sequence[str] | None = None) -> int:
     except OSError as exc:
         if args.debug:
             raise
-        where = f"{exc.filename}: " if exc.filename else ""
+        where = f"{_published_name(exc.filename)}: " if exc.filename else ""
         print(f"ruledmesh: error: {where}{exc.strerror or exc}", file=sys.stderr)
         return 2
     except KeyboardInterrupt:

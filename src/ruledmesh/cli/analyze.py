@@ -4,7 +4,6 @@ from __future__ import annotations
 
 import json
 import sys
-from pathlib import Path
 
 
 def add_parser(sub) -> None:
@@ -13,37 +12,39 @@ def add_parser(sub) -> None:
         help="analyse a mesh file or a design",
         description="Analyse a mesh file (geometric measures) or a design file (builds it, "
                     "then adds closeness to the smooth surface and coverage of the patch). "
-                    "Give --design with a mesh file to measure it against that design.",
-        epilog="examples:\n  ruledmesh analyze skew.obj\n  ruledmesh analyze skew.obj --design "
-               "examples/skew.toml --json",
+                    "Give --design with a mesh file to measure it against that design; a "
+                    "design the mesh does not match is reported. A construction's guarantee "
+                    "is shown with the figures that confirm it, or flagged as not met.",
+        epilog="examples:\n"
+               "  ruledmesh analyze skew.obj\n"
+               "  ruledmesh analyze examples/skew.toml\n"
+               "  ruledmesh analyze skew.obj --design examples/skew.toml --json\n",
     )
-    p.add_argument("file", help="mesh file (.obj, .ply, ...) or design file (.toml)")
+    p.add_argument("file", help="mesh file (.obj, .ply, .json) or design file (.toml)")
     p.add_argument("--design", help="design file the mesh was built from (for closeness, coverage)")
     p.add_argument("--json", action="store_true", help="machine-readable output")
     p.add_argument("--compare", action="store_true",
                    help="also triangulate the smooth surface the standard ways (parameter grid, "
                         "OCCT BRepMesh if installed) and compare triangle quality (slow)")
+    p.add_argument("-q", "--quiet", action="store_true", help="no progress display")
     p.set_defaults(run=run)
 
 
 def run(args) -> int:
     from ..analysis.report import analyze, format_table
-    from ..design import build_file
-    from ..io import load
+    from ._common import progress_for, read_design, read_source
 
-    path = Path(args.file)
-    reference = None
-    extras = {}
-    if path.suffix.lower() == ".toml":
-        built = build_file(path)
-        mesh, reference, extras = built.mesh, built.reference, built.extras
-    else:
-        mesh = load(path)
-        if args.design:
-            built = build_file(args.design)
-            reference, extras = built.reference, built.extras
-    report = analyze(mesh, reference=reference, extras=extras, compare=args.compare)
-    report["file"] = str(path)
+    progress = progress_for(args)
+    source = read_source(args.file, progress)
+    reference, extras = None, {}
+    if source.built is not None:
+        reference, extras = source.built.reference, source.built.extras
+    if args.design:
+        _, built = read_design(args.design, progress, option="--design")
+        reference, extras = built.reference, built.extras
+    report = analyze(source.mesh, reference=reference, extras=extras, compare=args.compare,
+                     progress=progress)
+    report["file"] = args.file
     if args.json:
         json.dump(report, sys.stdout, indent=2)
         sys.stdout.write("\n")

@@ -11,24 +11,32 @@ def add_parser(sub) -> None:
         "build",
         help="build a mesh from a design file",
         description="Build the mesh a design file describes and write it; the format "
-                    "follows the extension of -o.",
-        epilog="example: ruledmesh build examples/skew.toml -o skew.obj",
+                    "follows the extension of -o (.obj .ply .stl .glb .json .dxf .3dm .ifc). "
+                    "The output is checked before the build starts. Progress is shown on "
+                    "stderr when it is a terminal.",
+        epilog="examples:\n"
+               "  ruledmesh build examples/skew.toml -o skew.obj\n"
+               "  ruledmesh build examples/fig5b-torus.toml -o torus.glb --json\n",
     )
     p.add_argument("design", help="design file (.toml)")
     p.add_argument("-o", "--output", required=True, help="mesh file to write (.obj, .ply, ...)")
     p.add_argument("--json", action="store_true", help="print the analysis summary as JSON")
-    p.add_argument("-q", "--quiet", action="store_true", help="print nothing on success")
+    p.add_argument("-q", "--quiet", action="store_true",
+                   help="print nothing on success (no progress, no summary)")
     p.set_defaults(run=run)
 
 
 def run(args) -> int:
     from ..analysis.report import analyze, format_summary
-    from ..design import build_file
-    from ..io import save
+    from ..io import WRITERS, save
+    from ._common import check_output_file, progress_for, read_design
 
-    built = build_file(args.design)
-    report = analyze(built.mesh, reference=built.reference, extras=built.extras)
-    save(args.output, built.mesh)
+    output = check_output_file(args.output, WRITERS)
+    progress = progress_for(args)
+    _, built = read_design(args.design, progress)
+    report = analyze(built.mesh, reference=built.reference, extras=built.extras, progress=progress)
+    with progress.task(f"write {args.output}"):
+        save(output, built.mesh)
     if args.json:
         json.dump(report, sys.stdout, indent=2)
         sys.stdout.write("\n")

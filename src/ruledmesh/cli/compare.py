@@ -27,7 +27,9 @@ def add_parser(sub) -> None:
                     "triangles, max planarity, closeness to the smooth surface, coverage and "
                     "min angle for both. Options of the design's [mesh] table that belong to "
                     "one method are passed to it.",
-        epilog="example: ruledmesh compare examples/fig10-skew-surface.toml --rows 16",
+        epilog="examples:\n"
+               "  ruledmesh compare examples/fig10-skew-surface.toml --rows 16\n"
+               "  ruledmesh compare examples/skew.toml --json\n",
     )
     p.add_argument("design", help="design file (.toml) with [rulings]")
     p.add_argument("--rows", type=int, help="PQ: rows (divisions of the primary generator)")
@@ -107,8 +109,9 @@ def format_comparison(reports: dict) -> str:
 
 def run(args) -> int:
     from ..design import load_design
+    from ._common import check_design_file
 
-    reports = compare(load_design(args.design), args.rows, args.divisions, args.midpoints)
+    reports = compare(load_design(check_design_file(args.design)), args.rows, args.divisions, args.midpoints)
     if args.json:
         json.dump({m: {k: v for k, v in r.items()} for m, r in reports.items()}, sys.stdout,
                   indent=2, default=str)

@@ -3,7 +3,6 @@
 from __future__ import annotations
 
 import inspect
-from pathlib import Path
 
 
 def add_parser(sub) -> None:
@@ -16,9 +15,11 @@ def add_parser(sub) -> None:
                     "shorter diagonal); the others keep quads and polygons.",
         epilog="examples:\n"
                "  ruledmesh export skew.obj -o skew.glb\n"
-               "  ruledmesh export examples/skew.toml -o skew.json   (mesh + design tables)\n"
+               "  ruledmesh export examples/skew.toml -o skew.json\n"
+               "  ruledmesh export skew.obj -o skew.stl --quads best\n"
                "  ruledmesh export skew.obj -o skew.ifc --units mm\n"
-               "  ruledmesh export site.obj -o site.stl --origin auto",
+               "  ruledmesh export site.obj -o site.stl --origin auto\n\n"
+               "A .json export of a design file holds the mesh and the design tables.",
     )
     p.add_argument("mesh", help="mesh file (.obj, .ply, .json) or design file (.toml)")
     p.add_argument("-o", "--output", required=True, help="file to write; its extension picks the format")
@@ -39,7 +40,8 @@ def add_parser(sub) -> None:
     p.add_argument("--extras", choices=["file", "inline", "omit"], default="file",
                    help="PLY: face kinds and generators in NAME.ruledmesh.ply (default; every "
                         "reader takes NAME.ply), inline in one file (not meshio), or omitted")
-    p.add_argument("-q", "--quiet", action="store_true", help="print nothing on success")
+    p.add_argument("-q", "--quiet", action="store_true",
+                   help="print nothing on success (no progress, no summary)")
     p.set_defaults(run=run)
 
 
@@ -61,20 +63,16 @@ def run(args) -> int:
     import sys
     import warnings
 
+    from ..analysis.report import kind_counts
     from ..errors import RuledMeshWarning
-    from ..io import WRITERS, _module, load, save
+    from ..io import WRITERS, _module, save
+    from ._common import check_output_file, progress_for, read_source
 
-    source = Path(args.mesh)
-    output = Path(args.output)
-    design = None
-    if source.suffix.lower() == ".toml":
-        from ..design import build_design, load_design
-
-        parsed = load_design(source)
-        mesh = build_design(parsed).mesh
-        design = parsed.data
-    else:
-        mesh = load(source)
+    output = check_output_file(args.output, WRITERS)
+    progress = progress_for(args)
+    source = read_source(args.mesh, progress)
+    mesh = source.mesh
+    design = source.design.data if source.design is not None else None
     if args.input_units:
         mesh = mesh.with_units(args.input_units, convert=False)
     if args.units:
@@ -84,12 +82,12 @@ def run(args) -> int:
     options = {"shading": args.shading, "quads": args.quads, "design": design,
                "origin": _origin(args.origin), "panels": args.panels, "extras": args.extras}
     options = {k: v for k, v in options.items() if k in accepted and v is not None}
-    with warnings.catch_warnings(record=True) as caught:
+    with progress.task(f"write {args.output}"), warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always", RuledMeshWarning)
         save(output, mesh, **options)
     for w in caught:
         print(f"warning: {w.message}", file=sys.stderr)
     if not args.quiet:
-        print(f"wrote {output}: {mesh.n_faces} faces, {mesh.n_vertices} vertices, "
-              f"{len(mesh.members)} members, units {mesh.units}")
+        print(f"wrote {args.output}: {mesh.n_faces} faces ({kind_counts(mesh.count_kinds())}), "
+              f"{mesh.n_vertices} vertices, {len(mesh.members)} members, units {mesh.units}")
     return 0

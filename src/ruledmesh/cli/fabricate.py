@@ -3,7 +3,6 @@
 from __future__ import annotations
 
 import sys
-from pathlib import Path
 
 
 def _size(text: str) -> tuple[float, float]:
@@ -16,6 +15,22 @@ def _size(text: str) -> tuple[float, float]:
     return w, h
 
 
+def _positive(text: str) -> float:
+    import argparse
+    import math
+
+    try:
+        value = float(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f'expected a number, got "{text}"') from None
+    if not (math.isfinite(value) and value > 0):
+        raise argparse.ArgumentTypeError(
+            f"expected a positive factor, got {text}"
+            + (" (a negative factor would mirror the panels; mirror the mesh explicitly "
+               "with a [[transform]] scale in the design instead)" if value < 0 else ""))
+    return value
+
+
 def add_parser(sub) -> None:
     p = sub.add_parser(
         "fabricate",
@@ -24,12 +39,15 @@ def add_parser(sub) -> None:
                     "(SVG, and DXF when ezdxf is installed), and write node/edge/member schedules, "
                     "panel statistics with congruence classes, and 4-axis hot-wire paths (CSV and "
                     "XYUV G-code) along the generators. See docs/fabrication.md.",
-        epilog="examples:\n  ruledmesh fabricate skew.obj -o skew-fab\n"
-               "  ruledmesh fabricate skew.obj -o fab --scale 1000 --unit mm --sheet 2500x1250",
+        epilog="examples:\n"
+               "  ruledmesh fabricate skew.obj -o skew-fab\n"
+               "  ruledmesh fabricate examples/fig5b-torus.toml -o torus-fab --scale 1000 --unit mm "
+               "--sheet 2500x1250\n",
     )
     p.add_argument("mesh", help="mesh file (.obj, .ply, ...) or design file (.toml)")
     p.add_argument("-o", "--output", required=True, help="folder to write into (created if missing)")
-    p.add_argument("--scale", type=float, default=1.0, help="multiply coordinates first (e.g. 1000: m -> mm)")
+    p.add_argument("--scale", type=_positive, default=1.0,
+                   help="multiply coordinates first, a positive factor (e.g. 1000: m -> mm)")
     p.add_argument("--unit", default="", choices=["", "mm", "cm", "m", "in", "ft"],
                    help="unit of the (scaled) coordinates (default: the mesh's own, from the "
                         "design's units key or the file)")
@@ -68,18 +86,19 @@ def add_parser(sub) -> None:
                    help="hot wire: safe rapid height above the cut (default 10 mm / 0.5 in)")
     p.add_argument("--allow-bent", action="store_true",
                    help="project non-planar faces instead of refusing them")
-    p.add_argument("-q", "--quiet", action="store_true", help="print nothing on success")
+    p.add_argument("-q", "--quiet", action="store_true",
+                   help="print nothing on success (no progress, no summary)")
     p.set_defaults(run=run)
 
 
 def run(args) -> int:
-    from ..design import build_file
     from ..fabricate.machine import Machine
     from ..fabricate.output import fabricate
-    from ..io import load
+    from ._common import check_output_folder, progress_for, read_source
 
-    path = Path(args.mesh)
-    mesh = build_file(path).mesh if path.suffix.lower() == ".toml" else load(path)
+    check_output_folder(args.output)
+    progress = progress_for(args)
+    mesh = read_source(args.mesh, progress).mesh
     if args.scale != 1.0:
         mesh = mesh.with_vertices(mesh.vertices * args.scale)
     if args.unit:
@@ -95,7 +114,7 @@ def run(args) -> int:
         dxf=False if args.no_dxf else None,
         hotwire=True if args.span != "auto" else None, span=args.span, up=args.up,
         kerf=args.kerf, kerf_side=args.kerf_side, feed=args.feed,
-        require_planar=not args.allow_bent)
+        require_planar=not args.allow_bent, progress=progress)
     for note in summary["notes"]:
         print(f"warning: {note}", file=sys.stderr)
     if not args.quiet:

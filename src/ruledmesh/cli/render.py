@@ -2,8 +2,6 @@
 
 from __future__ import annotations
 
-from pathlib import Path
-
 
 def _pair(text: str, kind=float) -> tuple:
     import argparse
@@ -24,9 +22,14 @@ def add_parser(sub) -> None:
         description="Render a mesh file (or a design file, built first) with its faces coloured "
                     "by planarity, closeness to the design surface, or face kind, the generators "
                     "drawn as dark lines, and a colour bar. The format follows the extension of -o.",
-        epilog="examples:\n  ruledmesh render skew.obj -o skew.png\n"
+        epilog="examples:\n"
+               "  ruledmesh render skew.obj -o skew.png\n"
                "  ruledmesh render skew.obj --design examples/skew.toml --color closeness -o c.png\n"
-               "  ruledmesh render examples/skew.toml --color kind --view 30,-45 -o k.png",
+               "  ruledmesh render examples/skew.toml --color kind --view 30,-45 -o k.png\n"
+               "  ruledmesh render skew.obj -o big.png --size 3000x2400 --edges off --title Skew\n\n"
+               "Large meshes: face outlines are dropped once faces get smaller than a few "
+               "pixels, and only an evenly spaced subset of the generators is drawn "
+               "(--edges auto, --generators auto); 'on' or 'off' forces either.",
     )
     p.add_argument("mesh", help="mesh file (.obj, .ply, ...) or design file (.toml)")
     p.add_argument("-o", "--output", required=True, help="image to write (.png, .svg, .pdf)")
@@ -37,28 +40,32 @@ def add_parser(sub) -> None:
                    help="camera elevation and azimuth in degrees (default: 25,-60)")
     p.add_argument("--size", type=lambda s: _pair(s, int), default=(1000, 800), metavar="WxH",
                    help="image size in pixels (default: 1000x800)")
-    p.add_argument("--title", help="title above the picture")
-    p.add_argument("--no-generators", action="store_true", help="do not draw the generators")
+    p.add_argument("--title", help="title, drawn at the top of the image")
+    p.add_argument("--edges", choices=["on", "off", "auto"], default="auto",
+                   help="outline the faces (default auto: only while faces are large enough)")
+    p.add_argument("--generators", choices=["on", "off", "auto"], default="auto",
+                   help="draw the generators (default auto: thinned out on dense meshes)")
+    p.add_argument("--no-generators", dest="generators", action="store_const", const="off",
+                   help="same as --generators off")
     p.add_argument("-q", "--quiet", action="store_true", help="print nothing on success")
     p.set_defaults(run=run)
 
 
 def run(args) -> int:
-    from ..design import build_file
-    from ..io import load
-    from ..render import save_render
+    from ..render import FORMATS, save_render
+    from ._common import check_output_file, progress_for, read_design, read_source
 
-    path = Path(args.mesh)
-    reference = None
-    if path.suffix.lower() == ".toml":
-        built = build_file(path)
-        mesh, reference = built.mesh, built.reference
-    else:
-        mesh = load(path)
+    check_output_file(args.output, FORMATS,
+                      optional={ext: ("matplotlib", "plot") for ext in FORMATS})
+    progress = progress_for(args)
+    source = read_source(args.mesh, progress)
+    reference = source.built.reference if source.built is not None else None
     if args.design:
-        reference = build_file(args.design).reference
-    save_render(args.output, mesh, color=args.color, reference=reference, view=args.view,
-                size=args.size, title=args.title, generators=not args.no_generators)
+        reference = read_design(args.design, progress, option="--design")[1].reference
+    with progress.task(f"render {args.output}"):
+        save_render(args.output, source.mesh, color=args.color, reference=reference,
+                    view=args.view, size=args.size, title=args.title, edges=args.edges,
+                    generators=args.generators)
     if not args.quiet:
         print(f"wrote {args.output}")
     return 0

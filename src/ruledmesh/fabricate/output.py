@@ -27,6 +27,7 @@ import numpy as np
 from ..errors import GeometryError
 from ..io import write_atomic
 from ..mesh import Mesh
+from ..progress import SILENT, Progress, stages
 from ..tolerances import DEFAULT, Tolerances
 from . import hotwire as hw
 from . import machine as hm
@@ -92,7 +93,7 @@ def fabricate(mesh: Mesh, folder: str | os.PathLike, *, sheet: tuple[float, floa
               kerf: float = 0.0, kerf_side: str = "left", feed: float = 300.0,
               machine: hm.Machine | None = None, nesting: str = "auto", nest_seconds: int = 4,
               tool: float | None = None, require_planar: bool = True,
-              tol: Tolerances = DEFAULT) -> dict[str, Any]:
+              tol: Tolerances = DEFAULT, progress: Progress | None = None) -> dict[str, Any]:
     """Write the fabrication files of ``mesh`` into ``folder`` (created if missing).
 
     Parameters
@@ -132,6 +133,8 @@ def fabricate(mesh: Mesh, folder: str | os.PathLike, *, sheet: tuple[float, floa
     require_planar : bool
         Refuse bent panels (see :func:`~ruledmesh.fabricate.unroll.unroll`).
     tol : Tolerances
+    progress : Progress, optional
+        Told the stages and each sheet as it is written (see :mod:`ruledmesh.progress`).
 
     Returns
     -------
@@ -147,7 +150,11 @@ def fabricate(mesh: Mesh, folder: str | os.PathLike, *, sheet: tuple[float, floa
         written.append(name)
 
     unit = mesh.units if not unit else unit
+    progress = progress or SILENT
+    # Not a ``with``: the caller closes what an error leaves open (TerminalProgress.close).
+    task = stages(progress, "fabricate", ["unroll", "hot wire", "layout", "labels", "classes"])
     unrolled = unroll(mesh, require_planar=require_planar, tol=tol)
+    task.advance(note="hot wire")
     # Everything that can refuse runs before the first file is written, the quick
     # checks before the nesting search.
     path = program_text = None
@@ -162,32 +169,29 @@ def fabricate(mesh: Mesh, folder: str | os.PathLike, *, sheet: tuple[float, floa
     elif hotwire and not len(mesh.members):
         raise GeometryError("the mesh has no generators (members) to cut along")
 
+    task.advance(note="layout")
     if gap is None and tool is not None:
         gap = tool
     if nesting == "auto" and not _spyrrow_available():
         notes.append("sheets packed by shelves: true-shape nesting needs spyrrow "
                      "(pip install 'ruledmesh[nesting]')")
     lay = layout(unrolled, sheet, gap=gap, units=unit, method=nesting, seconds=nest_seconds)
+    task.advance(note="labels")
     labels = panel_labels(lay, decimals=decimals)
-
+    task.advance(note="classes")
     tolerances = {"length_tol": length_tol if length_tol is not None
                   else 1e-9 * (mesh.diagonal() or 1.0), "angle_tol": angle_tol}
     classes = congruence_classes(mesh, unrolled=unrolled, **tolerances)
     table = panel_table(mesh, unrolled=unrolled, classes=classes)
     table.update({"sheet": lay.sheet + 1, "sheet_x": lay.offset[:, 0], "sheet_y": lay.offset[:, 1],
                   "rotation_deg": np.degrees(lay.rotation)})
+    task.advance()
+    task.close()
     (folder / "sheets").mkdir(parents=True, exist_ok=True)
     dxf = _want_dxf(dxf, notes)
-    for s in range(lay.n_sheets):
-        put(f"sheets/sheet-{s + 1:03d}.svg",
-            sheet_svg(lay, s, labels=labels, unit=unit, decimals=decimals).encode("utf-8"))
-        if dxf:
-            put(f"sheets/sheet-{s + 1:03d}.dxf", sheet_dxf(lay, s, labels=labels, unit=unit))
-
-    put("panels.csv", csv_bytes(table))
-    put("nodes.csv", csv_bytes(node_schedule(mesh)))
-    put("edges.csv", csv_bytes(edge_schedule(mesh)))
-    put("members.csv", csv_bytes(member_schedule(mesh)))
+    _write_sheets(put, lay, labels, unit=unit, decimals=decimals, dxf=bool(dxf),
+                  progress=progress)
+    _write_schedules(put, mesh, table, progress)
 
     wire: dict[str, Any] | None = None
     if path is not None and program_text is not None:
@@ -208,3 +212,28 @@ def fabricate(mesh: Mesh, folder: str | os.PathLike, *, sheet: tuple[float, floa
     }
     put("summary.json", (json.dumps(summary, indent=2) + "\n").encode("utf-8"))
     return summary
+
+
+def _write_sheets(put, lay, labels, *, unit: str, decimals: int, dxf: bool,
+                  progress: Progress) -> None:
+    """One SVG (and DXF) per sheet, reported sheet by sheet."""
+    with progress.task("sheets", total=lay.n_sheets) as sheets:
+        for s in range(lay.n_sheets):
+            put(f"sheets/sheet-{s + 1:03d}.svg",
+                sheet_svg(lay, s, labels=labels, unit=unit, decimals=decimals).encode("utf-8"))
+            if dxf:
+                put(f"sheets/sheet-{s + 1:03d}.dxf", sheet_dxf(lay, s, labels=labels, unit=unit))
+            sheets.advance()
+
+
+def _write_schedules(put, mesh: Mesh, table: dict, progress: Progress) -> None:
+    """The panel, node, edge and member schedules (CSV)."""
+    with stages(progress, "schedules", ["panels", "nodes", "edges", "members"]) as task:
+        put("panels.csv", csv_bytes(table))
+        task.advance(note="nodes")
+        put("nodes.csv", csv_bytes(node_schedule(mesh)))
+        task.advance(note="edges")
+        put("edges.csv", csv_bytes(edge_schedule(mesh)))
+        task.advance(note="members")
+        put("members.csv", csv_bytes(member_schedule(mesh)))
+        task.advance()

@@ -230,6 +230,7 @@ def fast_figures(mesh: Mesh) -> tuple[dict[str, Any], np.ndarray]:
         Per-face planarity (:func:`ruledmesh.analysis.faces.planarity`).
     """
     from ..analysis import faces as F
+    from ..analysis.report import kind_counts
     from ..tolerances import DEFAULT
 
     plan = F.planarity(mesh)
@@ -239,6 +240,8 @@ def fast_figures(mesh: Mesh) -> tuple[dict[str, Any], np.ndarray]:
         "faces": mesh.n_faces,
         "triangles": int(np.count_nonzero(mesh.valences == 3)),
         "kinds": mesh.count_kinds(),
+        # The same words as the command line: "633 quads, 9 border faces, 306 fill triangles".
+        "kinds_text": kind_counts(mesh.count_kinds()),
         "planarity_max": float(plan.max()) if plan.size else 0.0,
         "planarity_tolerance": DEFAULT.planarity,
         "non_convex": int(np.count_nonzero(~convex)),

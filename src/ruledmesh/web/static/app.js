@@ -302,8 +302,7 @@ function setFig(name, text, pending = false) {
 
 function showFigures(fig) {
   setFig('faces', fig.faces);
-  setFig('triangles', fig.triangles);
-  setFig('kinds', Object.entries(fig.kinds).map(([k, c]) => `${c} ${k}`).join(', ') || '-');
+  setFig('kinds', fig.kinds_text || '-');
   setFig('planarity', fmt(fig.planarity_max));
   setFig('non_convex', fig.non_convex);
   for (const k of ['coverage', 'closeness', 'panels']) setFig(k, '...', true);
