@@ -22,6 +22,8 @@ ON_BORDER = 1e-12
 # A vertex nearer a director curve than this share of the step to the next
 # vertex on its generator is taken as the border point of its generator.
 SNAP_STEP = 0.06
+# ... and the border it makes stays this close (share of the diagonal) to the director curve.
+SNAP_GAP = 1e-3
 
 
 def group_starts(keys: np.ndarray) -> np.ndarray:
@@ -29,9 +31,11 @@ def group_starts(keys: np.ndarray) -> np.ndarray:
     return np.r_[True, keys[1:] != keys[:-1]] if keys.size else np.zeros(0, bool)
 
 
-def _near_border(gi: np.ndarray, ti: np.ndarray, m: int, upper: bool) -> np.ndarray:
+def _near_border(gi: np.ndarray, ti: np.ndarray, m: int, rel_len: np.ndarray,
+                 upper: bool) -> np.ndarray:
     """(m,) bool: the generator's vertex nearest a director curve is within ``SNAP_STEP`` of
-    the step to the next vertex along the generator."""
+    the step to the next vertex along the generator, and within ``SNAP_GAP`` of the
+    diagonal (``rel_len``: generator lengths over the diagonal) of the curve."""
     t = 1.0 - ti if upper else ti
     order = np.lexsort((t, gi))
     g, t = gi[order], t[order]
@@ -41,7 +45,7 @@ def _near_border(gi: np.ndarray, ti: np.ndarray, m: int, upper: bool) -> np.ndar
     nxt = idx + 1
     ok = (nxt < len(g)) & (g[np.minimum(nxt, len(g) - 1)] == g[idx])
     idx, nxt = idx[ok], nxt[ok]
-    near = t[idx] < SNAP_STEP * (t[nxt] - t[idx])
+    near = (t[idx] < SNAP_STEP * (t[nxt] - t[idx])) & (t[idx] * rel_len[g[idx]] < SNAP_GAP)
     out[g[idx][near]] = True
     return out
 
@@ -68,8 +72,9 @@ def chains(V, T, G, good_v, a, d, m, scale):
     # vertex on its generator, is the border point of its generator itself: a
     # director point beside it would leave a splinter.  (Parameters along a
     # generator: the decision commutes with affine maps.)
-    has0 |= _near_border(gi, ti, m, upper=False)
-    has1 |= _near_border(gi, ti, m, upper=True)
+    glen = np.linalg.norm(d, axis=1)
+    has0 |= _near_border(gi, ti, m, glen / scale, upper=False)
+    has1 |= _near_border(gi, ti, m, glen / scale, upper=True)
     new0, new1 = np.flatnonzero(~has0), np.flatnonzero(~has1)
     base = len(V)
     V = np.concatenate([V, a[new0], a[new1] + d[new1]])
