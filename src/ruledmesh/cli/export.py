@@ -18,7 +18,7 @@ def add_parser(sub) -> None:
                "  ruledmesh export examples/skew.toml -o skew.json\n"
                "  ruledmesh export skew.obj -o skew.stl --quads best\n"
                "  ruledmesh export skew.obj -o skew.ifc --units mm\n"
-               "  ruledmesh export site.obj -o site.stl --origin auto\n\n"
+               "  ruledmesh export skew.obj -o skew.stl --origin auto\n\n"
                "A .json export of a design file holds the mesh and the design tables.",
     )
     p.add_argument("mesh", help="mesh file (.obj, .ply, .json) or design file (.toml)")

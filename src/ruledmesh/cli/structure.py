@@ -48,7 +48,7 @@ def add_parser(sub) -> None:
                "  ruledmesh structure examples/fig7b-hyperboloid-circular.toml --offset 0.2 -o hyp\n"
                "  ruledmesh structure skew.obj --offset 0.5 --beams edges,generators "
                "--width 0.05 -o skew-frame\n"
-               "  ruledmesh structure mesh.obj --offset -0.3 --thickness 0.02 --render -o out",
+               "  ruledmesh structure skew.obj --offset -0.3 --thickness 0.02 --render -o out",
     )
     p.add_argument("mesh", help="design file (.toml) or mesh file (.obj, .ply, .json)")
     p.add_argument("--offset", type=float, required=True, metavar="D",
