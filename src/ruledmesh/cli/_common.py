@@ -123,8 +123,14 @@ def file_kind(path: Path) -> str | None:
 
 
 def _existing(typed: str, what: str) -> Path:
-    """``typed`` as a readable file, or an error naming it as typed and what to do."""
-    path = Path(typed)
+    """``typed`` as a readable file, or an error naming it as typed and what to do.
+
+    A relative ``examples/NAME.toml`` that does not exist here is the bundled example of
+    that name, as for :func:`ruledmesh.design.load_design`.
+    """
+    from ..bundled import resolve
+
+    path = Path(resolve(typed))
     if path.is_dir():
         raise InputError(f"{typed}: is a folder, not {what}; give the file inside it")
     if not path.exists():
