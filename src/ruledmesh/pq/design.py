@@ -88,6 +88,7 @@ def _refined(rulings, mesh, options: dict):
     grid, _ = _dense_grid(len(rulings.u))
     best = (area_shares(mesh)["quads"], rulings, mesh)
     user = len(rulings.u) - int(rulings.info.get("inserted", 0))
+    start = len(rulings.u)
     for _ in range(_REFINE_ROUNDS):
         cur_rulings, cur_mesh = best[1], best[2]
         u = np.asarray(cur_rulings.u)
@@ -115,9 +116,8 @@ def _refined(rulings, mesh, options: dict):
             break
         best = (share, candidate, cand_mesh)
     rulings, mesh = best[1], best[2]
-    added = len(rulings.u) - user - int(best[1].info.get("crease_generators") is not None
-                                        and len(best[1].info["crease_generators"]) or 0)
-    if mesh is not best[2] or added <= 0:
+    added = len(rulings.u) - start
+    if added <= 0:
         return rulings, mesh
     note = (f"{added} generators of the smooth surface added where the rows needed them "
             f"({len(rulings.u)} in all, {user} given)")

@@ -250,6 +250,66 @@ def pq_mesh(a, b, rows: int = 20, primary: int | str = "middle", option: int = 0
     >>> bool(np.abs(v[:, 0]**2 + v[:, 1]**2 - v[:, 2]**2 - 1).max() < 1e-12)
     True
     """
+    a, b, args = _checked(a, b, rows, primary, option, extend, trim, max_extend,
+                          planarity_tolerance, tol)
+    rows, ptol = args.rows, args.ptol
+    m = len(a)
+    d = b - a
+    scale = _patch_scale(a, b, d, tol)
+    warnings: list[str] = []
+    # Torsal generators cut the generators into segments: where the twist changes
+    # sign the two segments share the generator (hops across it would reverse the
+    # rows); a coplanar pair, or a crease inside a strip, leaves that strip to be
+    # closed by strip quads (planar for a coplanar pair) or triangles (§4.3).
+    flat, change, crease = _torsal_cuts(a, d, scale, tol, creases, m)
+    if ptol > tol.planarity:
+        flat = flat | _nearly_flat(a, d, rows, ptol)
+    torsal = np.flatnonzero(flat | change)
+    kinks = np.flatnonzero(crease & ~(flat | change))
+    if torsal.size:
+        warnings.append(f"{torsal.size} torsal strips (generators {_listed(torsal)}: consecutive "
+                        "generators coplanar, or the twist changes sign): rows restarted there")
+    if kinks.size:
+        warnings.append(f"{kinks.size} crease strips (generators {_listed(kinks)}: a director curve "
+                        "has a corner there): rows restarted, strips filled with triangles")
+    cg = _crease_generators(crease_generators, m)
+    segs = _segments(m, np.union1d(np.flatnonzero(change & ~flat & ~crease), cg),
+                     np.flatnonzero(flat | crease))
+    plan = _Plan(a, d, tol, scale, warnings, frozenset(cg.tolist()))
+    parts = _build_all(plan, segs, args.primary, args.middle,
+                       Division(rows, args.option, args.extend, args.max_extend), m)
+    restarts = len([r for r in parts if len(r.left)]) - len([s for s in segs if s.hi - s.lo >= 2])
+    even = _even_ranges(parts, segs)
+    if even:
+        warnings.append(f"generators {', '.join(even[:8])}{' ...' if len(even) > 8 else ''} carry no "
+                        "§4.3 rows (the rows bunch along the generators there: nearly developable, "
+                        "or next to a torsal generator) and are closed by strip quads or triangles; "
+                        "planarity_tolerance = 1e-3 admits nearly planar strip quads there")
+    meet = np.zeros(m, bool)
+    meet[:-1] |= flat
+    meet[1:] |= flat
+    mesh = assemble(parts, a, d, args.trim, tol, ptol, warnings, scale, meet)
+    _warn_share(mesh, warnings, torsal.size, even, max(restarts, 0), m, rows)
+    return mesh.with_info(runs=len(parts), restarts=max(restarts, 0), planarity_tolerance=ptol)
+
+
+@dataclass(frozen=True)
+class _Args:
+    """The mesher's arguments, checked."""
+
+    rows: int
+    primary: int
+    middle: bool
+    option: int
+    extend: float | str
+    trim: bool
+    max_extend: float
+    ptol: float
+
+
+def _checked(a, b, rows, primary, option, extend, trim, max_extend, planarity_tolerance,
+             tol: Tolerances) -> tuple[np.ndarray, np.ndarray, _Args]:
+    """Validate the arguments of :func:`pq_mesh` (ParameterError naming the parameter)."""
     a = check_points(a, "a", min_count=3)
     b = check_points(b, "b", min_count=3)
     if a.shape != b.shape:
@@ -272,60 +332,33 @@ def pq_mesh(a, b, rows: int = 20, primary: int | str = "middle", option: int = 0
     max_extend = check_float(max_extend, "max_extend", lo=0.0, hi=1e3)
     ptol = tol.planarity if planarity_tolerance is None else check_float(
         planarity_tolerance, "planarity_tolerance", lo=0.0, hi=0.1)
-    ptol = max(ptol, tol.planarity)
     if m * (rows + 1) > MAX_GRID_POINTS:
         need = m * (rows + 1) * BYTES_PER_GRID_POINT / 2**30
         raise GeometryError(f"{m} generators x {rows + 1} rows would need at least "
                             f"{need:.1f} GiB; reduce the generator count or the rows")
-    d = b - a
+    return a, b, _Args(rows, p, middle, option, extend, trim, max_extend, max(ptol, tol.planarity))
+
+
+def _patch_scale(a: np.ndarray, b: np.ndarray, d: np.ndarray, tol: Tolerances) -> float:
+    """Diagonal of the generators' bounding box; refuses zero-length generators."""
     lo, hi = np.minimum(a.min(0), b.min(0)), np.maximum(a.max(0), b.max(0))
     scale = float(np.linalg.norm(hi - lo))
     if scale == 0.0:
         raise GeometryError("all generator end points coincide")
-    glen = np.linalg.norm(d, axis=1)
-    short = np.flatnonzero(glen <= tol.degenerate * scale)
+    short = np.flatnonzero(np.linalg.norm(d, axis=1) <= tol.degenerate * scale)
     if short.size:
         raise GeometryError(f"generator {int(short[0])} has zero length (its end points coincide)"
                             + (f", and {short.size - 1} more" if short.size > 1 else ""))
-    warnings: list[str] = []
-    # Torsal generators cut the generators into segments: where the twist changes
-    # sign the two segments share the generator (hops across it would reverse the
-    # rows); a coplanar pair, or a crease inside a strip, leaves that strip to be
-    # closed by strip quads (planar for a coplanar pair) or triangles (§4.3).
-    flat, change, crease = _torsal_cuts(a, d, scale, tol, creases, m)
-    if ptol > tol.planarity:
-        flat = flat | _nearly_flat(a, d, rows, ptol)
-    torsal = np.flatnonzero(flat | change)
-    kinks = np.flatnonzero(crease & ~(flat | change))
-    if torsal.size:
-        warnings.append(f"{torsal.size} torsal strips (generators {_listed(torsal)}: consecutive "
-                        "generators coplanar, or the twist changes sign): rows restarted there")
-    if kinks.size:
-        warnings.append(f"{kinks.size} crease strips (generators {_listed(kinks)}: a director curve "
-                        "has a corner there): rows restarted, strips filled with triangles")
+    return scale
+
+
+def _crease_generators(crease_generators, m: int) -> np.ndarray:
     cg = np.zeros(0, np.int64) if crease_generators is None else \
         np.asarray(crease_generators, dtype=np.int64).reshape(-1)
     if cg.size and (cg.min() < 1 or cg.max() > m - 2):
         raise ParameterError(f"expected generator indices in [1, {m - 2}], got {cg.tolist()}",
                              "crease_generators")
-    segs = _segments(m, np.union1d(np.flatnonzero(change & ~flat & ~crease), cg),
-                     np.flatnonzero(flat | crease))
-    plan = _Plan(a, d, tol, scale, warnings, frozenset(cg.tolist()))
-    parts = _build_all(plan, segs, p, middle,
-                       Division(rows, option, extend, max_extend), m)
-    restarts = len([r for r in parts if len(r.left)]) - len([s for s in segs if s.hi - s.lo >= 2])
-    even = _even_ranges(parts, segs)
-    if even:
-        warnings.append(f"generators {', '.join(even[:8])}{' ...' if len(even) > 8 else ''} carry no "
-                        "§4.3 rows (the rows bunch along the generators there: nearly developable, "
-                        "or next to a torsal generator) and are closed by strip quads or triangles; "
-                        "planarity_tolerance = 1e-3 admits nearly planar strip quads there")
-    meet = np.zeros(m, bool)
-    meet[:-1] |= flat
-    meet[1:] |= flat
-    mesh = assemble(parts, a, d, trim, tol, ptol, warnings, scale, meet)
-    _warn_share(mesh, warnings, torsal.size, even, max(restarts, 0), m, rows)
-    return mesh.with_info(runs=len(parts), restarts=max(restarts, 0), planarity_tolerance=ptol)
+    return cg
 
 
 def _even_ranges(parts: list[Run], segs: list[_Segment]) -> list[str]:

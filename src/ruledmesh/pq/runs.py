@@ -119,7 +119,7 @@ def _uniform_rows(M: np.ndarray, div: Division, primary_global: int, tol: Tolera
     return (j0 + np.arange(count)) / rows
 
 
-def _matched_rows(M: np.ndarray, div: Division, primary: int, tol: Tolerances) -> np.ndarray:
+def _matched_rows(M: np.ndarray, div: Division, tol: Tolerances) -> np.ndarray:
     """Root parameters from a matched division, extended by the end spacings."""
     given = np.asarray(div.matched, dtype=np.float64)
     lo, hi, bounded = patch_preimage(M, tol.degenerate)
@@ -218,7 +218,7 @@ def mesh_run(a: np.ndarray, d: np.ndarray, first: int, primary: int, div: Divisi
     primary = maps.primary
     M = compose(maps, m)
     if div.matched is not None and len(div.matched):
-        tau = _matched_rows(M, div, primary, tol)
+        tau = _matched_rows(M, div, tol)
     else:
         tau = _uniform_rows(M, div, first + primary, tol, warnings)
     H = len(tau) // 2

@@ -106,8 +106,7 @@ class Gaps:
     """Stretches of strips that no PQ half-face covers, to be closed.
 
     Gap ``g`` runs in strip ``strip[g]`` from rank ``k0`` on the lower
-    generator and ``l0`` on the upper one, ``na`` and ``nb`` steps along them;
-    ``whole`` marks gaps that are an entire strip.
+    generator and ``l0`` on the upper one, ``na`` and ``nb`` steps along them.
     """
 
     strip: np.ndarray
@@ -115,7 +114,6 @@ class Gaps:
     l0: np.ndarray
     na: np.ndarray
     nb: np.ndarray
-    whole: np.ndarray
 
 
 def strip_paths(T, chain, gstart, m, L, R, ok_l, ok_r, CG):
@@ -202,8 +200,7 @@ def strip_paths(T, chain, gstart, m, L, R, ok_l, ok_r, CG):
     g_l1 = np.concatenate([st_l[fst], st_l[btw], clen[st_strip[lst] + 1] - 1, clen[empty + 1] - 1])
     na = np.maximum(g_k1 - g_k0, 0)
     nb = np.maximum(g_l1 - g_l0, 0)
-    whole = np.concatenate([np.zeros(len(fst) + len(btw) + len(lst), bool), np.ones(len(empty), bool)])
-    return keep_l, keep_r, Gaps(g_strip, g_k0, g_l0, na, nb, whole), jump_l, jump_r
+    return keep_l, keep_r, Gaps(g_strip, g_k0, g_l0, na, nb), jump_l, jump_r
 
 
 def zippers(T, chain, gstart, strip, k0, l0, na, nb) -> np.ndarray:
