@@ -264,14 +264,7 @@ def pq_mesh(a, b, rows: int = 20, primary: int | str = "middle", option: int = 0
     flat, change, crease = _torsal_cuts(a, d, scale, tol, creases, m)
     if ptol > tol.planarity:
         flat = flat | _nearly_flat(a, d, rows, ptol)
-    torsal = np.flatnonzero(flat | change)
-    kinks = np.flatnonzero(crease & ~(flat | change))
-    if torsal.size:
-        warnings.append(f"{torsal.size} torsal strips (generators {_listed(torsal)}: consecutive "
-                        "generators coplanar, or the twist changes sign): rows restarted there")
-    if kinks.size:
-        warnings.append(f"{kinks.size} crease strips (generators {_listed(kinks)}: a director curve "
-                        "has a corner there): rows restarted, strips filled with triangles")
+    torsal = _say_cuts(flat, change, crease, warnings)
     cg = _crease_generators(crease_generators, m)
     segs = _segments(m, np.union1d(np.flatnonzero(change & ~flat & ~crease), cg),
                      np.flatnonzero(flat | crease))
@@ -279,12 +272,7 @@ def pq_mesh(a, b, rows: int = 20, primary: int | str = "middle", option: int = 0
     parts = _build_all(plan, segs, args.primary, args.middle,
                        Division(rows, args.option, args.extend, args.max_extend), m)
     restarts = len([r for r in parts if len(r.left)]) - len([s for s in segs if s.hi - s.lo >= 2])
-    even = _even_ranges(parts, segs)
-    if even:
-        warnings.append(f"generators {', '.join(even[:8])}{' ...' if len(even) > 8 else ''} carry no "
-                        "§4.3 rows (the rows bunch along the generators there: nearly developable, "
-                        "or next to a torsal generator) and are closed by strip quads or triangles; "
-                        "planarity_tolerance = 1e-3 admits nearly planar strip quads there")
+    even = _even_ranges(parts, segs, warnings)
     meet = np.zeros(m, bool)
     meet[:-1] |= flat
     meet[1:] |= flat
@@ -361,7 +349,21 @@ def _crease_generators(crease_generators, m: int) -> np.ndarray:
     return cg
 
 
-def _even_ranges(parts: list[Run], segs: list[_Segment]) -> list[str]:
+def _say_cuts(flat: np.ndarray, change: np.ndarray, crease: np.ndarray,
+              warnings: list[str]) -> np.ndarray:
+    """Warn of torsal and crease strips; the torsal ones."""
+    torsal = np.flatnonzero(flat | change)
+    kinks = np.flatnonzero(crease & ~(flat | change))
+    if torsal.size:
+        warnings.append(f"{torsal.size} torsal strips (generators {_listed(torsal)}: consecutive "
+                        "generators coplanar, or the twist changes sign): rows restarted there")
+    if kinks.size:
+        warnings.append(f"{kinks.size} crease strips (generators {_listed(kinks)}: a director curve "
+                        "has a corner there): rows restarted, strips filled with triangles")
+    return torsal
+
+
+def _even_ranges(parts: list[Run], segs: list[_Segment], warnings: list[str]) -> list[str]:
     """Generator ranges that carry an even division without hops (not the short segments)."""
     short = {(s.lo, s.hi) for s in segs if s.hi - s.lo < 2}
     out = []
@@ -370,6 +372,11 @@ def _even_ranges(parts: list[Run], segs: list[_Segment]) -> list[str]:
             lo, hi = int(r.gen.min()), int(r.gen.max())
             if (lo, hi) not in short:
                 out.append(f"{lo}-{hi}" if hi > lo else f"{lo}")
+    if out:
+        warnings.append(f"generators {', '.join(out[:8])}{' ...' if len(out) > 8 else ''} carry no "
+                        "§4.3 rows (the rows bunch along the generators there: nearly developable, "
+                        "or next to a torsal generator) and are closed by strip quads or triangles; "
+                        "planarity_tolerance = 1e-3 admits nearly planar strip quads there")
     return out
 
 
