@@ -79,6 +79,23 @@ def _worker_main(conn) -> None:  # pragma: no cover - runs in the child process
                 return
 
 
+def spawn_worker(ctx: Any, target: Any, name: str) -> tuple[Any, Any]:
+    """Start ``target(conn)`` in a daemon process; its process and the parent's end of the pipe."""
+    parent, child = ctx.Pipe()
+    proc = ctx.Process(target=target, args=(child,), daemon=True, name=name)
+    proc.start()
+    child.close()
+    return proc, parent
+
+
+def stop_worker(proc: Any, conn: Any) -> None:
+    """Kill a worker process (if any) and close its pipe."""
+    if proc is not None:
+        proc.kill()
+        proc.join(timeout=5)
+        conn.close()
+
+
 class InProcessBuilder:
     """Builds in the calling thread (no time limit): a :class:`Session` used as a library.
 
@@ -131,11 +148,7 @@ class BuildWorker(InProcessBuilder):
 
     # ---------------------------------------------------------------- process
     def _start(self) -> None:
-        parent, child = self._ctx.Pipe()
-        proc = self._ctx.Process(target=_worker_main, args=(child,), daemon=True,
-                                 name="ruledmesh-build")
-        proc.start()
-        child.close()
+        proc, parent = spawn_worker(self._ctx, _worker_main, "ruledmesh-build")
         self._proc, self._conn = proc, parent
         # Importing numpy and scipy takes a second or more on a busy machine: not build time.
         try:
@@ -150,10 +163,7 @@ class BuildWorker(InProcessBuilder):
             raise RuledMeshError("the build process did not start") from None
 
     def _stop(self) -> None:
-        if self._proc is not None:
-            self._proc.kill()
-            self._proc.join(timeout=5)
-            self._conn.close()
+        stop_worker(self._proc, self._conn)
         self._proc = self._conn = None
 
     def start(self) -> None:

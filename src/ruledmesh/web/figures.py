@@ -19,6 +19,8 @@ from typing import Any
 
 import numpy as np
 
+from .builder import spawn_worker, stop_worker
+
 __all__ = ["FigureWorker"]
 
 
@@ -70,18 +72,10 @@ class FigureWorker:
 
     # ---------------------------------------------------------------- child
     def _start(self) -> None:
-        parent, child = self._ctx.Pipe()
-        proc = self._ctx.Process(target=_worker_main, args=(child,), daemon=True,
-                                 name="ruledmesh-figures")
-        proc.start()
-        child.close()
-        self._proc, self._conn = proc, parent
+        self._proc, self._conn = spawn_worker(self._ctx, _worker_main, "ruledmesh-figures")
 
     def _stop(self) -> None:
-        if self._proc is not None:
-            self._proc.kill()
-            self._proc.join(timeout=5)
-            self._conn.close()
+        stop_worker(self._proc, self._conn)
         self._proc = self._conn = None
 
     def _run(self) -> None:
