@@ -86,6 +86,25 @@ def _floor(x: float) -> float:
     return max(float(x), 1e-17)
 
 
+SPLINTER_DEG = 3.0
+
+
+def _quad_angles(P: np.ndarray) -> np.ndarray:
+    """(F,) smallest interior angle, degrees, of quads ``P`` (F, 4, 3)."""
+    u = np.roll(P, 1, axis=1) - P
+    w = np.roll(P, -1, axis=1) - P
+    cos = np.einsum("fkc,fkc->fk", u, w) / np.maximum(
+        np.linalg.norm(u, axis=2) * np.linalg.norm(w, axis=2), 1e-300)
+    return np.degrees(np.arccos(np.clip(cos, -1.0, 1.0))).min(axis=1)
+
+
+def _shape(quad_share: float, min_angles: np.ndarray) -> dict:
+    """What a fabricator reads beside planarity: area share in quads, smallest angle, splinters."""
+    return {"quad_area_share": float(quad_share),
+            "min_angle_deg": float(min_angles.min()) if min_angles.size else 0.0,
+            "splinters": int(np.count_nonzero(min_angles < SPLINTER_DEG))}
+
+
 def _row(name, tool, config, surface, size, faces, plan, disp_max, disp_mean, seconds,
          start_planarity, **extra) -> dict:
     pmax = float(plan.max()) if plan.size else 0.0
@@ -101,7 +120,7 @@ def _row(name, tool, config, surface, size, faces, plan, disp_max, disp_mean, se
 
 def measure_ruledmesh(surface, n: int) -> dict:
     """pq_mesh of n generators x n rows: median build time and its figures."""
-    from ruledmesh.analysis.faces import planarity
+    from ruledmesh.analysis.faces import area_shares, face_min_angles, planarity
     from ruledmesh.pq import pq_mesh
 
     a, b = surface.generators(n)
@@ -118,6 +137,7 @@ def measure_ruledmesh(surface, n: int) -> dict:
     return _row("ruledmesh", "ruledmesh", "pq_mesh(rows=n, trim=True)", surface.name, n,
                 mesh.n_faces, plan, dist.max(), dist.mean(), sec, start,
                 vertices=mesh.n_vertices, kinds=mesh.count_kinds(), repeats=len(times),
+                **_shape(area_shares(mesh)["quads"], face_min_angles(mesh)),
                 warnings=list(mesh.info.get("warnings", [])))
 
 
@@ -149,18 +169,22 @@ def measure_peer(peer, surface, n: int, timeout: float) -> tuple[dict | None, di
     start = quad_planarity(V[F]).max()
     return _row(peer.name, peer.tool, peer.config, surface.name, n, len(F), plan, dist.max(),
                 dist.mean(), res["seconds"], start, vertices=len(W), call=peer.call,
+                # The peers keep the grid's quads (all of the area), bent to near planarity.
+                **_shape(1.0, _quad_angles(W[F])),
                 moved_max=float(np.linalg.norm(W - V, axis=1).max() / surface.diagonal)), None
 
 
 # ---------------------------------------------------------------------- output
 def format_table(methods: list[dict]) -> str:
     head = (f"{'method':22s} {'surface':22s} {'size':>5s} {'faces':>8s} {'plan max':>9s} "
-            f"{'plan mean':>9s} {'disp max':>9s} {'seconds':>9s} {'digits/s':>9s}")
+            f"{'plan mean':>9s} {'disp max':>9s} {'quads':>6s} {'min ang':>7s} {'seconds':>9s} "
+            f"{'digits/s':>9s}")
     lines = [head, "-" * len(head)]
     for r in methods:
         lines.append(f"{r['name']:22s} {r['surface']:22s} {r['size']:5d} {r['faces']:8d} "
                      f"{r['planarity_max']:9.2e} {r['planarity_mean']:9.2e} "
-                     f"{r['displacement_max']:9.2e} {r['seconds']:9.3g} "
+                     f"{r['displacement_max']:9.2e} {r.get('quad_area_share', 1.0):6.1%} "
+                     f"{r.get('min_angle_deg', float('nan')):7.2f} {r['seconds']:9.3g} "
                      f"{r['planarity_digits_per_second']:9.3g}")
     return "\n".join(lines)
 

@@ -193,3 +193,53 @@ def test_pluecker_conoid_closeness_finds_the_right_sheet():
     built = build_design(parse_design(text))
     report = analyze(built.mesh, built.reference)
     assert report["closeness"]["vertices_max"] <= 1e-10
+
+
+def _triangulated_grid(n, bend=0.0):
+    """An n x n grid of squares, each cut into two triangles; ``bend`` lifts alternate rows."""
+    from ruledmesh.mesh import Mesh
+
+    i, j = np.meshgrid(np.arange(n + 1), np.arange(n + 1), indexing="ij")
+    V = np.c_[i.ravel(), j.ravel(), bend * (j.ravel() % 2) * (i.ravel() % 2)].astype(float)
+    k = (i[:-1, :-1] * (n + 1) + j[:-1, :-1]).ravel()
+    tris = np.concatenate([np.c_[k, k + n + 1, k + n + 2], np.c_[k, k + n + 2, k + 1]])
+    off = np.arange(len(tris) + 1) * 3
+    return Mesh(V, off, tris.ravel(), np.full(len(tris), FaceKind.FILL, np.uint8),
+                vertex_data={"generator": (V[:, 0]).astype(np.int64), "t": V[:, 1] / n})
+
+
+def test_pairing_makes_quads_of_coplanar_triangle_pairs():
+    from ruledmesh.analysis.faces import face_areas
+    from ruledmesh.pq.pairing import pair_triangles
+
+    mesh = _triangulated_grid(6)
+    paired, made = pair_triangles(mesh, 1e-3)
+    assert made == 36 and paired.n_faces == 36 and np.all(paired.valences == 4)
+    assert np.isclose(face_areas(paired).sum(), face_areas(mesh).sum())
+    assert convexity(paired).all() and planarity(paired).max() <= 1e-12
+    # The squares' corners lie on two generators each: strip quads.
+    assert np.all(paired.face_kind == FaceKind.STRIP)
+    # Orientation is kept: every normal still points up.
+    from ruledmesh.analysis.faces import face_normals
+    assert np.all(face_normals(paired)[0][:, 2] > 0)
+
+
+def test_pairing_refuses_quads_beyond_the_tolerance():
+    from ruledmesh.pq.pairing import pair_triangles
+
+    mesh = _triangulated_grid(4, bend=0.05)
+    loose, n_loose = pair_triangles(mesh, 0.1)
+    tight, n_tight = pair_triangles(mesh, 1e-4)
+    assert n_loose > n_tight
+    assert planarity(tight).max() <= 1e-4 and planarity(loose).max() <= 0.1
+
+
+def test_tolerance_mode_pairs_triangles_on_a_general_surface():
+    """Tolerance mode takes triangle pairs planar within the tolerance: fewer triangles than
+    exact mode, and every face within it."""
+    text = (EXAMPLES.parent / "benchmarks" / "quality" / "skew-bspline-51x30.toml").read_text()
+    exact = build_design(parse_design(text)).mesh
+    loose = build_design(parse_design(text.replace("[mesh]", "[mesh]\nplanarity_tolerance = 1e-3", 1))).mesh
+    assert loose.info["paired"] > 0
+    assert planarity(loose).max() <= 1e-3 and convexity(loose).all()
+    assert area_shares(loose)["triangles"] < area_shares(exact)["triangles"] - 0.03

@@ -12,6 +12,7 @@ from ..hop import coplanarity
 from ..mesh import Mesh
 from ..tolerances import DEFAULT, Tolerances
 from .assemble import assemble
+from .pairing import pair_triangles
 from .runs import (
     BYTES_PER_GRID_POINT,
     MAX_GRID_POINTS,
@@ -33,6 +34,8 @@ _MIN_RUN = 4
 _HOPELESS_SHARE = 0.3
 # A build with more than this share of its area outside quads says why.
 _WARN_SHARE = 0.3
+# Tolerance mode pairs triangles into quads planar within this share of the stated tolerance.
+_PAIRING_MARGIN = 0.9
 
 
 @dataclass(frozen=True)
@@ -277,8 +280,14 @@ def pq_mesh(a, b, rows: int = 20, primary: int | str = "middle", option: int = 0
     meet[:-1] |= flat
     meet[1:] |= flat
     mesh = assemble(parts, a, d, args.trim, tol, ptol, warnings, scale, meet)
+    paired = 0
+    if ptol > tol.planarity:
+        # A margin below the stated tolerance, so that rounding in another
+        # reader's measure cannot push a paired quad over it.
+        mesh, paired = pair_triangles(mesh, _PAIRING_MARGIN * ptol)
     _warn_share(mesh, warnings, torsal.size, even, max(restarts, 0), m, rows)
-    return mesh.with_info(runs=len(parts), restarts=max(restarts, 0), planarity_tolerance=ptol)
+    return mesh.with_info(runs=len(parts), restarts=max(restarts, 0), planarity_tolerance=ptol,
+                          paired=paired)
 
 
 @dataclass(frozen=True)

@@ -1,0 +1,153 @@
+"""Tolerance mode: pairs of triangles that make a quad planar within the tolerance.
+
+Exact quads of §4.3 need a line meeting three consecutive generators; where the
+rows cannot supply one (torsal bands, nearly developable stretches, the border
+band between the last row and a director curve) the mesher leaves triangles.
+With ``[mesh] planarity_tolerance`` the user accepts panels planar within a
+stated relative tolerance, so two triangles sharing an edge become one quad
+when that quad is planar within it (the paper's measure: distance between the
+diagonal lines over the mean diagonal), convex with its diagonals crossing well
+inside both, and no thinner than the thinner of the two triangles.
+
+Pairs are chosen by rounds of mutual best choice (each triangle names its best
+partner; pairs that name each other are taken), which is greedy matching in
+whole-array steps: no loop over faces.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from ..mesh import FaceKind, Mesh
+
+__all__ = ["pair_triangles"]
+
+# A paired quad's diagonals must cross at least this share of each diagonal from its ends.
+_MIN_CROSSING = 0.05
+_ROUNDS = 6
+
+
+def _angles(P: np.ndarray) -> np.ndarray:
+    """(F, k) interior angles, degrees, of polygons ``P`` (F, k, 3)."""
+    u = np.roll(P, 1, axis=1) - P
+    w = np.roll(P, -1, axis=1) - P
+    nu = np.linalg.norm(u, axis=2)
+    nw = np.linalg.norm(w, axis=2)
+    cos = np.einsum("fkc,fkc->fk", u, w) / np.maximum(nu * nw, 1e-300)
+    return np.degrees(np.arccos(np.clip(cos, -1.0, 1.0)))
+
+
+def _candidates(V: np.ndarray, tri: np.ndarray):
+    """Every pair of triangles sharing an edge, as quads (t1, t2, corners)."""
+    e_from = tri.reshape(-1)
+    e_to = np.roll(tri, -1, axis=1).reshape(-1)
+    lo, hi = np.minimum(e_from, e_to), np.maximum(e_from, e_to)
+    key = lo * (int(V.shape[0]) + 1) + hi
+    order = np.argsort(key, kind="stable")
+    ks = key[order]
+    pair = np.flatnonzero(ks[1:] == ks[:-1])
+    # An edge used by more than two triangles is not a manifold edge: never merge across it.
+    single = np.ones(len(pair), bool)
+    if len(pair) > 1:
+        single &= np.r_[True, pair[1:] != pair[:-1] + 1] & np.r_[pair[:-1] + 1 != pair[1:], True]
+    pair = pair[single]
+    s1, s2 = order[pair], order[pair + 1]
+    t1, j1 = s1 // 3, s1 % 3
+    t2, j2 = s2 // 3, s2 % 3
+    ok = (t1 != t2) & (e_from[s1] == e_to[s2])      # opposite orientation: consistent sides
+    t1, j1, t2, j2 = t1[ok], j1[ok], t2[ok], j2[ok]
+    a = tri[t1, (j1 + 2) % 3]
+    b = tri[t1, j1]
+    c = tri[t1, (j1 + 1) % 3]
+    d = tri[t2, (j2 + 2) % 3]
+    return t1, t2, np.stack([a, b, d, c], axis=1)
+
+
+def pair_triangles(mesh: Mesh, ptol: float, kinds: tuple[int, ...] | None = None) -> tuple[Mesh, int]:
+    """Merge pairs of triangles into quads planar within ``ptol``.
+
+    Parameters
+    ----------
+    mesh : Mesh
+    ptol : float
+        Relative planarity tolerance (distance between the diagonal lines over
+        the mean diagonal length).
+    kinds : tuple of int, optional
+        Face kinds whose triangles may be paired (default: fill, border and
+        split halves).
+
+    Returns
+    -------
+    Mesh
+        The same vertices and members; paired triangles replaced by quads of
+        kind :attr:`FaceKind.STRIP` when all four corners lie on two generators,
+        else :attr:`FaceKind.QUAD`.
+    int
+        Number of quads made.
+    """
+    from ..analysis.faces import quad_diagonal_crossing, quad_planarity
+
+    if kinds is None:
+        kinds = (FaceKind.FILL, FaceKind.BORDER, FaceKind.SPLIT)
+    val = mesh.valences
+    ids = np.flatnonzero((val == 3) & np.isin(mesh.face_kind, np.asarray(kinds, np.uint8)))
+    if ids.size < 2 or ptol <= 0:
+        return mesh, 0
+    V = mesh.vertices
+    tri = mesh.face_indices[mesh.face_offsets[ids][:, None] + np.arange(3)]
+    t1, t2, quad = _candidates(V, tri)
+    if t1.size == 0:
+        return mesh, 0
+    P = V[quad]
+    sq, tq, _ = quad_diagonal_crossing(P)
+    ang = _angles(P).min(axis=1)
+    tri_min = _angles(V[tri]).min(axis=1)
+    ok = (quad_planarity(P) <= ptol) & (sq > _MIN_CROSSING) & (sq < 1 - _MIN_CROSSING) \
+        & (tq > _MIN_CROSSING) & (tq < 1 - _MIN_CROSSING) \
+        & (ang >= np.minimum(tri_min[t1], tri_min[t2]))
+    t1, t2, quad, score = t1[ok], t2[ok], quad[ok], ang[ok]
+    taken = np.zeros(len(tri), bool)
+    chosen = np.zeros(len(t1), bool)
+    for _ in range(_ROUNDS):
+        live = ~taken[t1] & ~taken[t2] & ~chosen
+        if not live.any():
+            break
+        best = np.full(len(tri), -1.0)
+        np.maximum.at(best, t1[live], score[live])
+        np.maximum.at(best, t2[live], score[live])
+        # Ties: the first candidate of each triangle wins, so both ends agree.
+        top = live & (score >= best[t1]) & (score >= best[t2])
+        first_of = np.full(len(tri), len(t1))
+        cand = np.flatnonzero(top)
+        np.minimum.at(first_of, t1[cand], cand)
+        np.minimum.at(first_of, t2[cand], cand)
+        mutual = cand[(first_of[t1[cand]] == cand) & (first_of[t2[cand]] == cand)]
+        if mutual.size == 0:
+            break
+        chosen[mutual] = True
+        taken[t1[mutual]] = True
+        taken[t2[mutual]] = True
+    made = np.flatnonzero(chosen)
+    if made.size == 0:
+        return mesh, 0
+    g = np.sort(np.asarray(mesh.vertex_data["generator"])[quad[made]], axis=1)
+    on_two = (g[:, 1:] != g[:, :-1]).sum(axis=1) <= 1
+    keep = np.ones(mesh.n_faces, bool)
+    keep[ids[taken]] = False
+    return _rebuilt(mesh, keep, quad[made], np.where(on_two, FaceKind.STRIP, FaceKind.QUAD)), int(made.size)
+
+
+def _rebuilt(mesh: Mesh, keep: np.ndarray, quads: np.ndarray, quad_kind: np.ndarray) -> Mesh:
+    """``mesh`` with the faces not kept dropped and ``quads`` added (vertices unchanged)."""
+    val = mesh.valences
+    kept = np.flatnonzero(keep)
+    starts = mesh.face_offsets[kept]
+    n = val[kept]
+    flat = np.repeat(starts, n) + (np.arange(n.sum()) - np.repeat(np.cumsum(n) - n, n))
+    idx = np.concatenate([mesh.face_indices[flat], quads.reshape(-1)]).astype(np.int64)
+    counts = np.concatenate([n, np.full(len(quads), 4)])
+    off = np.zeros(len(counts) + 1, np.int64)
+    np.cumsum(counts, out=off[1:])
+    kind = np.concatenate([mesh.face_kind[kept], quad_kind.astype(np.uint8)])
+    return Mesh(mesh.vertices, off, idx, kind, mesh.members, mesh.member_id, mesh.vertex_data,
+                mesh.info)
