@@ -99,12 +99,33 @@ def test_members_are_generator_segments():
     np.testing.assert_allclose(per_gen, np.linalg.norm(d, axis=1), rtol=1e-12)
 
 
-def test_affine_maps_commute_with_the_construction():
+def _quads(mesh):
+    """Corner coordinates of the §4.3 quads (kind QUAD), in a canonical order."""
+    ids = np.flatnonzero(mesh.face_kind == FaceKind.QUAD)
+    return mesh.vertices[mesh.face_indices[mesh.face_offsets[ids][:, None] + np.arange(4)]]
+
+
+def test_affine_maps_commute_with_the_checkerboard():
+    """The §4.3 construction is affine: the quads map to the quads.  (The fill between them is
+    shaped by angles and lengths, which affine maps do not keep; similarities below.)"""
     rng = np.random.default_rng(3)
     A, B = hyperboloid_lines(1.2, 0.8, 0.3, 2.5, 17)
     M = rng.normal(size=(3, 3)) + 3 * np.eye(3)
     t = rng.normal(size=3)
     f = lambda p: p @ M.T + t
+    direct = pq_mesh(A, B, rows=10)
+    mapped = pq_mesh(f(A), f(B), rows=10)
+    qd, qm = _quads(direct), _quads(mapped)
+    assert len(qd) == len(qm) > 0
+    np.testing.assert_allclose(qm, f(qd), atol=1e-11 * mapped.diagonal())
+
+
+def test_similarities_commute_with_the_whole_mesh():
+    rng = np.random.default_rng(4)
+    A, B = hyperboloid_lines(1.2, 0.8, 0.3, 2.5, 17)
+    Q, _ = np.linalg.qr(rng.normal(size=(3, 3)))
+    t = rng.normal(size=3) * 100
+    f = lambda p: 7.5 * p @ Q.T + t
     direct = pq_mesh(A, B, rows=10)
     mapped = pq_mesh(f(A), f(B), rows=10)
     assert mapped.n_faces == direct.n_faces

@@ -62,7 +62,6 @@ SHORT_OF_ANGLE = {
     "fig10-skew-surface": "smallest angle 0.0364 deg, 27 faces below 3 deg",
     "millimetre-scale": "smallest angle 0.0487 deg, 115 faces below 3 deg",
     "moebius-lines": "smallest angle 1.76 deg, 5 faces below 3 deg",
-    "near-cylinder-twist": "smallest angle 0.182 deg, 95 faces below 3 deg",
     "plucker-conoid": "smallest angle 0.123 deg, 102 faces below 3 deg",
     "plucker-lines": "smallest angle 0.00846 deg, 1101 faces below 3 deg",
     "plucker-lines-tol1e-3": "smallest angle 0.00846 deg, 789 faces below 3 deg",

@@ -15,6 +15,7 @@ import numpy as np
 from ..mesh import FaceKind, Mesh
 from ..tolerances import Tolerances
 from .runs import Run
+from .ladders import free_edges, ladder_points
 from .strips import ON_BORDER, Gaps, chains, strip_paths, zippers
 
 __all__ = ["assemble", "to_mesh"]
@@ -99,8 +100,14 @@ def _substitute_border(V, T, FAR, L, R, CG, good_v, bottom, top):
     return L, R, below | above
 
 
-def _close_gaps(V, T, chain, gstart, gaps: Gaps, ptol: float):
-    """Strip quads where a gap is planar within ``ptol`` and evenly matched; zippers elsewhere."""
+def _strip_quads(V, chain, gstart, gaps: Gaps, ptol: float):
+    """Gaps planar within ``ptol`` and evenly matched, and their strip quads.
+
+    Returns
+    -------
+    use : (n_gaps,) bool
+    quads : (q, 4) int64
+    """
     from ..analysis.faces import quad_diagonal_crossing, quad_planarity
 
     even = (gaps.na == gaps.nb) & (gaps.na > 0)
@@ -121,9 +128,31 @@ def _close_gaps(V, T, chain, gstart, gaps: Gaps, ptol: float):
     use = np.zeros(len(gaps.strip), bool)
     use[ge[bad == 0]] = True
     strip_quads = quads[np.repeat(bad == 0, n)] if len(quads) else np.zeros((0, 4), np.int64)
+    return use, strip_quads
+
+
+def _close_gaps(V, T, chain, gstart, gaps: Gaps, ptol: float):
+    """Strip quads where a gap is planar within ``ptol`` and evenly matched; zippers elsewhere."""
+    use, strip_quads = _strip_quads(V, chain, gstart, gaps, ptol)
     z = ~use
-    fill = zippers(T, chain, gstart, gaps.strip[z], gaps.k0[z], gaps.l0[z], gaps.na[z], gaps.nb[z])
+    fill = zippers(V, T, chain, gstart, gaps.strip[z], gaps.k0[z], gaps.l0[z], gaps.na[z],
+                   gaps.nb[z])
     return fill, strip_quads
+
+
+def _with_ladders(V, T, G, FAR, good_v, chain, gstart, gaps: Gaps, a, d, ptol: float, rows: int):
+    """Points on the long generator edges that only fill triangles use (see :mod:`.ladders`).
+
+    Gaps that strip quads close keep their divisions (a ladder would unmatch them).
+    """
+    use, _ = _strip_quads(V, chain, gstart, gaps, ptol)
+    open_gaps = Gaps(*(x[~use] for x in (gaps.strip, gaps.k0, gaps.l0, gaps.na, gaps.nb)))
+    free = free_edges(open_gaps, gstart, len(a))
+    n0 = len(V)
+    V, T, G, chain, gstart, added = ladder_points(V, T, G, chain, gstart, free, a, d, rows)
+    FAR = np.r_[FAR, np.zeros(len(V) - n0, bool)]
+    good_v = np.r_[good_v, np.ones(len(V) - n0, bool)]
+    return V, T, G, FAR, good_v, chain, gstart, added
 
 
 def _notch_fans(chain, gstart, L, R, sel_l, sel_r, CG, jump_l, jump_r) -> np.ndarray:
@@ -152,7 +181,8 @@ def _notch_fans(chain, gstart, L, R, sel_l, sel_r, CG, jump_l, jump_r) -> np.nda
 
 
 def assemble(parts: list[Run], a, d, trim: bool, tol: Tolerances, ptol: float,
-             warnings: list[str], scale: float, meet: np.ndarray | None = None) -> Mesh:
+             warnings: list[str], scale: float, meet: np.ndarray | None = None,
+             rows: int = 20) -> Mesh:
     """Join the runs; keep convex quads and valid halves; close the strips; add members."""
     from ..analysis.faces import quad_diagonal_crossing
 
@@ -179,6 +209,11 @@ def assemble(parts: list[Run], a, d, trim: bool, tol: Tolerances, ptol: float,
     cand_r = (R[:, 0] >= 0) & ~POLE & good_v[np.maximum(R, 0)].all(axis=1)
     if trim:
         ok_l, ok_r, gaps, jump_l, jump_r = strip_paths(T, chain, gstart, m, L, R, cand_l, cand_r, CG)
+        V, T, G, FAR, good_v, chain, gstart, added = _with_ladders(
+            V, T, G, FAR, good_v, chain, gstart, gaps, a, d, ptol, rows)
+        if added:
+            ok_l, ok_r, gaps, jump_l, jump_r = strip_paths(T, chain, gstart, m, L, R, cand_l,
+                                                           cand_r, CG)
         fill, strip_quads = _close_gaps(V, T, chain, gstart, gaps, ptol)
     else:
         chain = gstart = None

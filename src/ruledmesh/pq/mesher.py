@@ -279,7 +279,7 @@ def pq_mesh(a, b, rows: int = 20, primary: int | str = "middle", option: int = 0
     meet = np.zeros(m, bool)
     meet[:-1] |= flat
     meet[1:] |= flat
-    mesh = assemble(parts, a, d, args.trim, tol, ptol, warnings, scale, meet)
+    mesh = assemble(parts, a, d, args.trim, tol, ptol, warnings, scale, meet, rows=rows)
     paired = 0
     if ptol > tol.planarity:
         # A margin below the stated tolerance, so that rounding in another

@@ -203,11 +203,14 @@ def strip_paths(T, chain, gstart, m, L, R, ok_l, ok_r, CG):
     return keep_l, keep_r, Gaps(g_strip, g_k0, g_l0, na, nb), jump_l, jump_r
 
 
-def zippers(T, chain, gstart, strip, k0, l0, na, nb) -> np.ndarray:
+def zippers(V, T, chain, gstart, strip, k0, l0, na, nb) -> np.ndarray:
     """Zipper triangles of many gaps at once.
 
     Gap g runs from (k0, l0) to (k0 + na, l0 + nb) in strip ``strip[g]``;
-    chain A is generator ``strip``, chain B is ``strip + 1``.
+    chain A is generator ``strip``, chain B is ``strip + 1``.  The two chains
+    are merged in the order of their points along generator A (chain B's
+    points projected onto it), so each triangle joins points that lie side by
+    side, whatever the parametrisation of the two generators.
     """
     ng = len(strip)
     if ng == 0 or (na.sum() + nb.sum()) == 0:
@@ -219,7 +222,16 @@ def zippers(T, chain, gstart, strip, k0, l0, na, nb) -> np.ndarray:
     A = lambda g, k: chain[gstart[strip[g]] + k]
     B = lambda g, l: chain[gstart[strip[g] + 1] + l]
     key_a = T[A(gid_a, k0[gid_a] + ka + 1)]
-    key_b = T[B(gid_b, l0[gid_b] + lb + 1)]
+    # Generator A through its first and last chain points (t = 0 and 1 of the patch, or the
+    # ends of the trimmed chain: the line is the same).
+    s_b = strip[gid_b]
+    p0 = V[chain[gstart[s_b]]]
+    p1 = V[chain[gstart[s_b + 1] - 1]]
+    t0, t1 = T[chain[gstart[s_b]]], T[chain[gstart[s_b + 1] - 1]]
+    dir_ = p1 - p0
+    pb = V[B(gid_b, l0[gid_b] + lb + 1)]
+    w = np.einsum("ij,ij->i", pb - p0, dir_) / np.maximum(np.einsum("ij,ij->i", dir_, dir_), 1e-300)
+    key_b = t0 + w * (t1 - t0)
     gid = np.concatenate([gid_a, gid_b])
     is_a = np.concatenate([np.ones(gid_a.size, bool), np.zeros(gid_b.size, bool)])
     key = np.concatenate([key_a, key_b])
