@@ -14,8 +14,8 @@ import numpy as np
 
 from ..mesh import FaceKind, Mesh
 from ..tolerances import Tolerances
-from .runs import Run
 from .ladders import free_edges, ladder_points
+from .runs import Run
 from .strips import ON_BORDER, Gaps, chains, strip_paths, zippers
 
 __all__ = ["assemble", "to_mesh"]
