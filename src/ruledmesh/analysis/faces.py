@@ -264,6 +264,10 @@ def longest_edges(mesh: Mesh) -> np.ndarray:
     return np.maximum.reduceat(length, mesh.face_offsets[:-1])
 
 
+SPLINTER_DEG = 3.0
+"""Degrees: a face (quad or triangle) with a smaller interior angle is a splinter for fabrication."""
+
+
 def face_min_angles(mesh: Mesh) -> np.ndarray:
     """(F,) float64: the smallest interior angle of every face, degrees."""
     ang = corner_angles(mesh)

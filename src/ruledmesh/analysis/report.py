@@ -118,7 +118,7 @@ def _quality(mesh: Mesh, tol: Tolerances) -> dict[str, Any]:
             "p5": float(np.percentile(smallest, 5)) if smallest.size else 0.0,
             "median": float(np.median(smallest)) if smallest.size else 0.0,
         },
-        "faces_below_3deg": int(np.count_nonzero(smallest < 3.0)),
+        "faces_below_3deg": int(np.count_nonzero(smallest < F.SPLINTER_DEG)),
         "degenerate_faces": int(np.count_nonzero(F.degenerate_faces(mesh, tol.degenerate))),
     }
 

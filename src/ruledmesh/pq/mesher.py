@@ -286,6 +286,7 @@ def pq_mesh(a, b, rows: int = 20, primary: int | str = "middle", option: int = 0
         # reader's measure cannot push a paired quad over it.
         mesh, paired = pair_triangles(mesh, _PAIRING_MARGIN * ptol)
     _warn_share(mesh, warnings, torsal.size, even, max(restarts, 0), m, rows)
+    _warn_splinters(mesh, warnings, torsal)
     return mesh.with_info(runs=len(parts), restarts=max(restarts, 0), planarity_tolerance=ptol,
                           paired=paired)
 
@@ -411,6 +412,45 @@ def _warn_share(mesh: Mesh, warnings: list[str], torsal: int, even: list[str], r
     warnings.append(f"{share:.0%} of the area is not in quads ({'; '.join(causes) or 'border'}): "
                     "more generators (rulings.count), fewer rows, [mesh] planarity_tolerance = 1e-3 "
                     "for nearly developable parts, or method = \"hybrid\"")
+
+
+def _warn_splinters(mesh: Mesh, warnings: list[str], torsal: np.ndarray) -> None:
+    """Say how many faces are splinters for fabrication, where, and next to what."""
+    from ..analysis.faces import SPLINTER_DEG, face_min_angles
+
+    if mesh.n_faces == 0:
+        return
+    ang = face_min_angles(mesh)
+    bad = np.flatnonzero(ang < SPLINTER_DEG)
+    if bad.size == 0:
+        return
+    gen = np.asarray(mesh.vertex_data["generator"])[mesh.face_indices]
+    t = np.asarray(mesh.vertex_data["t"])[mesh.face_indices]
+    g0 = np.minimum.reduceat(gen, mesh.face_offsets[:-1])[bad]
+    t_lo = np.minimum.reduceat(t, mesh.face_offsets[:-1])[bad]
+    t_hi = np.maximum.reduceat(t, mesh.face_offsets[:-1])[bad]
+    near_torsal = np.zeros(bad.size, bool)
+    for k in torsal.tolist():
+        near_torsal |= np.abs(g0 - k) <= 2
+    border = (t_lo <= 1e-9) | (t_hi >= 1 - 1e-9)
+    quads = mesh.valences[bad] == 4
+    where = []
+    for count, label in ((near_torsal.sum(), "next to torsal generators"),
+                         ((border & ~near_torsal).sum(), "at the border"),
+                         ((quads & ~border & ~near_torsal).sum(),
+                          "thin quads where the rows run nearly along the generators"),
+                         ((~quads & ~border & ~near_torsal).sum(), "between runs of rows")):
+        if count:
+            where.append(f"{count} {label}")
+    gs = np.unique(g0)
+    cuts = np.flatnonzero(np.diff(gs) > 1)
+    spans = [f"{lo}-{hi}" if hi > lo else f"{lo}" for lo, hi in
+             zip(gs[np.r_[0, cuts + 1]].tolist(), gs[np.r_[cuts, gs.size - 1]].tolist())]
+    warnings.append(
+        f"{bad.size} faces have an angle below {SPLINTER_DEG:g} deg (smallest {ang[bad].min():.2g} deg; "
+        f"{', '.join(where)}; generators {', '.join(spans[:6])}{' ...' if len(spans) > 6 else ''}): "
+        "strips narrow against the row step make thin panels; fewer rows, other generators "
+        "(rulings.count, distribution) or [mesh] planarity_tolerance = 1e-3 give fatter ones")
 
 
 def _nearly_flat(a: np.ndarray, d: np.ndarray, rows: int, ptol: float) -> np.ndarray:
