@@ -243,3 +243,17 @@ def test_tolerance_mode_pairs_triangles_on_a_general_surface():
     assert loose.info["paired"] > 0
     assert planarity(loose).max() <= 1e-3 and convexity(loose).all()
     assert area_shares(loose)["triangles"] < area_shares(exact)["triangles"] - 0.03
+
+
+def test_build_warns_of_splinters_with_the_figures_analyze_reports():
+    from ruledmesh.analysis.faces import SPLINTER_DEG
+
+    built = build_design(parse_design((EXAMPLES / "fig10-skew-surface.toml").read_text()))
+    angles = face_min_angles(built.mesh)
+    n = int(np.count_nonzero(angles < SPLINTER_DEG))
+    said = [w for w in built.mesh.info["warnings"] if "faces have an angle below" in w]
+    if n == 0:
+        assert not said
+    else:
+        assert len(said) == 1 and said[0].startswith(f"{n} faces have an angle below 3 deg")
+        assert f"smallest {angles.min():.2g} deg" in said[0]
