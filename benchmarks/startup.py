@@ -2,14 +2,15 @@
 
     python benchmarks/startup.py [--label NAME] [--json FILE] [--repeats N]
 
-Start-up: the minimum over ``--repeats`` fresh processes of ``python -c "import
+Start-up: the minimum wall time and CPU time (user + system, less sensitive to other
+jobs on the machine) over ``--repeats`` fresh processes of ``python -c "import
 numpy"`` (the floor), ``import ruledmesh``, ``ruledmesh --help`` and ``ruledmesh
 build examples/skew.toml -o FILE.obj`` (the README's quick start, analysis summary
 included), and the ratio of each to the floor; run alternately so load changes hit
 all alike.  Generators: the minimum over repeats of ``rulings.between(c1, c2, n,
 "arc-length")`` on the director curves of examples/skew.toml (a cubic B-spline and a
 polyline), freshly parsed each time so no cached table helps, for designer sizes n = 50
-and 100, and of ``BSpline.arclength_params(n)`` alone.  The load average is recorded
+and 100, and of ``BSpline.arclength_params(n)`` alone (CPU time of this process).  The load average is recorded
 with the figures (the machine may be shared).  ``--label`` names the run in the JSON,
 which keeps the runs already there (e.g. ``before`` and ``after``).
 """
@@ -19,6 +20,7 @@ from __future__ import annotations
 import argparse
 import json
 import os
+import resource
 import subprocess
 import sys
 import tempfile
@@ -40,21 +42,28 @@ def _commands(out: str) -> dict[str, list[str]]:
     }
 
 
-def startup(repeats: int) -> dict[str, float]:
-    """Minimum wall seconds of each command over ``repeats`` rounds."""
+def _child_cpu() -> float:
+    use = resource.getrusage(resource.RUSAGE_CHILDREN)
+    return use.ru_utime + use.ru_stime
+
+
+def startup(repeats: int) -> tuple[dict[str, float], dict[str, float]]:
+    """Minimum wall and CPU seconds (user + system) of each command over ``repeats`` rounds."""
     with tempfile.TemporaryDirectory() as tmp:
         cmds = _commands(str(Path(tmp) / "skew.obj"))
-        best = dict.fromkeys(cmds, float("inf"))
+        wall = dict.fromkeys(cmds, float("inf"))
+        cpu = dict.fromkeys(cmds, float("inf"))
         for _ in range(repeats):
             for name, cmd in cmds.items():
-                t0 = time.perf_counter()
+                c0, t0 = _child_cpu(), time.perf_counter()
                 subprocess.run(cmd, check=True, capture_output=True, cwd=tmp)
-                best[name] = min(best[name], time.perf_counter() - t0)
-    return best
+                wall[name] = min(wall[name], time.perf_counter() - t0)
+                cpu[name] = min(cpu[name], _child_cpu() - c0)
+    return wall, cpu
 
 
 def generators(repeats: int) -> dict[str, float]:
-    """Minimum seconds of generators from the skew example's director curves."""
+    """Minimum CPU seconds of generators from the skew example's director curves."""
     from ruledmesh.curves import curve_from_spec
     from ruledmesh.rulings import between
 
@@ -64,13 +73,13 @@ def generators(repeats: int) -> dict[str, float]:
         best_between = best_params = float("inf")
         for _ in range(repeats):
             c1, c2 = (curve_from_spec(spec[k], k) for k in ("c1", "c2"))
-            t0 = time.perf_counter()
+            t0 = time.process_time()
             between(c1, c2, n, "arc-length")
-            best_between = min(best_between, time.perf_counter() - t0)
+            best_between = min(best_between, time.process_time() - t0)
             c1 = curve_from_spec(spec["c1"], "c1")
-            t0 = time.perf_counter()
+            t0 = time.process_time()
             c1.arclength_params(n)
-            best_params = min(best_params, time.perf_counter() - t0)
+            best_params = min(best_params, time.process_time() - t0)
         out[f"between arc-length {n}"] = best_between
         out[f"bspline arclength_params {n}"] = best_params
     return out
@@ -83,14 +92,16 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--json", type=Path)
     args = parser.parse_args(argv)
     load = os.getloadavg()
-    start = startup(args.repeats)
+    start, cpu = startup(args.repeats)
     gens = generators(args.repeats * 4)
-    floor = start["import numpy"]
+    floor, cpu_floor = start["import numpy"], cpu["import numpy"]
     run = {"loadavg_start": load, "loadavg_end": os.getloadavg(), "repeats": args.repeats,
            "startup_s": start, "ratio_to_numpy": {k: v / floor for k, v in start.items()},
+           "startup_cpu_s": cpu, "cpu_ratio_to_numpy": {k: v / cpu_floor for k, v in cpu.items()},
            "generators_ms": {k: v * 1e3 for k, v in gens.items()}}
     for k, v in start.items():
-        print(f"{k:>24}: {v * 1e3:7.1f} ms  ({v / floor:.2f} x import numpy)")
+        print(f"{k:>24}: {v * 1e3:7.1f} ms wall ({v / floor:.2f} x import numpy), "
+              f"{cpu[k] * 1e3:7.1f} ms CPU ({cpu[k] / cpu_floor:.2f} x)")
     for k, v in gens.items():
         print(f"{k:>30}: {v * 1e3:7.3f} ms")
     print(f"load average {tuple(round(x, 2) for x in load)} -> "
