@@ -562,7 +562,12 @@ class Curve:
         seg = (b - a) * (values @ w)
         cum = np.concatenate([[0.0], np.cumsum(seg)])
         fit, integ = _legendre_fit()
-        return pieces, cum, values @ fit.T, values @ integ
+        speed, length = values @ fit.T, values @ integ
+        # Drop the trailing coefficients that are below rounding on every piece: smooth
+        # pieces need far fewer than the nodes, and each one costs a Clenshaw step.
+        keep = np.abs(length).max(axis=0) > 1e-15 * max(float(np.abs(length).max()), 1e-300)
+        n = max(int(np.flatnonzero(keep)[-1]) + 1 if keep.any() else 1, 2)
+        return pieces, cum, speed[:, :max(n - 1, 1)], length[:, :n]
 
     def _length_pieces(self) -> np.ndarray:
         return self._breaks()

@@ -18,7 +18,7 @@ def add_parser(sub) -> None:
         epilog="examples:\n"
                "  ruledmesh build examples/skew.toml -o skew.obj\n"
                "  ruledmesh build examples/fig5b-torus.toml -o torus.glb --json\n"
-               "  ruledmesh build site.toml -o site.stl --origin auto\n",
+               "  ruledmesh build examples/skew.toml -o skew.stl --origin auto\n",
     )
     p.add_argument("design", help="design file (.toml)")
     p.add_argument("-o", "--output", required=True, help="mesh file to write (.obj, .ply, ...)")
