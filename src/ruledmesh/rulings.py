@@ -51,6 +51,7 @@ from ._validation import (
     check_vector,
     describe,
 )
+
 # scipy is imported where it is used (lines through points, PCHIP at tangencies, root
 # brackets), so building from director curves starts without it.
 from .curves import BSpline, CubicHermite, Curve, _Level, _perpendicular
