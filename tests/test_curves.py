@@ -321,3 +321,92 @@ def test_spec_errors_name_the_field(spec, message):
     with pytest.raises(DesignError) as err:
         curve_from_spec(spec, "curves.c1")
     assert str(err.value).startswith(message), str(err.value)
+
+
+# --- numpy B-spline evaluation, the Hermite helper and the fast arc-length inverse -------
+def _random_bspline(rng, degree):
+    n = int(rng.integers(degree + 1, degree + 9))
+    inner = np.sort(rng.uniform(0, 1, n - degree - 1))
+    if degree > 1 and len(inner) > 1 and rng.uniform() < 0.3:
+        inner[1] = inner[0]  # a double knot
+    knots = np.r_[np.zeros(degree + 1), inner, np.ones(degree + 1)]
+    return rng.normal(size=(n, 3)), knots
+
+
+@pytest.mark.parametrize("degree", [1, 2, 3, 4, 5])
+def test_de_boor_matches_scipy_bspline(degree):
+    from scipy.interpolate import BSpline as SciBSpline
+
+    rng = np.random.default_rng(degree)
+    for _ in range(10):
+        cp, knots = _random_bspline(rng, degree)
+        curve = BSpline(cp, degree, knots)
+        ref = SciBSpline(knots, cp, degree, extrapolate=True)
+        u = np.r_[np.linspace(0, 1, 301), -0.01, 1.01]
+        np.testing.assert_allclose(curve.evaluate(u[:-2]), ref(u[:-2]), rtol=0, atol=5e-14)
+        want = ref(u)  # with the end polynomials continued
+        np.testing.assert_allclose(curve._eval(u), want, rtol=0, atol=5e-14 * np.abs(want).max())
+        for order in range(1, degree + 1):
+            got, want = curve.derivative(u[:-2], order), ref(u[:-2], nu=order)
+            np.testing.assert_allclose(got, want, rtol=0, atol=1e-13 * max(np.abs(want).max(), 1))
+
+
+def test_cubic_hermite_matches_scipy():
+    from scipy.interpolate import CubicHermiteSpline
+
+    from ruledmesh.curves import CubicHermite
+
+    rng = np.random.default_rng(7)
+    x = np.sort(rng.uniform(0, 5, 12))
+    for y, m in [(rng.normal(size=12), rng.normal(size=12)),
+                 (rng.normal(size=(12, 3)), rng.normal(size=(12, 3)))]:
+        q = np.linspace(x[0], x[-1], 400).reshape(20, 20)
+        ref = CubicHermiteSpline(x, y, m)
+        np.testing.assert_allclose(CubicHermite(x, y, m)(q), ref(q), rtol=0, atol=1e-13)
+        np.testing.assert_allclose(CubicHermite(x, y, m)(q, 1), ref(q, 1), rtol=0, atol=1e-12)
+
+
+@pytest.mark.parametrize("degree", [1, 2, 3, 4, 5])
+def test_tabulated_inverse_is_the_exact_inverse(degree):
+    """param_at_length from the table + Newton equals a bisection of the exact arc length
+    to 1e-14 in u (the tolerance stated in docs/benchmarks.md)."""
+    rng = np.random.default_rng(10 + degree)
+    for _ in range(8):
+        cp, knots = _random_bspline(rng, degree)
+        curve = BSpline(cp, degree, knots)
+        s = np.linspace(0, curve.length(), 257)
+        u = curve.param_at_length(s)
+        lo, hi = np.zeros_like(s), np.ones_like(s)
+        for _ in range(60):  # bisection: slow, sure
+            mid = 0.5 * (lo + hi)
+            below = curve.arclength(mid) < s
+            lo, hi = np.where(below, mid, lo), np.where(below, hi, mid)
+        np.testing.assert_allclose(u, 0.5 * (lo + hi), rtol=0, atol=1e-14)
+        np.testing.assert_allclose(curve.arclength(u), s, rtol=0, atol=4e-14 * curve.length())
+
+
+def test_brentq_is_scipys():
+    import math
+
+    from scipy.optimize import brentq as scipy_brentq
+
+    from ruledmesh._roots import brentq
+
+    rng = np.random.default_rng(3)
+    checked = 0
+    for i in range(600):
+        c = rng.normal(size=5)
+
+        def f(x, c=c):
+            return float(np.polyval(c, x) + 0.3 * math.sin(5 * x))
+
+        a, b = sorted(rng.uniform(-3, 3, 2))
+        if f(a) * f(b) >= 0:
+            continue
+        xtol = [2e-12, 1e-16][i % 2]
+        assert brentq(f, a, b, xtol=xtol, rtol=8.9e-16) == scipy_brentq(f, a, b, xtol=xtol,
+                                                                        rtol=8.9e-16)
+        checked += 1
+    assert checked > 100
+    with pytest.raises(ValueError, match="sign change"):
+        brentq(lambda x: x * x + 1.0, -1.0, 1.0)

@@ -177,3 +177,55 @@ def test_cli_render_edges_and_generators_options(tmp_path):
         assert main(["render", str(tmp_path / "m.obj"), "-o", str(out), "-q",
                      "--size", "320x240", *extra]) == 0
         assert mpimg.imread(out).shape[:2] == (240, 320)
+
+
+def _svg_texts(svg: bytes) -> list[str]:
+    import xml.etree.ElementTree as ET
+
+    root = ET.fromstring(svg)
+    return [t.text for t in root.iter("{http://www.w3.org/2000/svg}text") if t.text]
+
+
+def _labelled_svg(mesh, **options) -> list[str]:
+    from matplotlib import rc_context
+
+    # Text as <text> elements instead of glyph paths, so the SVG can be read back.
+    with rc_context({"svg.fonttype": "none"}):
+        return _svg_texts(render(mesh, fmt="svg", **options))
+
+
+def test_labels_are_the_schedule_labels_of_every_visible_face():
+    """A sheet seen from above: every face is visible and carries its panels.csv label."""
+    from ruledmesh.fabricate.labels import panel_labels
+    from ruledmesh.fabricate.panels import panel_table
+
+    mesh = translational_mesh(5, 4)
+    texts = _labelled_svg(mesh, labels="on", view=(90.0, -90.0))
+    labels = [t for t in texts if t.startswith("P")]
+    assert sorted(labels) == sorted(panel_labels(mesh.n_faces).tolist())
+    assert sorted(labels) == sorted(panel_table(mesh)["label"].tolist())
+    assert not any(t.startswith("P") for t in _labelled_svg(mesh, labels="off"))
+
+
+def test_labels_of_hidden_faces_are_not_drawn():
+    """Two squares one above the other, seen from above and from below."""
+    sq = np.array([[0, 0], [1, 0], [1, 1], [0, 1]], float)
+    verts = np.r_[np.c_[sq, np.zeros(4)], np.c_[sq, np.ones(4)]]
+    mesh = Mesh.from_faces(verts, np.array([[0, 1, 2, 3], [4, 5, 6, 7]]))
+    top = [t for t in _labelled_svg(mesh, labels="on", view=(90.0, 0.0)) if t.startswith("P")]
+    below = [t for t in _labelled_svg(mesh, labels="on", view=(-90.0, 0.0)) if t.startswith("P")]
+    side = [t for t in _labelled_svg(mesh, labels="on", view=(0.0, 0.0)) if t.startswith("P")]
+    assert top == ["P1"] and below == ["P0"] and sorted(side) == ["P0", "P1"]
+
+
+def test_labels_auto_follows_face_size_and_cli_option(tmp_path):
+    mesh = translational_mesh(5, 4)
+    assert any(t.startswith("P") for t in _labelled_svg(mesh, labels="auto"))
+    dense = translational_mesh(60, 40)
+    assert not any(t.startswith("P") for t in _labelled_svg(dense, labels="auto"))
+    save(tmp_path / "m.obj", mesh)
+    assert main(["render", str(tmp_path / "m.obj"), "-o", str(tmp_path / "m.png"), "--labels", "on",
+                 "-q"]) == 0
+    assert mpimg.imread(tmp_path / "m.png").shape[:2] == (800, 1000)
+    with pytest.raises(ParameterError, match="labels"):
+        render(mesh, labels="sometimes")

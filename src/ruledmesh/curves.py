@@ -6,7 +6,10 @@ methods are vectorised over ``u`` of any shape ``(...)`` and return
 distributions of generators (paper §5, :mod:`ruledmesh.rulings`) ask:
 
 * arc length and its inverse (``arclength``, ``param_at_length``,
-  ``arclength_params``), Gauss-Legendre per smooth piece, Newton-polished;
+  ``arclength_params``), tabulated: the speed sampled at Gauss-Legendre nodes
+  of each smooth piece and integrated as its Legendre interpolant, so lengths
+  and their inverse (Newton on that series from a cubic Hermite start) need
+  no further curve evaluation;
 * plane intersections (``intersect_plane``: every root; ``plane_sweep``: one
   branch followed continuously through a pencil of parallel planes).
 
@@ -19,10 +22,16 @@ passes a piece end at which ``g`` turns back, or an end of the curve.
 
 ``curve_from_spec`` reads the ``[curves.*]`` tables of a design file and
 ``Curve.to_spec`` writes them back (``curve_from_spec(c.to_spec(), p) == c``).
+
+B-splines are evaluated as one polynomial per knot span (Taylor coefficients
+from de Boor's algorithm, once per curve; Horner's rule per call), in numpy, so
+building from curves needs no ``scipy`` import: scipy is imported where it is
+needed (interpolation through points).
 """
 
 from __future__ import annotations
 
+import functools
 import math
 from collections.abc import Callable, Mapping
 from dataclasses import dataclass, fields
@@ -31,9 +40,6 @@ from functools import cached_property
 from typing import Any
 
 import numpy as np
-from scipy.interpolate import BSpline as _SciBSpline
-from scipy.interpolate import make_interp_spline
-from scipy.optimize import brentq
 
 from ._validation import (
     check_bool,
@@ -49,6 +55,7 @@ from .errors import DesignError, GeometryError, ParameterError
 from .tolerances import DEFAULT, Tolerances
 
 __all__ = [
+    "CubicHermite",
     "Curve",
     "Line",
     "Polyline",
@@ -63,6 +70,10 @@ __all__ = [
 # knot span this integrates the speed of smooth splines to ~1e-13.
 _GL_NODES = 20
 _NEWTON_ITERATIONS = 60
+# Arc-length pieces per B-spline knot span (each with _GL_NODES speed samples).
+_LENGTH_PIECES_PER_SPAN = 8
+# A Newton step this small (in u) ends the iteration.
+_NEWTON_FINAL_STEP = 1e-15
 
 
 # --------------------------------------------------------------------------
@@ -111,9 +122,97 @@ def _unit_params(u: Any, name: str = "u") -> np.ndarray:
     return np.clip(arr, 0.0, 1.0)
 
 
+@functools.lru_cache(maxsize=4)
 def _gauss_legendre(n: int = _GL_NODES) -> tuple[np.ndarray, np.ndarray]:
     x, w = np.polynomial.legendre.leggauss(n)
     return 0.5 * (x + 1.0), 0.5 * w
+
+
+@functools.lru_cache(maxsize=4)
+def _legendre_fit(n: int = _GL_NODES) -> tuple[np.ndarray, np.ndarray]:
+    """Matrices from values at the ``n`` Gauss-Legendre nodes of [0, 1] to the Legendre
+    coefficients (on [0, 1]) of their interpolant ``(n, n)`` and of its antiderivative
+    that is zero at 0 ``(n, n + 1)``: discrete orthogonality, exact for degree < n."""
+    leg = np.polynomial.legendre
+    x, w = leg.leggauss(n)
+    basis = leg.legvander(x, n - 1)  # (nodes, degree)
+    fit = (basis * w[:, None]).T * ((2 * np.arange(n) + 1) / 2)[:, None]
+    # On [0, 1] (xi = 2u - 1) the antiderivative in u is half that in xi.
+    integ = 0.5 * leg.legint(np.eye(n), lbnd=-1.0, axis=0).T  # (degree, degree + 1)
+    return fit, fit.T @ integ
+
+
+# (-1)^j: a Legendre series at xi = -1 is sum_j (-1)^j c_j (and at +1, sum_j c_j).
+_ALTERNATING = (-1.0) ** np.arange(_GL_NODES + 2)
+
+
+def _clenshaw(coef: np.ndarray, xi: np.ndarray) -> np.ndarray:
+    """(N,) values of Legendre series with per-point coefficients ``coef (N, n)`` at ``xi``."""
+    b1 = np.zeros_like(xi)
+    b2 = np.zeros_like(xi)
+    for j in range(coef.shape[1] - 1, 0, -1):
+        b1, b2 = coef[:, j] + (2 * j + 1) / (j + 1) * xi * b1 - (j + 1) / (j + 2) * b2, b1
+    return coef[:, 0] + xi * b1 - 0.5 * b2
+
+
+class CubicHermite:
+    """The piecewise cubic through ``(x, y)`` with slopes ``dydx`` (C1), in numpy.
+
+    Parameters
+    ----------
+    x : (n,) float64
+        Strictly increasing.
+    y, dydx : (n, ...) float64
+
+    Calling it with ``(...)`` points gives ``(..., *y.shape[1:])`` values
+    (``nu=1``: first derivatives); outside ``[x[0], x[-1]]`` the end cubics
+    continue.  The same interpolant as ``scipy.interpolate.CubicHermiteSpline``.
+    """
+
+    def __init__(self, x: np.ndarray, y: np.ndarray, dydx: np.ndarray):
+        self.x = np.asarray(x, dtype=np.float64)
+        self.y = np.asarray(y, dtype=np.float64)
+        self.dydx = np.asarray(dydx, dtype=np.float64)
+
+    def __call__(self, u: Any, nu: int = 0) -> np.ndarray:
+        u = np.asarray(u, dtype=np.float64)
+        x = self.x
+        k = np.clip(np.searchsorted(x, u, side="right") - 1, 0, len(x) - 2)
+        h = x[k + 1] - x[k]
+        t = (u - x[k]) / h
+        extra = (slice(None),) * u.ndim + (None,) * (self.y.ndim - 1)
+        y0, y1 = self.y[k], self.y[k + 1]
+        m0, m1 = self.dydx[k] * h[extra], self.dydx[k + 1] * h[extra]
+        t = t[extra]
+        if nu == 0:
+            t2 = t * t
+            t3 = t2 * t
+            return ((2 * t3 - 3 * t2 + 1) * y0 + (t3 - 2 * t2 + t) * m0
+                    + (-2 * t3 + 3 * t2) * y1 + (t3 - t2) * m1)
+        t2 = t * t
+        return ((6 * t2 - 6 * t) * (y0 - y1) + (3 * t2 - 4 * t + 1) * m0
+                + (3 * t2 - 2 * t) * m1) / h[extra]
+
+
+def _de_boor(knots: np.ndarray, control: np.ndarray, degree: int, x: np.ndarray) -> np.ndarray:
+    """(..., d) points of the B-spline ``(knots, control, degree)`` at knot values ``x``.
+
+    Each ``x`` is evaluated on the knot span that holds it (the first or last
+    valid span outside the domain, so the end polynomials continue), by de
+    Boor's algorithm: one array operation per step of the triangle.
+    """
+    n = len(control)
+    flat = x.ravel()
+    span = np.clip(np.searchsorted(knots, flat, side="right") - 1, degree, n - 1)
+    d = [control[span - degree + j] for j in range(degree + 1)]
+    for r in range(1, degree + 1):
+        for j in range(degree, r - 1, -1):
+            left = knots[span + j - degree]
+            right = knots[span + j + 1 - r]
+            denom = right - left
+            alpha = np.divide(flat - left, denom, out=np.zeros_like(flat), where=denom > 0)
+            d[j] = (1.0 - alpha)[:, None] * d[j - 1] + alpha[:, None] * d[j]
+    return d[degree].reshape(x.shape + (control.shape[1],))
 
 
 # --------------------------------------------------------------------------
@@ -150,7 +249,10 @@ class _Level:
             return float(dg(np.float64(x)))
 
         crit = []
-        for i in np.nonzero(dl * dr < 0)[0]:
+        signs = np.nonzero(dl * dr < 0)[0]
+        if signs.size:
+            from ._roots import brentq
+        for i in signs:
             lo, hi = a[i] + delta[i], b[i] - delta[i]
             # Evaluated one by one, a derivative at rounding level (a curve
             # lying almost in a level plane) may lose its sign change: no root.
@@ -427,13 +529,45 @@ class Curve:
     @cached_property
     def _length_table(self) -> tuple[np.ndarray, np.ndarray]:
         """Piece starts (p,) + end, and cumulative length at each of them."""
+        pieces, cum, _, _ = self._length_series
+        return pieces, cum
+
+    @cached_property
+    def _length_series(self) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+        """The tabulated arc length: per piece, Legendre series of the speed and of its integral.
+
+        The speed is sampled at :data:`_GL_NODES` Gauss-Legendre nodes of
+        each piece; its interpolant integrates to the Gauss-Legendre sum over
+        the whole piece (so the lengths at piece ends are the quadrature's),
+        and in between its antiderivative is the arc length, to the same
+        accuracy, without evaluating the curve again.
+
+        Returns
+        -------
+        pieces : (p + 1,) float64
+        cum : (p + 1,) float64
+            Arc length at each piece end.
+        speed : (p, n) float64
+            Legendre coefficients (on each piece, ``u`` mapped to [-1, 1]) of
+            the speed, d s / d u.
+        length : (p, n + 1) float64
+            Coefficients of the arc length from the piece start (in units of
+            the piece width: multiply by it).
+        """
         pieces = self._length_pieces()
         x, w = _gauss_legendre()
         a, b = pieces[:-1], pieces[1:]
         nodes = a[:, None] + (b - a)[:, None] * x[None, :]
-        seg = (b - a) * (self._speed(nodes) @ w)
+        values = self._speed(nodes)
+        seg = (b - a) * (values @ w)
         cum = np.concatenate([[0.0], np.cumsum(seg)])
-        return pieces, cum
+        fit, integ = _legendre_fit()
+        speed, length = values @ fit.T, values @ integ
+        # Drop the trailing coefficients that are below rounding on every piece: smooth
+        # pieces need far fewer than the nodes, and each one costs a Clenshaw step.
+        keep = np.abs(length).max(axis=0) > 1e-15 * max(float(np.abs(length).max()), 1e-300)
+        n = max(int(np.flatnonzero(keep)[-1]) + 1 if keep.any() else 1, 2)
+        return pieces, cum, speed[:, :max(n - 1, 1)], length[:, :n]
 
     def _length_pieces(self) -> np.ndarray:
         return self._breaks()
@@ -442,15 +576,18 @@ class Curve:
         """Total arc length."""
         return float(self._length_table[1][-1])
 
+    def _series_at(self, u: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """Piece index, local coordinate in [-1, 1] and piece width at each ``u``."""
+        pieces = self._length_series[0]
+        k = np.clip(np.searchsorted(pieces, u, side="right") - 1, 0, len(pieces) - 2)
+        width = pieces[k + 1] - pieces[k]
+        return k, 2.0 * (u - pieces[k]) / width - 1.0, width
+
     def _arclength(self, u: np.ndarray) -> np.ndarray:
-        pieces, cum = self._length_table
+        _, cum, _, length = self._length_series
         flat = u.ravel()
-        k = np.clip(np.searchsorted(pieces, flat, side="right") - 1, 0, len(pieces) - 2)
-        start = pieces[k]
-        x, w = _gauss_legendre()
-        nodes = start[:, None] + (flat - start)[:, None] * x[None, :]
-        part = (flat - start) * (self._speed(nodes) @ w)
-        return (cum[k] + part).reshape(u.shape)
+        k, xi, width = self._series_at(flat)
+        return (cum[k] + width * _clenshaw(length[k], xi)).reshape(u.shape)
 
     def arclength(self, u: Any) -> np.ndarray:
         """Arc length from ``c(0)`` to ``c(u)``.
@@ -466,30 +603,45 @@ class Curve:
         return self._arclength(_unit_params(u))
 
     def _param_at_length(self, s: np.ndarray) -> np.ndarray:
-        pieces, cum = self._length_table
+        pieces, cum, speed_c, length_c = self._length_series
         total = cum[-1]
         flat = np.clip(s.ravel(), 0.0, total)
+        # The piece holding each length, then Newton on the piece's arc-length series
+        # (slope: its speed series, so convergence is quadratic), kept in a bracket.
         k = np.clip(np.searchsorted(cum, flat, side="right") - 1, 0, len(pieces) - 2)
         lo, hi = pieces[k].copy(), pieces[k + 1].copy()
+        width = hi - lo
         span = cum[k + 1] - cum[k]
         frac = np.divide(flat - cum[k], span, out=np.zeros_like(flat), where=span > 0)
-        u = lo + frac * (hi - lo)
-        x, w = _gauss_legendre()
-        start = pieces[k]
+        u = lo + frac * width
+        # Start from the cubic Hermite in s through the piece ends (du/ds = 1 / speed there):
+        # then Newton needs a step or two.
+        ends = speed_c[k]
+        v0, v1 = ends @ _ALTERNATING[:ends.shape[1]], ends.sum(axis=1)  # speed at xi = -1, +1
+        with np.errstate(divide="ignore", invalid="ignore"):
+            m0, m1 = span / (v0 * width), span / (v1 * width)
+            t = frac
+            guess = lo + width * ((-2 * t + 3) * t * t + (t * t - 2 * t + 1) * t * m0
+                                  + (t * t - t) * t * m1)
+        good = np.isfinite(guess) & (guess >= lo) & (guess <= hi) & (v0 > 0) & (v1 > 0)
+        u = np.where(good, guess, u)
         scale = max(total, 1e-300)
+        todo = np.arange(flat.size)
         for _ in range(_NEWTON_ITERATIONS):
-            nodes = start[:, None] + (u - start)[:, None] * x[None, :]
-            f = cum[k] + (u - start) * (self._speed(nodes) @ w) - flat
-            lo = np.where(f < 0, u, lo)
-            hi = np.where(f > 0, u, hi)
-            speed = self._speed(u)
+            uu, kk = u[todo], k[todo]
+            xi = 2.0 * (uu - pieces[kk]) / width[todo] - 1.0
+            f = cum[kk] + width[todo] * _clenshaw(length_c[kk], xi) - flat[todo]
+            lo[todo] = np.where(f < 0, uu, lo[todo])
+            hi[todo] = np.where(f > 0, uu, hi[todo])
             with np.errstate(divide="ignore", invalid="ignore"):
-                new = u - f / speed
-            bad = ~np.isfinite(new) | (new < lo) | (new > hi)
-            new = np.where(bad, 0.5 * (lo + hi), new)
-            done = (np.abs(f) <= 4e-16 * scale) | (np.abs(new - u) <= 1e-16)
-            u = np.where(done, u, new)
-            if np.all(done):
+                new = uu - f / _clenshaw(speed_c[kk], xi)
+            bad = ~np.isfinite(new) | (new < lo[todo]) | (new > hi[todo])
+            new = np.where(bad, 0.5 * (lo[todo] + hi[todo]), new)
+            exact = np.abs(f) <= 4e-16 * scale
+            u[todo] = np.where(exact, uu, new)
+            done = exact | (np.abs(new - uu) <= _NEWTON_FINAL_STEP)
+            todo = todo[~done]
+            if not todo.size:
                 break
         u = np.where(flat <= 0.0, 0.0, np.where(flat >= total, 1.0, u))
         return u.reshape(s.shape)
@@ -966,12 +1118,78 @@ class BSpline(Curve):
         seg = np.linalg.norm(np.diff(pts, axis=0), axis=1)
         x = np.concatenate([[0.0], np.cumsum(seg)]) / seg.sum()
         x[-1] = 1.0
+        from scipy.interpolate import make_interp_spline
+
         spl = make_interp_spline(x, pts, k=degree)
         return cls(np.asarray(spl.c), degree, np.asarray(spl.t))
 
     @cached_property
-    def _spline(self) -> _SciBSpline:
-        return _SciBSpline(self.knots, self.control_points, self.degree, extrapolate=True)
+    def _derivative_nets(self) -> list[tuple[np.ndarray, np.ndarray, int]]:
+        """(knots, control points, degree) of the curve and its derivatives up to the degree.
+
+        The derivative of a degree-p B-spline is the degree-(p-1) B-spline on
+        the knots without their ends, control points
+        ``p (c[i+1] - c[i]) / (t[i+p+1] - t[i+1])`` (zero over empty spans).
+        """
+        nets = [(self.knots, self.control_points, self.degree)]
+        for _ in range(self.degree):
+            t, c, p = nets[-1]
+            denom = (t[p + 1:-1] - t[1:-p - 1])[:, None]
+            diff = np.divide(p * np.diff(c, axis=0), denom, out=np.zeros((len(c) - 1, 3)),
+                             where=denom > 0)
+            nets.append((t[1:-1], diff, p - 1))
+        return nets
+
+    @cached_property
+    def _pieces(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """The curve as polynomials per knot span, in ``u``.
+
+        Returns span starts ``(m,)`` and lengths ``(m,)`` in ``u``, and
+        coefficients ``(m, degree + 1, 3)``: on span ``k`` the curve is
+        ``sum_j C[k, j] tau^j``, ``tau = (u - start[k]) / length[k]``, from the
+        derivatives at each span's start (de Boor, right-sided), i.e. exact
+        Taylor polynomials.
+        """
+        t0, t1 = self._domain
+        b = self._breaks()
+        start, width = b[:-1], np.diff(b)
+        x = t0 + start * (t1 - t0)
+        coef = np.empty((len(start), self.degree + 1, 3))
+        fact = 1.0
+        for j, (knots, control, degree) in enumerate(self._derivative_nets):
+            fact *= max(j, 1)
+            d = _de_boor(knots, control, degree, x) * (t1 - t0) ** j
+            coef[:, j] = d * (width ** j / fact)[:, None]
+        return start, width, coef
+
+    @cached_property
+    def _derivative_pieces(self) -> list[np.ndarray]:
+        """Per derivative order ``m``: coefficients ``(spans, degree + 1 - m, 3)`` in ``tau``
+        of the ``m``-th derivative with respect to ``u`` (span lengths divided out)."""
+        _, width, coef = self._pieces
+        out = []
+        for m in range(self.degree + 1):
+            scale = np.array([math.perm(j, m) for j in range(m, self.degree + 1)], float)
+            out.append(coef[:, m:] * scale[None, :, None] / (width ** m)[:, None, None])
+        return out
+
+    def _poly(self, u: np.ndarray, order: int) -> np.ndarray:
+        """(..., 3): the ``order``-th derivative from the span polynomials (Horner)."""
+        start, width, _ = self._pieces
+        c = self._derivative_pieces[order]
+        flat = u.ravel()
+        if len(start) == 1:  # one span: no gather
+            tau = ((flat - start[0]) / width[0])[:, None]
+            out = np.broadcast_to(c[0, -1], (flat.size, 3))
+            for j in range(c.shape[1] - 2, -1, -1):
+                out = out * tau + c[0, j]
+        else:
+            k = np.clip(np.searchsorted(start, flat, side="right") - 1, 0, len(start) - 1)
+            tau = ((flat - start[k]) / width[k])[:, None]
+            out = c[k, -1]
+            for j in range(c.shape[1] - 2, -1, -1):
+                out = out * tau + c[k, j]
+        return np.array(out, copy=True).reshape(u.shape + (3,))
 
     @property
     def _domain(self) -> tuple[float, float]:
@@ -979,14 +1197,12 @@ class BSpline(Curve):
         return float(self.knots[self.degree]), float(self.knots[n])
 
     def _eval(self, u):
-        t0, t1 = self._domain
-        return self._spline(t0 + u * (t1 - t0))
+        return self._poly(np.asarray(u, dtype=np.float64), 0)
 
     def _deriv(self, u, order):
-        t0, t1 = self._domain
         if order > self.degree:
-            return np.zeros(u.shape + (3,))
-        return self._spline(t0 + u * (t1 - t0), nu=order) * (t1 - t0) ** order
+            return np.zeros(np.shape(u) + (3,))
+        return self._poly(np.asarray(u, dtype=np.float64), order)
 
     def _breaks(self):
         t0, t1 = self._domain
@@ -997,11 +1213,11 @@ class BSpline(Curve):
         return u
 
     def _length_pieces(self):
+        # Each knot span cut into equal pieces: the speed's Legendre interpolant on a
+        # piece (the tabulated arc length) then reaches rounding except near cusps.
         b = self._breaks()
-        # halve each span: the speed is smooth there, 20 nodes on half a span
-        # reach rounding level for all but near-cusp splines
-        mid = 0.5 * (b[:-1] + b[1:])
-        return np.sort(np.concatenate([b, mid]))
+        steps = np.linspace(0.0, 1.0, _LENGTH_PIECES_PER_SPAN + 1)[:-1]
+        return np.concatenate([(b[:-1, None] + np.diff(b)[:, None] * steps).ravel(), [1.0]])
 
     def _level_grid(self):
         b = self._breaks()

@@ -270,8 +270,6 @@ def _with_creases(rulings, table: Mapping, curves: Mapping) -> Any:
 
 def _kink_parameter(rail: Any, u0: float, u1: float, kink: float) -> float | None:
     """The surface parameter in (u0, u1) where a rail reaches the curve parameter ``kink``."""
-    from scipy.optimize import brentq
-
     sigma = getattr(rail, "sigma", None)
     if sigma is None:
         return None
@@ -279,6 +277,8 @@ def _kink_parameter(rail: Any, u0: float, u1: float, kink: float) -> float | Non
     f1 = float(sigma.value(np.float64(u1))) - kink
     if f0 == 0.0 or f1 == 0.0 or f0 * f1 > 0:
         return None
+    from ._roots import brentq
+
     u = brentq(lambda x: float(sigma.value(np.float64(x))) - kink, u0, u1, xtol=1e-15)
     if u - u0 < 1e-6 * (u1 - u0) or u1 - u < 1e-6 * (u1 - u0):
         return None

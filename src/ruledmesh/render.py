@@ -23,8 +23,8 @@ from .errors import ExportError, ParameterError
 from .mesh import FaceKind, Mesh
 from .tolerances import DEFAULT
 
-__all__ = ["FORMATS", "MIN_FACE_PIXELS", "MIN_GENERATOR_SPACING", "ColorBy", "Switch", "face_values",
-           "render", "save_render"]
+__all__ = ["FORMATS", "MAX_LABELS", "MIN_FACE_PIXELS", "MIN_GENERATOR_SPACING", "MIN_LABEL_PIXELS",
+           "ColorBy", "Switch", "face_values", "render", "save_render", "visible_faces"]
 
 # File types the Agg-based figure can write, by extension.
 FORMATS = {".png": "png", ".svg": "svg", ".pdf": "pdf"}
@@ -166,6 +166,86 @@ def _generator_subset(mesh: Mesh, generators: bool | str, width: int) -> np.ndar
     return mesh.members[index % step == 0]
 
 
+# ``labels="auto"`` writes panel labels while a face covers at least this many pixels on
+# average (a label needs room to be read) ...
+MIN_LABEL_PIXELS = 1500.0
+# ... and at most this many, drawn or asked for: every label is a text object of its own.
+MAX_LABELS = 5000
+
+
+def _projected(ax, points: np.ndarray) -> np.ndarray:
+    """(..., 3) screen x, y and depth (smaller is nearer) of 3-D points in ``ax``'s camera."""
+    m = ax.get_proj()
+    h = points @ m[:3, :3].T + m[:3, 3]
+    w = points @ m[3, :3] + m[3, 3]
+    return h / w[..., None]
+
+
+def visible_faces(ax, mesh: Mesh, faces: np.ndarray) -> np.ndarray:
+    """(k,) bool: whether the centroid of each face in ``faces`` is seen by ``ax``'s camera.
+
+    A centroid is hidden when another face covers it on the screen and lies
+    nearer to the camera there (faces fanned into triangles, depth
+    interpolated across each triangle).
+
+    Parameters
+    ----------
+    ax : mpl_toolkits.mplot3d.Axes3D
+        Axes whose camera and limits are set.
+    mesh : Mesh
+    faces : (k,) int64
+    """
+    c = _projected(ax, F.face_centroids(mesh)[faces])
+    poly = _projected(ax, _face_polygons(mesh))
+    k = poly.shape[1]
+    tri = np.stack([np.repeat(poly[:, :1], k - 2, axis=1), poly[:, 1:-1], poly[:, 2:]], axis=2)
+    owner = np.repeat(np.arange(mesh.n_faces), k - 2)
+    tri = tri.reshape(-1, 3, 3)
+    e1, e2 = tri[:, 1, :2] - tri[:, 0, :2], tri[:, 2, :2] - tri[:, 0, :2]
+    det = e1[:, 0] * e2[:, 1] - e1[:, 1] * e2[:, 0]
+    keep = np.abs(det) > 1e-14 * (np.abs(e1).sum(axis=1) * np.abs(e2).sum(axis=1) + 1e-300)
+    tri, e1, e2, det, owner = tri[keep], e1[keep], e2[keep], det[keep], owner[keep]
+    depth = float(np.ptp(poly[..., 2])) or 1.0
+    seen = np.ones(len(faces), dtype=bool)
+    # Label-by-triangle tests in blocks that keep the temporaries to a few million entries.
+    block = max(1, 2_000_000 // max(len(tri), 1))
+    for s in range(0, len(faces), block):
+        d = c[s:s + block, None, :2] - tri[None, :, 0, :2]
+        u = (d[..., 0] * e2[:, 1] - d[..., 1] * e2[:, 0]) / det
+        v = (e1[:, 0] * d[..., 1] - e1[:, 1] * d[..., 0]) / det
+        inside = (u >= 0) & (v >= 0) & (u + v <= 1)
+        z = tri[:, 0, 2] + u * (tri[:, 1, 2] - tri[:, 0, 2]) + v * (tri[:, 2, 2] - tri[:, 0, 2])
+        nearer = z < c[s:s + block, None, 2] - 1e-6 * depth
+        other = owner[None, :] != faces[s:s + block, None]
+        seen[s:s + block] = ~np.any(inside & nearer & other, axis=1)
+    return seen
+
+
+def _draw_labels(ax, mesh: Mesh, labels: bool | str, pixels: float) -> int:
+    """Write the panel labels of the fabrication schedules at the visible face centroids.
+
+    Returns the number of labels drawn.
+    """
+    from .fabricate.labels import panel_labels
+
+    per_face = pixels / mesh.n_faces
+    auto = per_face >= MIN_LABEL_PIXELS and mesh.n_faces <= MAX_LABELS
+    if not _switch(labels, "labels", auto):
+        return 0
+    if mesh.n_faces > MAX_LABELS:
+        raise ParameterError(f"{mesh.n_faces} faces are too many to label (at most {MAX_LABELS}); "
+                             "render a part of the mesh", "labels")
+    faces = np.arange(mesh.n_faces)
+    faces = faces[visible_faces(ax, mesh, faces)]
+    names = panel_labels(mesh.n_faces)[faces]
+    at = F.face_centroids(mesh)[faces]
+    size = float(np.clip(0.12 * np.sqrt(per_face), 4.0, 10.0))
+    for (x, y, z), name in zip(at.tolist(), names.tolist(), strict=True):
+        ax.text(x, y, z, name, fontsize=size, ha="center", va="center", zorder=4,
+                color="#111111", gid=f"label-{name}")
+    return len(faces)
+
+
 def _frame(ax, mesh: Mesh, elev: float, azim: float) -> None:
     """Axis limits around the mesh at equal scale, the camera, no axes drawn."""
     lo, hi = mesh.bounding_box()
@@ -182,7 +262,7 @@ def _frame(ax, mesh: Mesh, elev: float, azim: float) -> None:
 def render(mesh: Mesh, *, color: ColorBy | str = ColorBy.PLANARITY, reference=None,
            view: tuple[float, float] = (25.0, -60.0), size: tuple[int, int] = (1000, 800),
            dpi: int = 100, generators: bool | str = "auto", edges: bool | str = "auto",
-           title: str | None = None, fmt: str = "png") -> bytes:
+           labels: bool | str = "off", title: str | None = None, fmt: str = "png") -> bytes:
     """The picture of ``mesh`` as image bytes.
 
     Parameters
@@ -207,6 +287,14 @@ def render(mesh: Mesh, *, color: ColorBy | str = ColorBy.PLANARITY, reference=No
         Outline the faces.  ``"auto"`` outlines them while a face covers at
         least :data:`MIN_FACE_PIXELS` pixels on average and drops the outlines
         beyond (a million outlined faces would paint the picture black).
+    labels : bool or {"on", "off", "auto"}
+        Write each panel's label (``P0``, ``P1``, ...: the labels of the
+        cutting sheets, ``panels.csv`` and the IFC/3DM objects, see
+        :mod:`ruledmesh.fabricate.labels`) at its centroid, for the faces
+        whose centroid the camera sees (see :func:`visible_faces`).
+        ``"auto"`` labels while a face covers at least
+        :data:`MIN_LABEL_PIXELS` pixels on average; at most
+        :data:`MAX_LABELS` faces can be labelled.
     title : str, optional
     fmt : {"png", "svg", "pdf"}
 
@@ -261,6 +349,7 @@ def render(mesh: Mesh, *, color: ColorBy | str = ColorBy.PLANARITY, reference=No
                                              linewidths=0.5 if thinned else 0.8))
 
     _frame(ax, mesh, elev, azim)
+    _draw_labels(ax, mesh, labels, pixels)
     bar = fig.colorbar(polys, cax=fig.add_axes((0.88, 0.2, 0.025, 0.6)))
     bar.set_label(label)
     if ticks is not None:

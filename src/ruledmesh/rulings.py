@@ -42,8 +42,6 @@ from enum import Enum
 from typing import Any
 
 import numpy as np
-from scipy.interpolate import CubicHermiteSpline, CubicSpline, PchipInterpolator
-from scipy.optimize import brentq
 
 from ._validation import (
     check_choice,
@@ -53,7 +51,10 @@ from ._validation import (
     check_vector,
     describe,
 )
-from .curves import BSpline, Curve, _Level, _perpendicular
+
+# scipy is imported where it is used (lines through points, PCHIP at tangencies, root
+# brackets), so building from director curves starts without it.
+from .curves import BSpline, CubicHermite, Curve, _Level, _perpendicular
 from .errors import DesignError, GeometryError, ParameterError
 from .tolerances import DEFAULT, Tolerances
 
@@ -141,7 +142,9 @@ class _Pchip:
         fourth order, so the surface hardly depends on the sampling."""
         if dsigma is not None and np.all(np.isfinite(dsigma)) and (
                 np.all(dsigma >= 0) or np.all(dsigma <= 0)):
-            return cls(CubicHermiteSpline(u, sigma, dsigma))
+            return cls(CubicHermite(u, sigma, dsigma))
+        from scipy.interpolate import PchipInterpolator
+
         return cls(PchipInterpolator(u, sigma))
 
     def value(self, u):
@@ -169,7 +172,7 @@ class _CurveTrack:
 class _SplineTrack:
     """A(u) = a C2 cubic spline through given points."""
 
-    spline: CubicSpline
+    spline: Any  # scipy.interpolate.CubicSpline
 
     def value(self, u):
         return self.spline(u)
@@ -517,6 +520,8 @@ class _PencilAngle:
 
         xm = grid[i]
         if approach(lo) < 0 < approach(hi):
+            from ._roots import brentq
+
             xm = brentq(approach, lo, hi, xtol=1e-16, rtol=8.9e-16)
         rmin = float(self.radius(curve._eval(np.float64(xm))))
         if rmin <= tol.degenerate * curve._size:
@@ -852,6 +857,8 @@ def from_lines(lines: Any, *, tol: Tolerances = DEFAULT) -> Rulings:
         raise GeometryError(f"lines: generators {i} and {i + 1} are the same line")
     u = np.concatenate([[0.0], np.cumsum(step)]) / step.sum()
     u[-1] = 1.0
+    from scipy.interpolate import CubicSpline
+
     surface = RuledSurface(_SplineTrack(CubicSpline(u, a, axis=0)),
                            _SplineTrack(CubicSpline(u, b, axis=0)), u)
     return Rulings(a, b, u, surface, {"distribution": "lines", "warnings": []})

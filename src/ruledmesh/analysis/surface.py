@@ -13,6 +13,9 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+# Up to this many point-sample pairs the nearest seeds are found by comparing all pairs.
+_BRUTE_FORCE = 2_000_000
+
 __all__ = ["RuledReference"]
 
 
@@ -32,16 +35,35 @@ class RuledReference:
     samples: int = 64
     _cache: dict = field(default_factory=dict, repr=False)
 
-    def _seed_tree(self):
-        if "tree" not in self._cache:
-            from scipy.spatial import cKDTree
-
+    def _seeds(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """Sample points of the patch and their parameters ``u``, ``t``."""
+        if "seeds" not in self._cache:
             u = np.linspace(0.0, 1.0, self.samples)
             t = np.linspace(0.0, 1.0, max(self.samples // 4, 9))
             uu, tt = np.meshgrid(u, t, indexing="ij")
             pts = self.surface.point(uu.ravel(), tt.ravel())
-            self._cache["tree"] = (cKDTree(pts), uu.ravel(), tt.ravel())
-        return self._cache["tree"]
+            self._cache["seeds"] = (pts, uu.ravel(), tt.ravel())
+        return self._cache["seeds"]
+
+    def _nearest_seeds(self, points: np.ndarray, k: int) -> np.ndarray:
+        """(n, k) int64: the ``k`` samples nearest to each point (in no particular order)."""
+        pts = self._seeds()[0]
+        if len(points) * len(pts) <= _BRUTE_FORCE:
+            # A small analysis (a designer edit, a small build) compares every pair in numpy
+            # instead of importing scipy.spatial for a k-d tree.  Centred first: at site
+            # coordinates the expanded squares would round the distances away.
+            centre = pts.mean(axis=0)
+            p, q = points - centre, pts - centre
+            d = (np.einsum("ij,ij->i", p, p)[:, None] - 2.0 * p @ q.T
+                 + np.einsum("ij,ij->i", q, q)[None, :])
+            return np.argpartition(d, k - 1, axis=1)[:, :k] if k < len(pts) else \
+                np.broadcast_to(np.arange(len(pts)), (len(points), len(pts)))
+        if "tree" not in self._cache:
+            from scipy.spatial import cKDTree
+
+            self._cache["tree"] = cKDTree(pts)
+        _, nearest = self._cache["tree"].query(points, k=k)
+        return np.asarray(nearest).reshape(len(points), k)
 
     def closest(self, points: np.ndarray, iterations: int = 12,
                 seeds: int = 6) -> tuple[np.ndarray, np.ndarray]:
@@ -60,10 +82,9 @@ class RuledReference:
         -------
         u, t : (n,) float64
         """
-        tree, us, ts = self._seed_tree()
+        _, us, ts = self._seeds()
         k = min(seeds, len(us))
-        _, nearest = tree.query(points, k=k)
-        nearest = np.asarray(nearest).reshape(len(points), k)
+        nearest = self._nearest_seeds(points, k)
         u, t = self._descend(np.repeat(points, k, axis=0), us[nearest].ravel(), ts[nearest].ravel(),
                              iterations)
         d = np.linalg.norm(self.surface.point(u, t) - np.repeat(points, k, axis=0), axis=1)

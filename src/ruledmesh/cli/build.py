@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import json
 import sys
+import warnings
 
 
 def add_parser(sub) -> None:
@@ -16,11 +17,15 @@ def add_parser(sub) -> None:
                     "stderr when it is a terminal.",
         epilog="examples:\n"
                "  ruledmesh build examples/skew.toml -o skew.obj\n"
-               "  ruledmesh build examples/fig5b-torus.toml -o torus.glb --json\n",
+               "  ruledmesh build examples/fig5b-torus.toml -o torus.glb --json\n"
+               "  ruledmesh build examples/skew.toml -o skew.stl --origin auto\n",
     )
     p.add_argument("design", help="design file (.toml)")
     p.add_argument("-o", "--output", required=True, help="mesh file to write (.obj, .ply, ...)")
     p.add_argument("--json", action="store_true", help="print the analysis summary as JSON")
+    p.add_argument("--origin", metavar="X,Y,Z|auto",
+                   help="STL: subtract this point before float32 rounding (auto: the lower "
+                        "corner in whole units); recorded in the header")
     p.add_argument("-q", "--quiet", action="store_true",
                    help="print nothing on success (no progress, no summary)")
     p.set_defaults(run=run)
@@ -28,15 +33,24 @@ def add_parser(sub) -> None:
 
 def run(args) -> int:
     from ..analysis.report import analyze, format_summary
+    from ..errors import ParameterError, RuledMeshWarning
     from ..io import WRITERS, save
     from ._common import check_output_file, progress_for, read_design
+    from .export import _origin
 
     output = check_output_file(args.output, WRITERS)
+    origin = _origin(args.origin)
+    if origin is not None and output.suffix.lower() != ".stl":
+        raise ParameterError(f"applies to .stl output only, not {output.suffix or 'this file'}",
+                             "--origin")
     progress = progress_for(args)
     _, built = read_design(args.design, progress)
     report = analyze(built.mesh, reference=built.reference, extras=built.extras, progress=progress)
-    with progress.task(f"write {args.output}"):
-        save(output, built.mesh)
+    with progress.task(f"write {args.output}"), warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always", RuledMeshWarning)
+        save(output, built.mesh, **({} if origin is None else {"origin": origin}))
+    for w in caught:
+        print(f"warning: {w.message}", file=sys.stderr)
     if args.json:
         json.dump(report, sys.stdout, indent=2)
         sys.stdout.write("\n")

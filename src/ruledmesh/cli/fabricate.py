@@ -59,8 +59,9 @@ def add_parser(sub) -> None:
     p.add_argument("--nesting", default="auto", choices=["auto", "true-shape", "shelf"],
                    help="sheet packer: true-shape (spyrrow, pip install 'ruledmesh[nesting]'), "
                         "shelf packing of bounding boxes, or auto (true-shape when installed)")
-    p.add_argument("--nest-time", type=int, default=4,
-                   help="seconds the true-shape nesting may search (default 4)")
+    p.add_argument("--nest-time", type=int, default=2,
+                   help="seconds the true-shape nesting may search per sheet (default 2; a sheet "
+                        "takes one or two searches)")
     p.add_argument("--decimals", type=int, default=3, help="decimals of edge-length labels (default 3)")
     p.add_argument("--length-tol", type=float, help="congruence tolerance on edge lengths "
                    "(default 1e-9 x diagonal)")

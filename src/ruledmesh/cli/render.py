@@ -26,7 +26,8 @@ def add_parser(sub) -> None:
                "  ruledmesh render skew.obj -o skew.png\n"
                "  ruledmesh render skew.obj --design examples/skew.toml --color closeness -o c.png\n"
                "  ruledmesh render examples/skew.toml --color kind --view 30,-45 -o k.png\n"
-               "  ruledmesh render skew.obj -o big.png --size 3000x2400 --edges off --title Skew\n\n"
+               "  ruledmesh render skew.obj -o big.png --size 3000x2400 --edges off --title Skew\n"
+               "  ruledmesh render skew.obj -o labelled.png --labels on --size 2000x1600\n\n"
                "Large meshes: face outlines are dropped once faces get smaller than a few "
                "pixels, and only an evenly spaced subset of the generators is drawn "
                "(--edges auto, --generators auto); 'on' or 'off' forces either.",
@@ -45,6 +46,10 @@ def add_parser(sub) -> None:
                    help="outline the faces (default auto: only while faces are large enough)")
     p.add_argument("--generators", choices=["on", "off", "auto"], default="auto",
                    help="draw the generators (default auto: thinned out on dense meshes)")
+    p.add_argument("--labels", choices=["on", "off", "auto"], default="off",
+                   help="write each panel's label (P0, P1, ... as on the fabrication sheets and in "
+                        "panels.csv) at its centroid, where the camera sees it (default off; auto: "
+                        "only while faces are large enough to read them)")
     p.add_argument("--no-generators", dest="generators", action="store_const", const="off",
                    help="same as --generators off")
     p.add_argument("-q", "--quiet", action="store_true", help="print nothing on success")
@@ -65,7 +70,7 @@ def run(args) -> int:
     with progress.task(f"render {args.output}"):
         save_render(args.output, source.mesh, color=args.color, reference=reference,
                     view=args.view, size=args.size, title=args.title, edges=args.edges,
-                    generators=args.generators)
+                    generators=args.generators, labels=args.labels)
     if not args.quiet:
         print(f"wrote {args.output}")
     return 0

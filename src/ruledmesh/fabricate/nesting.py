@@ -26,6 +26,7 @@ import numpy as np
 
 from .._validation import check_float
 from ..errors import ParameterError
+from ..progress import Progress
 from .unroll import Unrolled, corner_structure, min_area_rotation
 
 __all__ = ["DEFAULT_TOOL_MM", "METHODS", "Layout", "auto_sheet", "default_gap", "layout"]
@@ -174,7 +175,8 @@ def _check_fits(box: np.ndarray, gap: float, sw: float, sh: float) -> None:
 
 
 def layout(unrolled: Unrolled, sheet: tuple[float, float] | None = None, *, gap: float | None = None,
-           units: str = "m", method: str = "shelf", seconds: int = 4, seed: int = 0) -> Layout:
+           units: str = "m", method: str = "shelf", seconds: int = 2, seed: int = 0,
+           progress: Progress | None = None) -> Layout:
     """Place the unrolled panels on sheets.
 
     Parameters
@@ -193,9 +195,12 @@ def layout(unrolled: Unrolled, sheet: tuple[float, float] | None = None, *, gap:
         is installed.  The default here is the fast shelf packer; ``ruledmesh
         fabricate`` defaults to ``"auto"``.
     seconds : int
-        Time budget of the true-shape solver.
+        Time budget of the true-shape solver per sheet (at least 1; a sheet
+        takes one or two solves).
     seed : int
         Seed of the true-shape solver.
+    progress : Progress, optional
+        Told the panels placed, sheet by sheet (true-shape nesting).
 
     Returns
     -------
@@ -224,30 +229,32 @@ def layout(unrolled: Unrolled, sheet: tuple[float, float] | None = None, *, gap:
 
         method = "true-shape" if available() and nf else "shelf"
     if method == "true-shape" and nf:
-        lay = _true_shape(unrolled, gap, sw, sh, seconds, seed)
+        lay = _true_shape(unrolled, gap, sw, sh, seconds, seed, progress)
         if lay is not None:
             return lay
     return _shelf(unrolled, rot, rp, lo, box, gap, sw, sh)
 
 
 def _true_shape(unrolled: Unrolled, gap: float, sw: float, sh: float, seconds: int,
-                seed: int) -> Layout | None:
-    """Nest with spyrrow; None if the solver turned a panel wider than the sheet."""
-    from .true_shape import sheets_from_strip, strip_pack
+                seed: int, progress: Progress | None) -> Layout | None:
+    """Nest with spyrrow sheet by sheet; None if the solver turned a panel wider than the sheet."""
+    from .true_shape import nest_sheets
 
     off = unrolled.face_offsets
     face, _, _ = corner_structure(off)
-    rotation, translation, _ = strip_pack(unrolled, sh - 2 * gap, gap, seconds, seed)
-    sheet_of, starts = sheets_from_strip(unrolled, rotation, translation, sw - 2 * gap)
-    offset = translation - np.c_[starts[sheet_of], np.zeros(len(sheet_of))] + gap
-    points = _rotate(unrolled.points, rotation[face]) + offset[face]
+    nested = nest_sheets(unrolled, sw - 2 * gap, sh - 2 * gap, gap, seconds=seconds, seed=seed,
+                         progress=progress)
+    if nested is None:
+        return None
+    offset = nested.translation + gap
+    points = _rotate(unrolled.points, nested.rotation[face]) + offset[face]
     lo = np.stack([np.minimum.reduceat(points[:, i], off[:-1]) for i in (0, 1)], axis=1)
     hi = np.stack([np.maximum.reduceat(points[:, i], off[:-1]) for i in (0, 1)], axis=1)
     eps = 1e-9 * max(sw, sh)
     if lo.min() < gap - eps or hi[:, 0].max() > sw - gap + eps or hi[:, 1].max() > sh - gap + eps:
         return None
-    return Layout(unrolled, points, sheet_of, rotation, offset, hi - lo, np.array([sw, sh]),
-                  int(starts.size), gap, "true-shape")
+    return Layout(unrolled, points, nested.sheet, nested.rotation, offset, hi - lo,
+                  np.array([sw, sh]), int(nested.sheet.max()) + 1, gap, "true-shape")
 
 
 def _shelf(unrolled: Unrolled, rot, rp, lo, box, gap: float, sw: float, sh: float) -> Layout:

@@ -91,7 +91,7 @@ def fabricate(mesh: Mesh, folder: str | os.PathLike, *, sheet: tuple[float, floa
               length_tol: float | None = None, angle_tol: float = 1e-4, dxf: bool | None = None,
               hotwire: bool | None = None, span: str = "auto", up: str | None = None,
               kerf: float = 0.0, kerf_side: str = "left", feed: float = 300.0,
-              machine: hm.Machine | None = None, nesting: str = "auto", nest_seconds: int = 4,
+              machine: hm.Machine | None = None, nesting: str = "auto", nest_seconds: int = 2,
               tool: float | None = None, require_planar: bool = True,
               tol: Tolerances = DEFAULT, progress: Progress | None = None) -> dict[str, Any]:
     """Write the fabrication files of ``mesh`` into ``folder`` (created if missing).
@@ -123,7 +123,8 @@ def fabricate(mesh: Mesh, folder: str | os.PathLike, *, sheet: tuple[float, floa
         Sheet packer (see :mod:`.nesting`); ``"auto"``: true-shape when
         ``spyrrow`` is installed, else shelf packing (with a note).
     nest_seconds : int
-        Time budget of the true-shape nesting.
+        Time budget of the true-shape nesting per sheet (a sheet takes one or
+        two solves).
     tool : float, optional
         Diameter or kerf of the sheet cutter, mesh units (default 3 mm).
     machine : Machine, optional

@@ -1,0 +1,65 @@
+"""Start-up: which modules ``import ruledmesh``, ``ruledmesh --help`` and a small
+``ruledmesh build`` load, read from ``python -X importtime`` in a fresh process.
+
+Times are not asserted (the machine is shared); the figures are in
+benchmarks/startup.py and docs/benchmarks.md.  What is guarded is the set of modules:
+no scipy, no plotting, no exporter the command does not write.
+"""
+
+from __future__ import annotations
+
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+
+EXAMPLES = Path(__file__).parents[1] / "examples"
+
+# Never needed to start, nor for a small build written as OBJ.
+HEAVY = ("scipy", "matplotlib", "tqdm", "trimesh", "ezdxf", "rhino3dm", "ifcopenshell",
+         "spyrrow", "PIL", "jsonschema", "numba")
+LAZY_OURS = ("ruledmesh.render", "ruledmesh.web", "ruledmesh.structure", "ruledmesh.hops",
+             "ruledmesh.io.gltf", "ruledmesh.io.ifc", "ruledmesh.io.rhino", "ruledmesh.io.dxf",
+             "ruledmesh.io.stl", "ruledmesh.fabricate.nesting", "ruledmesh.fabricate.true_shape",
+             "ruledmesh.blender")
+
+
+def imported(code: str, cwd: Path) -> set[str]:
+    """Modules a fresh interpreter imports running ``code`` (from ``-X importtime``)."""
+    run = subprocess.run([sys.executable, "-X", "importtime", "-c", code], capture_output=True,
+                         text=True, cwd=cwd, timeout=300, check=False)
+    assert run.returncode == 0, run.stderr[-2000:]
+    names = set()
+    for line in run.stderr.splitlines():
+        if line.startswith("import time:") and "|" in line and "self [us]" not in line:
+            names.add(line.rsplit("|", 1)[1].strip())
+    assert "numpy" in names
+    return names
+
+
+def _offenders(names: set[str]) -> list[str]:
+    return sorted(n for n in names if n.split(".")[0] in HEAVY
+                  or any(n == m or n.startswith(m + ".") for m in LAZY_OURS))
+
+
+def test_import_ruledmesh_loads_no_heavy_module(tmp_path):
+    names = imported("import ruledmesh", tmp_path)
+    assert _offenders(names) == []
+    assert not any(n.startswith(("ruledmesh.pq", "ruledmesh.curves")) for n in names)
+
+
+def test_cli_help_loads_no_heavy_module(tmp_path):
+    names = imported("from ruledmesh.cli import main\ntry:\n    main(['--help'])\n"
+                     "except SystemExit:\n    pass", tmp_path)
+    assert _offenders(names) == []
+
+
+@pytest.mark.parametrize("example", ["skew", "fig7b-hyperboloid-circular"])
+def test_small_build_loads_no_scipy(tmp_path, example):
+    """A bundled design built to OBJ with its analysis summary: numpy only."""
+    code = (f"from ruledmesh.cli import main\n"
+            f"assert main(['build', {str(EXAMPLES / (example + '.toml'))!r}, '-o', 'm.obj']) == 0")
+    names = imported(code, tmp_path)
+    assert (tmp_path / "m.obj").is_file()
+    assert _offenders(names) == []
