@@ -42,6 +42,7 @@ from typing import Any, Mapping
 import numpy as np
 
 from ._validation import check_int, check_keys, check_points, describe
+from .budget import HYBRID_BYTES_PER_NODE, check_budget
 from .errors import DesignError, GeometryError, ParameterError
 from .mesh import FaceKind, Mesh
 from .registry import BuildContext, Built, surface_kind
@@ -300,6 +301,9 @@ def compound_mesh(P: Any, midpoints: int = 1, divisions: int = 8, border: str = 
         raise ParameterError(f'expected "notched" or "triangles", got {describe(border)}', "border")
     I, J = P.shape[0] - 1, P.shape[1] - 1
     CX, CY = I * nu, J * nv
+    check_budget(float(CX + 1) * (CY + 1), HYBRID_BYTES_PER_NODE,
+                 f"{I} x {J} patches x {nu} columns x {nv} divisions",
+                 "reduce the midpoints or the divisions", "divisions", ParameterError)
     x, y = np.meshgrid(np.arange(CX + 1), np.arange(CY + 1), indexing="ij")
     i, j = np.minimum(x // nu, I - 1), np.minimum(y // nv, J - 1)
     X = _bilinear(P, i, j, (x - i * nu) / nu, (y - j * nv) / nv)[0].reshape(-1, 3)

@@ -17,6 +17,7 @@ from typing import Any, Mapping
 
 import numpy as np
 
+from . import budget as _budget
 from ._validation import check_keys, describe, near_miss
 from .errors import DesignError, RuledMeshError
 from .progress import SILENT, Progress, Task, stages
@@ -64,11 +65,39 @@ def parse_design(text: str, source: str = "<design>", base_dir: str | os.PathLik
         data = tomllib.loads(text)
     except tomllib.TOMLDecodeError as exc:
         raise DesignError(f"invalid TOML: {exc}", None, source) from None
+    except RecursionError:
+        raise DesignError(f"invalid design: tables or arrays nested deeper than the TOML "
+                          f"reader can follow (a design needs at most {MAX_NESTING} levels)",
+                          None, source) from None
+    where = _too_deep(data)
+    if where is not None:
+        raise DesignError(f"nested more than {MAX_NESTING} levels deep; a design needs a few",
+                          where, source)
     try:
         check_keys(data, TOP_LEVEL, "", err=DesignError)
     except DesignError as exc:
         raise exc.with_source(source) from None
     return Design(data, source, Path(base_dir))
+
+
+# Deepest nesting of tables and arrays a design may have: the deepest real one
+# (transform tables holding a matrix) has 4; deeper data only makes every walker
+# over it recurse.
+MAX_NESTING = 32
+
+
+def _too_deep(data: Any) -> str | None:
+    """The dotted path at which ``data`` nests deeper than :data:`MAX_NESTING`, else ``None``."""
+    stack: list[tuple[Any, str, int]] = [(data, "", 0)]
+    while stack:
+        value, path, depth = stack.pop()
+        if depth > MAX_NESTING:
+            return path or None
+        if isinstance(value, Mapping):
+            stack.extend((v, f"{path}.{k}" if path else str(k), depth + 1) for k, v in value.items())
+        elif isinstance(value, list):
+            stack.extend((v, f"{path}[{i}]", depth + 1) for i, v in enumerate(value))
+    return None
 
 
 def load_design(path: str | os.PathLike) -> Design:
@@ -77,13 +106,16 @@ def load_design(path: str | os.PathLike) -> Design:
     A relative ``examples/NAME.toml`` that does not exist here is the bundled
     example of that name (:func:`ruledmesh.bundled.resolve`).
     """
+    from ._files import MAX_DESIGN_BYTES, FileRefused, read_capped
     from .bundled import resolve
 
     path = resolve(path)
     try:
-        text = path.read_text(encoding="utf-8")
+        text = read_capped(path, MAX_DESIGN_BYTES, "a design file").decode("utf-8")
     except FileNotFoundError:
         raise DesignError("file not found", None, str(path)) from None
+    except FileRefused as exc:
+        raise DesignError(str(exc.strerror), None, str(path)) from None
     except (OSError, UnicodeDecodeError) as exc:
         raise DesignError(f"cannot read: {exc}", None, str(path)) from None
     return parse_design(text, path.name, path.parent)
@@ -151,8 +183,7 @@ def _build_surface(design: Design, mesh_table: Mapping, task: Task) -> Built:
         method = mesh_table.get("method", "pq")
         if not isinstance(method, str) or method not in MESH_METHODS:
             raise _unknown("mesh.method", method, MESH_METHODS)
-        if method == "pq":
-            _check_budget(len(rulings), mesh_table.get("rows", 20))
+        _check_budget(len(rulings), mesh_table, method)
         built = MESH_METHODS[method](rulings, mesh_table, ctx)
     return built
 
@@ -170,21 +201,45 @@ def _apply_transforms(built: Built, transforms: list) -> Built:
 
 
 # Refuse builds whose estimated peak memory exceeds this, before allocating anything.
-MAX_BUILD_BYTES = 8 * 2**30
+MAX_BUILD_BYTES = _budget.MAX_BUILD_BYTES
 
 
-def _check_budget(generators: int, rows: Any) -> None:
-    """Refuse a §4.3 grid of ``generators x (rows + 1)`` points too large to build."""
-    from .rulings import BUILD_BYTES_PER_GRID_POINT
+def _count(table: Mapping, key: str, default: int) -> int | None:
+    """``table[key]`` when it is a usable count, else ``None`` (the mesher reports it)."""
+    value = table.get(key, default)
+    if isinstance(value, bool) or not isinstance(value, int) or value < 0:
+        return None
+    return value
 
-    if isinstance(rows, bool) or not isinstance(rows, int) or rows < 1:
-        return  # the mesher reports a malformed value itself
-    need = generators * (rows + 1) * BUILD_BYTES_PER_GRID_POINT
-    if need > MAX_BUILD_BYTES:
-        raise DesignError(
-            f"{generators} generators x {rows + 1} rows would need about {need / 2**30:.1f} GiB "
-            f"of memory (limit {MAX_BUILD_BYTES / 2**30:.0f} GiB); reduce the rows or the "
-            "generator count", "mesh.rows")
+
+def _check_budget(generators: int, mesh_table: Mapping, method: str) -> None:
+    """Refuse a grid too large to build, from every count that multiplies it.
+
+    §4.3: ``generators x (rows + 1) x (1 + 2 extend)``; hybrid:
+    ``(generators - 1)(midpoints + 1) + 1`` columns ``x (divisions + 1)``.
+    """
+    if method == "pq":
+        rows = _count(mesh_table, "rows", 20)
+        extend = mesh_table.get("extend", "auto")
+        if rows is None or rows < 1:
+            return
+        factor = 1.0
+        what = f"{generators} generators x {rows + 1} rows"
+        if isinstance(extend, (int, float)) and not isinstance(extend, bool) and 0 < extend <= 1e3:
+            factor = 1.0 + 2.0 * float(extend)
+            what += f" x (1 + 2 x extend {extend:g})"
+        _budget.check_budget(generators * (rows + 1) * factor, _budget.PQ_BYTES_PER_GRID_POINT,
+                             what, "reduce the rows, the extension or the generator count",
+                             "mesh.rows", DesignError)
+    elif method == "hybrid":
+        mid, div = _count(mesh_table, "midpoints", 1), _count(mesh_table, "divisions", 8)
+        if mid is None or div is None:
+            return
+        columns = (generators - 1) * (mid + 1) + 1
+        _budget.check_budget(columns * (div + 1), _budget.HYBRID_BYTES_PER_NODE,
+                             f"{columns} columns ({generators} generators, {mid} midpoints) x "
+                             f"{div + 1} rows", "reduce the divisions, the midpoints or the "
+                             "generator count", "mesh.divisions", DesignError)
 
 
 def curve_kinks(curve) -> np.ndarray:
