@@ -7,6 +7,7 @@ strict JSON, one planarity measure, and examples that say what they build.
 
 from __future__ import annotations
 
+import json
 import os
 import subprocess
 import sys
@@ -193,3 +194,196 @@ def test_hybrid_and_compound_refuse_huge_grids():
 
 def test_every_refusal_is_a_ruledmesh_error():
     assert issubclass(GeometryError, RuledMeshError) and issubclass(DesignError, RuledMeshError)
+
+
+# ------------------------------------------------------------ empty and partial meshes
+def test_untrimmed_all_torsal_build_is_refused_not_empty(tmp_path, capsys):
+    path = tmp_path / "case.toml"
+    arcs = "".join(f'[curves.{n}]\ntype = "arc"\ncenter = [0, 0, {z}]\nradius = 1\n'
+                   f"normal = [0, 0, 1]\nstart_angle = 0\nend_angle = 180\n"
+                   for n, z in (("c1", 0), ("c2", 2)))
+    path.write_text(arcs + '[rulings]\nbetween = ["c1", "c2"]\ncount = 9\n[mesh]\nrows = 8\n'
+                    "trim = false\n")
+    line = one_error_line(*run_cli(capsys, "build", str(path), "-o", str(tmp_path / "o.obj"))[::2])
+    assert "has no faces" in line and "torsal" in line and "trim = true" in line
+    assert not (tmp_path / "o.obj").exists()
+
+
+def test_far_axis_rotational_is_refused_not_silent(tmp_path, capsys):
+    text = (EXAMPLES / "sec2-rotational.toml").read_text().replace("point = [0, 0, 0]",
+                                                                    "point = [1e30, 0, 0]")
+    path = tmp_path / "case.toml"
+    path.write_text(text)
+    line = one_error_line(*run_cli(capsys, "build", str(path), "-o", str(tmp_path / "o.obj"))[::2])
+    assert "has no area" in line and "float64 resolution" in line
+
+
+def test_tiny_generators_are_refused_with_the_range():
+    from ruledmesh.hybrid import hybrid_mesh
+
+    a, b = hyperboloid_lines()
+    with pytest.raises(GeometryError, match="at least 1e-60 across"):
+        hybrid_mesh(a * 1e-100, b * 1e-100)
+
+
+def test_low_coverage_is_warned_with_how_much(tmp_path, capsys):
+    text = (EXAMPLES / "fig7c-hyperboloid-generators.toml").read_text()
+    path = tmp_path / "case.toml"
+    path.write_text(text.replace("height = 1.5", "height = 2.0"))
+    code, out, err = run_cli(capsys, "build", str(path), "-o", str(tmp_path / "o.obj"))
+    assert code == 0 and "coverage 0.677" in out
+    assert "crossings reach |z| = 1.5, not the height 2" in err
+    assert "the mesh covers 67.7% of the designed patch" in err
+
+
+def test_analyze_measures_coverage_against_the_designed_patch():
+    from ruledmesh.analysis.report import analyze
+    from ruledmesh.api import build_full
+
+    text = (EXAMPLES / "fig7c-hyperboloid-generators.toml").read_text()
+    short = build_full(text.replace("height = 1.5", "height = 2.0"))
+    report = analyze(short.mesh, reference=short.reference, extras=short.extras)
+    # The reference is |z| <= 2 as designed, not the |z| <= 1.5 the mesh reaches.
+    assert report["coverage"]["ratio"] == pytest.approx(0.677, abs=0.002)
+    assert any("covers 67.7%" in w for w in report["warnings"])
+
+
+def test_notched_compound_coverage_is_warned(tmp_path, capsys):
+    text = (EXAMPLES / "compound-hp-strip.toml").read_text()
+    path = tmp_path / "case.toml"
+    path.write_text(text.replace('border = "triangles"', 'border = "notched"'))
+    code, _, err = run_cli(capsys, "build", str(path), "-o", str(tmp_path / "o.obj"))
+    assert code == 0 and "the mesh covers 72.9% of the designed patch" in err
+
+
+# ------------------------------------------------------------ scale and strict JSON
+@pytest.mark.parametrize("mesher", ["pq", "hybrid"])
+def test_meshes_are_the_same_at_every_scale(mesher):
+    from ruledmesh.hybrid import hybrid_mesh
+    from ruledmesh.pq import pq_mesh
+
+    fn = pq_mesh if mesher == "pq" else hybrid_mesh
+    a, b = hyperboloid_lines()
+    a, b = a + [0.3, 0.1, 0.7], b + [0.3, 0.1, 0.7]
+    ref = fn(a, b)
+    for k in (-190, -100, -40, 40, 100, 190):        # 2**k: exact scalings, 1e-57 .. 1e57
+        s = 2.0**k
+        mesh = fn(a * s, b * s)
+        assert np.array_equal(mesh.face_indices, ref.face_indices)
+        assert np.array_equal(mesh.vertices, ref.vertices * s)
+    for s in (1e-50, 1e-20, 1e20, 1e50):              # other scales: same faces, rounding apart
+        mesh = fn(a * s, b * s)
+        assert np.array_equal(mesh.face_indices, ref.face_indices)
+        np.testing.assert_allclose(mesh.vertices / s, ref.vertices, atol=1e-12)
+
+
+def test_coordinates_beyond_the_range_are_refused_naming_it():
+    from ruledmesh.pq import pq_mesh
+
+    a, b = hyperboloid_lines()
+    with pytest.raises(GeometryError, match=r"within \+-1e\+60"):
+        pq_mesh(a * 1e100, b * 1e100)
+
+
+def _strict_loads(text: str) -> dict:
+    def refuse(name: str) -> None:
+        raise ValueError(f"non-strict JSON constant {name}")
+
+    return json.loads(text, parse_constant=refuse)
+
+
+def test_analyze_json_of_a_mesh_near_the_float_limit_is_strict(tmp_path, capsys):
+    from ruledmesh.io import save
+    from ruledmesh.mesh import Mesh
+
+    quad = np.array([[0, 0, 0], [1, 0, 0], [1, 1, 0], [0, 1, 0]], dtype=float) * 1e307
+    path = tmp_path / "big.json"
+    save(path, Mesh.from_faces(quad, [[0, 1, 2, 3]]))
+    code, out, err = run_cli(capsys, "analyze", str(path), "--json")
+    assert code == 0 and err == ""
+    report = _strict_loads(out)
+    assert report["planarity"]["max"] == 0.0 and report["faces"] == 1
+    assert "area.total" in report["non_finite"]
+    assert any("beyond float64" in w for w in report["warnings"])
+
+
+def test_analysis_is_the_same_at_every_scale():
+    from ruledmesh.analysis.report import analyze
+    from ruledmesh.pq import pq_mesh
+
+    a, b = hyperboloid_lines()
+    ref = analyze(pq_mesh(a, b))
+    for s in (2.0**-180, 2.0**180):
+        rep = analyze(pq_mesh(a * s, b * s))
+        assert rep["planarity"] == ref["planarity"]
+        assert rep["quality"] == ref["quality"]
+        assert rep["area"]["total"] == ref["area"]["total"] * s * s
+
+
+# ------------------------------------------------------------ one planarity measure
+def test_fabricate_accepts_what_build_reports_planar():
+    """Needle triangles: the plane fit of the old rule called 18 of 20 "bent panels"."""
+    from ruledmesh.analysis.planar import bent_faces
+    from ruledmesh.analysis.report import analyze
+    from ruledmesh.fabricate.unroll import unroll
+    from ruledmesh.mesh import Mesh
+
+    rng = np.random.default_rng(1)
+    corners = []
+    for _ in range(20):
+        a, d, e = rng.normal(size=(3, 3))
+        d /= np.linalg.norm(d)
+        e -= e.dot(d) * d
+        e /= np.linalg.norm(e)
+        corners += [a, a + d, a + 0.5 * d + 3e-8 * e]   # area 1.5e-8 of the longest edge squared
+    mesh = Mesh.from_faces(np.array(corners), np.arange(60).reshape(20, 3))
+    assert analyze(mesh)["planarity"]["above_tolerance"] == 0
+    assert not bent_faces(mesh)[0].any()
+    assert unroll(mesh).n_faces == 20     # no GeometryError: triangles are planar
+
+
+def test_fabricate_and_analyze_name_the_same_bent_face():
+    from ruledmesh.analysis.report import analyze
+    from ruledmesh.errors import GeometryError as GE
+    from ruledmesh.fabricate.unroll import unroll
+    from ruledmesh.pq import pq_mesh
+
+    a, b = hyperboloid_lines()
+    mesh = pq_mesh(a, b)
+    v = mesh.vertices.copy()
+    v[mesh.face_indices[mesh.face_offsets[3]]] += [0, 0, 1e-3]
+    bent = mesh.with_vertices(v)
+    report = analyze(bent)
+    with pytest.raises(GE, match=f"{report['planarity']['above_tolerance']} faces are not planar"):
+        unroll(bent)
+
+
+# ------------------------------------------------------------ examples tell the truth
+def test_lines_hyperboloid_example_is_exact():
+    from ruledmesh import build
+
+    v = build(EXAMPLES / "lines-hyperboloid.toml").vertices
+    assert np.abs(v[:, 0] ** 2 + v[:, 1] ** 2 - v[:, 2] ** 2 - 1).max() < 1e-14
+
+
+def _report(name: str) -> dict:
+    from ruledmesh.analysis.report import analyze
+    from ruledmesh.api import build_full
+
+    built = build_full(EXAMPLES / f"{name}.toml")
+    return analyze(built.mesh, reference=built.reference, extras=built.extras)
+
+
+def test_fig3b_is_labelled_congruent_parallelograms():
+    report = _report("fig3b-strips-congruent")
+    assert report["guarantee"] == "parallelograms (congruent polygons)"
+    assert report["guarantee_check"]["met"]
+    assert _report("fig3c-strips-similar")["guarantee"] == "trapezoids (similar polygons)"
+
+
+@pytest.mark.parametrize("name", ["compound-hp-strip", "compound-hp-grid",
+                                  "fig7c-hyperboloid-generators"])
+def test_examples_cover_their_design(name):
+    report = _report(name)
+    assert abs(report["coverage"]["ratio"] - 1) < 0.01
+    assert not any("covers" in w for w in report["warnings"])

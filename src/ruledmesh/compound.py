@@ -43,6 +43,7 @@ import numpy as np
 
 from ._validation import check_int, check_keys, check_points, describe
 from .budget import HYBRID_BYTES_PER_NODE, check_budget
+from .budget import HYBRID_BYTES_PER_NODE, check_budget
 from .errors import DesignError, GeometryError, ParameterError
 from .mesh import FaceKind, Mesh
 from .registry import BuildContext, Built, surface_kind
@@ -283,7 +284,8 @@ def compound_mesh(P: Any, midpoints: int = 1, divisions: int = 8, border: str = 
     border : {"notched", "triangles"}
         ``"notched"``: only whole quads (the border is a zig-zag touching the
         patch border at every other node); ``"triangles"``: also the half
-        faces along the border, as triangles, so the mesh reaches the border.
+        faces along the border, as triangles, so the mesh reaches the border
+        (notched covers about three quarters of the patch at the default counts).
 
     Returns
     -------
@@ -301,6 +303,9 @@ def compound_mesh(P: Any, midpoints: int = 1, divisions: int = 8, border: str = 
         raise ParameterError(f'expected "notched" or "triangles", got {describe(border)}', "border")
     I, J = P.shape[0] - 1, P.shape[1] - 1
     CX, CY = I * nu, J * nv
+    check_budget(float(CX + 1) * (CY + 1), HYBRID_BYTES_PER_NODE,
+                 f"{I} x {J} patches x {nu} columns x {nv} divisions",
+                 "reduce the midpoints or the divisions", "divisions", ParameterError)
     check_budget(float(CX + 1) * (CY + 1), HYBRID_BYTES_PER_NODE,
                  f"{I} x {J} patches x {nu} columns x {nv} divisions",
                  "reduce the midpoints or the divisions", "divisions", ParameterError)

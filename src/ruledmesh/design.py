@@ -19,7 +19,7 @@ import numpy as np
 
 from . import budget as _budget
 from ._validation import check_keys, describe, near_miss
-from .errors import DesignError, RuledMeshError
+from .errors import DesignError, GeometryError, RuledMeshError
 from .progress import SILENT, Progress, Task, stages
 from .registry import (MESH_METHODS, SURFACE_KINDS, TRANSFORMS, BuildContext, Built,
                        load_plugins)
@@ -143,9 +143,13 @@ def _build(design: Design, progress: Progress) -> Built:
     names = ([] if "surface" in data else ["generators"]) + ["mesh"] + ["transforms"] * bool(transforms)
     with stages(progress, "build", names) as task:
         built = _build_surface(design, mesh_table, task)
+        hint = ("; trim = true closes torsal strips with triangles"
+                if mesh_table.get("trim") is False else "")
+        _in_range(built.mesh, "the mesh", hint)
         task.advance(note="transforms" if transforms else None)
         built = _apply_transforms(built, transforms)
         if transforms:
+            _in_range(built.mesh, "the transformed mesh")
             task.advance()
     from dataclasses import replace
 
@@ -186,6 +190,36 @@ def _build_surface(design: Design, mesh_table: Mapping, task: Task) -> Built:
         _check_budget(len(rulings), mesh_table, method)
         built = MESH_METHODS[method](rulings, mesh_table, ctx)
     return built
+
+
+def _in_range(mesh: Any, what: str, hint: str = "") -> None:
+    """Refuse a mesh that is empty, all degenerate, or beyond the coordinate range.
+
+    A build never ends with a mesh that has nothing to fabricate: no faces, or
+    only faces without area (the design's features below float64 resolution at
+    its size), or coordinates outside what the analysis and the file formats
+    hold faithfully (:func:`ruledmesh.normalise.check_range`).  The message
+    passes on what the mesher said about the parts it could not mesh.
+    """
+    from .analysis.faces import degenerate_faces
+    from .normalise import check_range, unit_frame
+
+    v = np.asarray(mesh.vertices, dtype=np.float64)
+    said = "; ".join(str(w) for w in mesh.info.get("warnings", [])[:2])
+    said = f" ({said})" if said else ""
+    if mesh.n_faces == 0:
+        raise GeometryError(f"{what} has no faces: nothing of the design could be meshed"
+                            f"{said}{hint}")
+    if not np.all(np.isfinite(v)):
+        raise GeometryError(f"{what} has NaN or infinite coordinates; check the numbers of "
+                            "the design (an angle, a scale, a far axis point)")
+    check_range(v, what)
+    centre, scale = unit_frame(v)
+    if np.all(degenerate_faces(mesh.with_vertices((v - centre) / scale))):
+        extent = float(np.linalg.norm(np.ptp(v, axis=0)))
+        raise GeometryError(f"every one of the {mesh.n_faces} faces of {what} has no area: the "
+                            f"design's features are below float64 resolution at its size "
+                            f"({extent:.3g} across); bring its parts to comparable sizes{said}")
 
 
 def _apply_transforms(built: Built, transforms: list) -> Built:

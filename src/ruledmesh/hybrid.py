@@ -46,6 +46,7 @@ from ._validation import check_bool, check_int, check_keys, check_points
 from .budget import HYBRID_BYTES_PER_NODE, MAX_BUILD_BYTES, gib
 from .errors import DesignError, GeometryError, ParameterError
 from .mesh import FaceKind, Mesh
+from .normalise import normalised
 from .registry import BuildContext, Built, mesh_method
 from .tolerances import DEFAULT, Tolerances
 
@@ -419,6 +420,7 @@ def _repair(V: np.ndarray, faces: list[np.ndarray], members: np.ndarray, member_
 
 
 # --------------------------------------------------------------------------- public
+@normalised  # meshes in a unit frame: results do not depend on scale
 def hybrid_mesh(a: Any, b: Any, *, midpoints: int = 1, divisions: int = 8, flip: bool = False,
                 orient: bool = True, tol: Tolerances = DEFAULT) -> Mesh:
     """Hybrid mesh of planar quads and triangles from any set of generators (§4.1).

@@ -10,6 +10,7 @@ from .._validation import check_bool, check_float, check_int, check_points, desc
 from ..errors import GeometryError, ParameterError
 from ..hop import coplanarity
 from ..mesh import Mesh
+from ..normalise import normalised
 from ..tolerances import DEFAULT, Tolerances
 from .assemble import assemble
 from .runs import (
@@ -179,6 +180,7 @@ def _listed(ks: np.ndarray) -> str:
     return ", ".join(f"{k}-{k + 1}" for k in ks[:8].tolist()) + (" ..." if ks.size > 8 else "")
 
 
+@normalised  # meshes in a unit frame: results do not depend on scale
 def pq_mesh(a, b, rows: int = 20, primary: int | str = "middle", option: int = 0,
             extend: float | str = "auto", trim: bool = True, *, max_extend: float = 20.0,
             creases=None, crease_generators=None, planarity_tolerance: float | None = None,
