@@ -387,3 +387,27 @@ def test_examples_cover_their_design(name):
     report = _report(name)
     assert abs(report["coverage"]["ratio"] - 1) < 0.01
     assert not any("covers" in w for w in report["warnings"])
+
+
+# ------------------------------------------------------------ reports say what they count
+def test_compare_reports_the_triangle_share_by_area_and_labels_the_count(capsys):
+    code, out, _ = run_cli(capsys, "compare", str(EXAMPLES / "fig10-skew-surface.toml"),
+                           "--rows", "16")
+    assert code == 0
+    rows = {ln[:28].strip(): ln[28:].split() for ln in out.splitlines()[1:]}
+    assert "area in triangles" in rows and "triangles (of the faces)" in rows
+    area_pq, count_pq = (float(rows[k][0].rstrip("%")) for k in
+                         ("area in triangles", "triangles (of the faces)"))
+    assert area_pq < count_pq  # the PQ mesh's triangles are small: area and count differ
+
+
+def test_hybrid_torsal_lines_t_junction_is_reported():
+    report = _report("hybrid-torsal-lines")
+    assert report["t_junctions"]["count"] == 1
+    v, a, b = report["t_junctions"]["first"][0]
+    from ruledmesh import build
+
+    P = build(EXAMPLES / "hybrid-torsal-lines.toml").vertices
+    np.testing.assert_allclose(P[v], 0.5 * (P[a] + P[b]), atol=1e-12)   # at the midpoint
+    assert any("T-junctions" in w for w in report["warnings"])
+    assert _report("hybrid-fig9")["t_junctions"]["count"] == 0

@@ -12,6 +12,8 @@ Figures (relative ones are divided by the bounding-box diagonal):
 * ``guarantee_check`` (when a construction states a ``guarantee``): each
   promised property measured (:mod:`.guarantees`); a promise the figures do
   not confirm becomes a warning;
+* ``t_junctions``: vertices inside an edge of a neighbouring face (:mod:`.conformity`),
+  with a warning;
 * ``matches_design`` (with a reference surface): False, with a warning, when
   closeness or coverage is far off (the mesh is not one of that design).
 
@@ -267,8 +269,17 @@ def _figures(mesh: Mesh, tol: Tolerances) -> dict[str, Any]:
         "min_angle_deg": float(angles.min()) if angles.size else 0.0,
         "quality": _quality(mesh, tol),
         "euler_characteristic": mesh.euler_characteristic(len(edges)),
+        "t_junctions": _t_junctions(mesh),
     }
     return report
+
+
+def _t_junctions(mesh: Mesh) -> dict[str, Any]:
+    """T-junctions (:mod:`.conformity`): how many, and the first few ``[vertex, a, b]``."""
+    from .conformity import t_junctions
+
+    found = t_junctions(mesh)
+    return {"count": int(len(found)), "first": found[:5].tolist()}
 
 
 def _closeness(mesh: Mesh, reference, mesh_area: float) -> dict[str, Any]:
@@ -327,6 +338,12 @@ def _warnings(mesh: Mesh, report: dict[str, Any], tol: Tolerances) -> list[str]:
     if mesh.n_faces and 1.0 - share["quads"] > 0.3 and not said:
         warnings.append(f"{1.0 - share['quads']:.0%} of the area is not in quads "
                         f"(by kind: {_shares(share['by_kind'])})")
+    tj = report["t_junctions"]
+    if tj["count"]:
+        v, a, b = tj["first"][0]
+        warnings.append(f"{tj['count']} T-junctions: vertex {v} lies inside the edge {a}-{b} of a "
+                        "neighbouring face (conforming by connectivity, not geometrically: "
+                        "welding or smoothing in another program would open a gap there)")
     if report["quality"]["degenerate_faces"]:
         warnings.append(f"{report['quality']['degenerate_faces']} faces have no area")
     if report["planarity"]["above_tolerance"]:
