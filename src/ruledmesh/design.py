@@ -69,10 +69,7 @@ def parse_design(text: str, source: str = "<design>", base_dir: str | os.PathLik
         raise DesignError(f"invalid design: tables or arrays nested deeper than the TOML "
                           f"reader can follow (a design needs at most {MAX_NESTING} levels)",
                           None, source) from None
-    where = _too_deep(data)
-    if where is not None:
-        raise DesignError(f"nested more than {MAX_NESTING} levels deep; a design needs a few",
-                          where, source)
+    _check_tree(data, source)
     try:
         check_keys(data, TOP_LEVEL, "", err=DesignError)
     except DesignError as exc:
@@ -86,18 +83,32 @@ def parse_design(text: str, source: str = "<design>", base_dir: str | os.PathLik
 MAX_NESTING = 32
 
 
-def _too_deep(data: Any) -> str | None:
-    """The dotted path at which ``data`` nests deeper than :data:`MAX_NESTING`, else ``None``."""
+def _check_tree(data: Any, source: str) -> None:
+    """Refuse nesting deeper than :data:`MAX_NESTING` and numbers beyond the coordinate range.
+
+    No field of a design needs a number larger than
+    :data:`ruledmesh.normalise.MAX_COORDINATE` (coordinates, lengths, angles in
+    degrees, counts); such a number only overflows somewhere inside a build.
+    NaN and infinity are left to the fields' own checks, which say "finite".
+    """
+    from .normalise import MAX_COORDINATE
+
     stack: list[tuple[Any, str, int]] = [(data, "", 0)]
     while stack:
         value, path, depth = stack.pop()
         if depth > MAX_NESTING:
-            return path or None
+            raise DesignError(f"nested more than {MAX_NESTING} levels deep; a design needs a "
+                              "few", path or None, source)
         if isinstance(value, Mapping):
             stack.extend((v, f"{path}.{k}" if path else str(k), depth + 1) for k, v in value.items())
         elif isinstance(value, list):
             stack.extend((v, f"{path}[{i}]", depth + 1) for i, v in enumerate(value))
-    return None
+        elif (isinstance(value, (int, float)) and not isinstance(value, bool)
+              and abs(value) > MAX_COORDINATE and abs(value) != float("inf")):
+            shown = (f"{value:.3g}" if isinstance(value, float)
+                     else f"an integer of {len(str(abs(value)))} digits")
+            raise DesignError(f"expected a number within +-{MAX_COORDINATE:g}, got {shown}",
+                              path or None, source)
 
 
 def load_design(path: str | os.PathLike) -> Design:
