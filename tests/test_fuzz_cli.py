@@ -54,7 +54,7 @@ def shrink(text: str) -> str:
     """The example with its counts capped, so a build costs little."""
     for pattern, cap in _CAPS:
         text = re.sub(pattern, lambda m, c=cap: m.group(1) + str(min(int(m.group(2)), c)),
-                      text, flags=re.M)
+                      text, flags=re.MULTILINE)
     return text
 
 

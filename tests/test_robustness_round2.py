@@ -411,3 +411,47 @@ def test_hybrid_torsal_lines_t_junction_is_reported():
     np.testing.assert_allclose(P[v], 0.5 * (P[a] + P[b]), atol=1e-12)   # at the midpoint
     assert any("T-junctions" in w for w in report["warnings"])
     assert _report("hybrid-fig9")["t_junctions"]["count"] == 0
+
+
+# ------------------------------------------------------------ found by tests/test_fuzz_cli.py
+@pytest.mark.parametrize(("example", "old", "new", "message"), [
+    ("fig7b-hyperboloid-circular", "a = 1.0", "a = 5e-324",
+     "surface.a: expected 0 or a number of magnitude at least 1e-60"),
+    ("fig7b-hyperboloid-circular", "height = 2.0", "height = 1e308",
+     "surface.height: expected a number within +-1e+60"),
+    ("right-conoid-arc", "end_angle = 180", "end_angle = 5e-324",
+     "curves.arc.end_angle: expected 0 or a number of magnitude at least 1e-60"),
+    ("skew", "[3, 1, 0]", "[3, 1e308, 0]", "curves.c1.points[1][1]: expected a number within"),
+])
+def test_design_numbers_that_would_overflow_are_refused(tmp_path, capsys, example, old, new,
+                                                         message):
+    text = (EXAMPLES / f"{example}.toml").read_text()
+    assert old in text
+    path = tmp_path / "case.toml"
+    path.write_text(text.replace(old, new, 1))
+    line = one_error_line(*run_cli(capsys, "build", str(path), "-o", str(tmp_path / "o.obj"))[::2])
+    assert message in line
+
+
+def test_arc_start_angle_of_6e301_degrees_is_refused(tmp_path, capsys):
+    path = tmp_path / "case.toml"
+    path.write_text(TWO_LINES.replace('type = "line"\npoints = [[0, 0, 0], [4, 0, 0]]',
+                                      'type = "arc"\ncenter = [0, 0, 0]\nradius = 2\n'
+                                      "normal = [0, 0, 1]\nstart_angle = 6e301\nend_angle = 90")
+                    + '[rulings]\nbetween = ["c1", "c2"]\n')
+    code, out, err = run_cli(capsys, "analyze", str(path), "--json")
+    assert "start_angle: expected a number within" in one_error_line(code, err) and out == ""
+
+
+def test_compound_seed_far_out_of_proportion_does_not_overflow(tmp_path, capsys):
+    import warnings
+
+    text = (EXAMPLES / "compound-hp-grid.toml").read_text()
+    path = tmp_path / "case.toml"
+    path.write_text(text.replace("[0.0, 1.5, 0.4]", "[0.0, 1e30, 0.4]"))
+    with warnings.catch_warnings():
+        warnings.simplefilter("error", RuntimeWarning)
+        code, _, err = run_cli(capsys, "build", str(path), "-o", str(tmp_path / "o.obj"))
+    assert "Warning" not in err and code in (0, 2), err
+    if code == 2:
+        one_error_line(code, err)

@@ -398,7 +398,15 @@ def build_compound(surface: Mapping[str, Any], mesh_table: Mapping[str, Any],
     if border not in ("notched", "triangles"):
         raise DesignError(f'expected "notched" or "triangles", got {describe(border)}',
                           "mesh.border")
-    P, gap = compound_net(arr, steps["u_steps"], steps["v_steps"])
+    # The steps are ratios and slides along the joints (affine-invariant): the net is
+    # grown in the seed's unit frame and mapped back, so its arithmetic never
+    # overflows; a net that is not finite is refused by compound_net.
+    from .normalise import unit_frame
+
+    centre, unit = unit_frame(arr.reshape(4, 3))
+    with np.errstate(all="ignore"):
+        P, gap = compound_net((arr - centre) / unit, steps["u_steps"], steps["v_steps"])
+    P, gap = P * unit + centre, gap * unit
     mesh = compound_mesh(P, midpoints, divisions, border)
     c1 = c1_residual(P)
     scale = float(np.linalg.norm(np.ptp(P.reshape(-1, 3), axis=0))) or 1.0

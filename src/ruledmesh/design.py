@@ -9,6 +9,7 @@ dotted field path and what was expected (see ``docs/design-reference.md``).
 
 from __future__ import annotations
 
+import math
 import os
 import tomllib
 from dataclasses import dataclass
@@ -81,6 +82,7 @@ def parse_design(text: str, source: str = "<design>", base_dir: str | os.PathLik
 # (transform tables holding a matrix) has 4; deeper data only makes every walker
 # over it recurse.
 MAX_NESTING = 32
+_SMALLEST_NORMAL = 2.2250738585072014e-308
 
 
 def _check_tree(data: Any, source: str) -> None:
@@ -88,11 +90,12 @@ def _check_tree(data: Any, source: str) -> None:
 
     No field of a design needs a number larger than
     :data:`ruledmesh.normalise.MAX_COORDINATE` (coordinates, lengths, angles in
-    degrees, counts); such a number only overflows somewhere inside a build.
+    degrees, counts), nor a non-zero scalar of a surface or curve below
+    :data:`~ruledmesh.normalise.MIN_EXTENT`, nor a subnormal number anywhere;
+    such a number only overflows or divides by zero somewhere inside a build
+    (a semi-axis of 5e-324).
     NaN and infinity are left to the fields' own checks, which say "finite".
     """
-    from .normalise import MAX_COORDINATE
-
     stack: list[tuple[Any, str, int]] = [(data, "", 0)]
     while stack:
         value, path, depth = stack.pop()
@@ -103,12 +106,30 @@ def _check_tree(data: Any, source: str) -> None:
             stack.extend((v, f"{path}.{k}" if path else str(k), depth + 1) for k, v in value.items())
         elif isinstance(value, list):
             stack.extend((v, f"{path}[{i}]", depth + 1) for i, v in enumerate(value))
-        elif (isinstance(value, (int, float)) and not isinstance(value, bool)
-              and abs(value) > MAX_COORDINATE and abs(value) != float("inf")):
-            shown = (f"{value:.3g}" if isinstance(value, float)
-                     else f"an integer of {len(str(abs(value)))} digits")
-            raise DesignError(f"expected a number within +-{MAX_COORDINATE:g}, got {shown}",
-                              path or None, source)
+        elif isinstance(value, (int, float)) and not isinstance(value, bool):
+            _check_number(value, path, source)
+
+
+def _check_number(value: float, path: str, source: str) -> None:
+    """Refuse a number no design field needs (see :func:`_check_tree`)."""
+    from .normalise import MAX_COORDINATE, MIN_EXTENT
+
+    size = abs(value)
+    if math.isinf(size) or math.isnan(size):
+        return  # the field's own check says "finite"
+    shown = (f"{value:.3g}" if isinstance(value, float)
+             else f"an integer of {len(str(abs(value)))} digits")
+    if size > MAX_COORDINATE:
+        raise DesignError(f"expected a number within +-{MAX_COORDINATE:g}, got {shown}",
+                          path or None, source)
+    # A scalar of a surface or curve (a radius, a semi-axis, a pitch, an angle) sets a size
+    # or a sweep: a tiny one divides by zero inside the construction.  Points in arrays
+    # may hold tiny coordinates (rounding noise next to the others).
+    scalar = path.split(".")[0] in ("surface", "curves") and not path.endswith("]")
+    if 0 < size < (MIN_EXTENT if scalar else _SMALLEST_NORMAL):
+        raise DesignError(f"expected 0 or a number of magnitude at least "
+                          f"{MIN_EXTENT if scalar else _SMALLEST_NORMAL:.3g}, got {shown}",
+                          path or None, source)
 
 
 def load_design(path: str | os.PathLike) -> Design:
