@@ -87,7 +87,7 @@ def main(argv: Sequence[str] | None = None) -> int:
 
     Exit codes: 0 success, 2 bad input (design file, parameters, files),
     3 an internal error (a bug: please report it with ``--debug`` output),
-    130 interrupted.
+    130 interrupted, 141 the reader of stdout went away (``| head``).
     """
     parser = build_parser()
     args = parser.parse_args(argv)
