@@ -233,7 +233,7 @@ def _in_range(mesh: Any, what: str, hint: str = "") -> None:
     hold faithfully (:func:`ruledmesh.normalise.check_range`).  The message
     passes on what the mesher said about the parts it could not mesh.
     """
-    from .analysis.faces import degenerate_faces
+    from .analysis.faces import degenerate_faces, face_normals
     from .normalise import check_range, unit_frame
 
     v = np.asarray(mesh.vertices, dtype=np.float64)
@@ -246,9 +246,13 @@ def _in_range(mesh: Any, what: str, hint: str = "") -> None:
         raise GeometryError(f"{what} has NaN or infinite coordinates; check the numbers of "
                             "the design (an angle, a scale, a far axis point)")
     check_range(v, what)
+    _, area = face_normals(mesh)
+    extent = float(np.linalg.norm(np.ptp(v, axis=0)))
+    # Cheap first: one face of real area (relative to the whole) settles it.
+    if area.max() > 1e-6 * extent * extent:
+        return
     centre, scale = unit_frame(v)
     if np.all(degenerate_faces(mesh.with_vertices((v - centre) / scale))):
-        extent = float(np.linalg.norm(np.ptp(v, axis=0)))
         raise GeometryError(f"every one of the {mesh.n_faces} faces of {what} has no area: the "
                             f"design's features are below float64 resolution at its size "
                             f"({extent:.3g} across); bring its parts to comparable sizes{said}")
