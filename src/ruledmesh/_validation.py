@@ -17,7 +17,7 @@ from typing import Any, TypeVar
 
 import numpy as np
 
-from .errors import ParameterError
+from .errors import ParameterError, printable
 
 E = TypeVar("E", bound=Enum)
 
@@ -37,7 +37,7 @@ __all__ = [
 def describe(value: Any) -> str:
     """A short, quoted description of a received value for an error message."""
     if isinstance(value, str):
-        return f'"{value}"'
+        return f'"{printable(value)}"'
     if isinstance(value, bool):
         return "true" if value else "false"
     if isinstance(value, np.ndarray):

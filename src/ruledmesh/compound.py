@@ -42,6 +42,8 @@ from typing import Any, Mapping
 import numpy as np
 
 from ._validation import check_int, check_keys, check_points, describe
+from .budget import HYBRID_BYTES_PER_NODE, check_budget
+from .budget import HYBRID_BYTES_PER_NODE, check_budget
 from .errors import DesignError, GeometryError, ParameterError
 from .mesh import FaceKind, Mesh
 from .registry import BuildContext, Built, surface_kind
@@ -282,7 +284,8 @@ def compound_mesh(P: Any, midpoints: int = 1, divisions: int = 8, border: str = 
     border : {"notched", "triangles"}
         ``"notched"``: only whole quads (the border is a zig-zag touching the
         patch border at every other node); ``"triangles"``: also the half
-        faces along the border, as triangles, so the mesh reaches the border.
+        faces along the border, as triangles, so the mesh reaches the border
+        (notched covers about three quarters of the patch at the default counts).
 
     Returns
     -------
@@ -300,6 +303,12 @@ def compound_mesh(P: Any, midpoints: int = 1, divisions: int = 8, border: str = 
         raise ParameterError(f'expected "notched" or "triangles", got {describe(border)}', "border")
     I, J = P.shape[0] - 1, P.shape[1] - 1
     CX, CY = I * nu, J * nv
+    check_budget(float(CX + 1) * (CY + 1), HYBRID_BYTES_PER_NODE,
+                 f"{I} x {J} patches x {nu} columns x {nv} divisions",
+                 "reduce the midpoints or the divisions", "divisions", ParameterError)
+    check_budget(float(CX + 1) * (CY + 1), HYBRID_BYTES_PER_NODE,
+                 f"{I} x {J} patches x {nu} columns x {nv} divisions",
+                 "reduce the midpoints or the divisions", "divisions", ParameterError)
     x, y = np.meshgrid(np.arange(CX + 1), np.arange(CY + 1), indexing="ij")
     i, j = np.minimum(x // nu, I - 1), np.minimum(y // nv, J - 1)
     X = _bilinear(P, i, j, (x - i * nu) / nu, (y - j * nv) / nv)[0].reshape(-1, 3)
@@ -389,7 +398,15 @@ def build_compound(surface: Mapping[str, Any], mesh_table: Mapping[str, Any],
     if border not in ("notched", "triangles"):
         raise DesignError(f'expected "notched" or "triangles", got {describe(border)}',
                           "mesh.border")
-    P, gap = compound_net(arr, steps["u_steps"], steps["v_steps"])
+    # The steps are ratios and slides along the joints (affine-invariant): the net is
+    # grown in the seed's unit frame and mapped back, so its arithmetic never
+    # overflows; a net that is not finite is refused by compound_net.
+    from .normalise import unit_frame
+
+    centre, unit = unit_frame(arr.reshape(4, 3))
+    with np.errstate(all="ignore"):
+        P, gap = compound_net((arr - centre) / unit, steps["u_steps"], steps["v_steps"])
+    P, gap = P * unit + centre, gap * unit
     mesh = compound_mesh(P, midpoints, divisions, border)
     c1 = c1_residual(P)
     scale = float(np.linalg.norm(np.ptp(P.reshape(-1, 3), axis=0))) or 1.0

@@ -9,6 +9,7 @@ dotted field path and what was expected (see ``docs/design-reference.md``).
 
 from __future__ import annotations
 
+import math
 import os
 import tomllib
 from dataclasses import dataclass
@@ -17,8 +18,9 @@ from typing import Any, Mapping
 
 import numpy as np
 
+from . import budget as _budget
 from ._validation import check_keys, describe, near_miss
-from .errors import DesignError, RuledMeshError
+from .errors import DesignError, GeometryError, RuledMeshError
 from .progress import SILENT, Progress, Task, stages
 from .registry import (MESH_METHODS, SURFACE_KINDS, TRANSFORMS, BuildContext, Built,
                        load_plugins)
@@ -64,11 +66,70 @@ def parse_design(text: str, source: str = "<design>", base_dir: str | os.PathLik
         data = tomllib.loads(text)
     except tomllib.TOMLDecodeError as exc:
         raise DesignError(f"invalid TOML: {exc}", None, source) from None
+    except RecursionError:
+        raise DesignError(f"invalid design: tables or arrays nested deeper than the TOML "
+                          f"reader can follow (a design needs at most {MAX_NESTING} levels)",
+                          None, source) from None
+    _check_tree(data, source)
     try:
         check_keys(data, TOP_LEVEL, "", err=DesignError)
     except DesignError as exc:
         raise exc.with_source(source) from None
     return Design(data, source, Path(base_dir))
+
+
+# Deepest nesting of tables and arrays a design may have: the deepest real one
+# (transform tables holding a matrix) has 4; deeper data only makes every walker
+# over it recurse.
+MAX_NESTING = 32
+_SMALLEST_NORMAL = 2.2250738585072014e-308
+
+
+def _check_tree(data: Any, source: str) -> None:
+    """Refuse nesting deeper than :data:`MAX_NESTING` and numbers beyond the coordinate range.
+
+    No field of a design needs a number larger than
+    :data:`ruledmesh.normalise.MAX_COORDINATE` (coordinates, lengths, angles in
+    degrees, counts), nor a non-zero scalar of a surface or curve below
+    :data:`~ruledmesh.normalise.MIN_EXTENT`, nor a subnormal number anywhere;
+    such a number only overflows or divides by zero somewhere inside a build
+    (a semi-axis of 5e-324).
+    NaN and infinity are left to the fields' own checks, which say "finite".
+    """
+    stack: list[tuple[Any, str, int]] = [(data, "", 0)]
+    while stack:
+        value, path, depth = stack.pop()
+        if depth > MAX_NESTING:
+            raise DesignError(f"nested more than {MAX_NESTING} levels deep; a design needs a "
+                              "few", path or None, source)
+        if isinstance(value, Mapping):
+            stack.extend((v, f"{path}.{k}" if path else str(k), depth + 1) for k, v in value.items())
+        elif isinstance(value, list):
+            stack.extend((v, f"{path}[{i}]", depth + 1) for i, v in enumerate(value))
+        elif isinstance(value, (int, float)) and not isinstance(value, bool):
+            _check_number(value, path, source)
+
+
+def _check_number(value: float, path: str, source: str) -> None:
+    """Refuse a number no design field needs (see :func:`_check_tree`)."""
+    from .normalise import MAX_COORDINATE, MIN_EXTENT
+
+    size = abs(value)
+    if math.isinf(size) or math.isnan(size):
+        return  # the field's own check says "finite"
+    shown = (f"{value:.3g}" if isinstance(value, float)
+             else f"an integer of {len(str(abs(value)))} digits")
+    if size > MAX_COORDINATE:
+        raise DesignError(f"expected a number within +-{MAX_COORDINATE:g}, got {shown}",
+                          path or None, source)
+    # A scalar of a surface or curve (a radius, a semi-axis, a pitch, an angle) sets a size
+    # or a sweep: a tiny one divides by zero inside the construction.  Points in arrays
+    # may hold tiny coordinates (rounding noise next to the others).
+    scalar = path.split(".")[0] in ("surface", "curves") and not path.endswith("]")
+    if 0 < size < (MIN_EXTENT if scalar else _SMALLEST_NORMAL):
+        raise DesignError(f"expected 0 or a number of magnitude at least "
+                          f"{MIN_EXTENT if scalar else _SMALLEST_NORMAL:.3g}, got {shown}",
+                          path or None, source)
 
 
 def load_design(path: str | os.PathLike) -> Design:
@@ -77,13 +138,16 @@ def load_design(path: str | os.PathLike) -> Design:
     A relative ``examples/NAME.toml`` that does not exist here is the bundled
     example of that name (:func:`ruledmesh.bundled.resolve`).
     """
+    from ._files import MAX_DESIGN_BYTES, FileRefused, read_capped
     from .bundled import resolve
 
     path = resolve(path)
     try:
-        text = path.read_text(encoding="utf-8")
+        text = read_capped(path, MAX_DESIGN_BYTES, "a design file").decode("utf-8")
     except FileNotFoundError:
         raise DesignError("file not found", None, str(path)) from None
+    except FileRefused as exc:
+        raise DesignError(str(exc.strerror), None, str(path)) from None
     except (OSError, UnicodeDecodeError) as exc:
         raise DesignError(f"cannot read: {exc}", None, str(path)) from None
     return parse_design(text, path.name, path.parent)
@@ -111,9 +175,13 @@ def _build(design: Design, progress: Progress) -> Built:
     names = ([] if "surface" in data else ["generators"]) + ["mesh"] + ["transforms"] * bool(transforms)
     with stages(progress, "build", names) as task:
         built = _build_surface(design, mesh_table, task)
+        hint = ("; trim = true closes torsal strips with triangles"
+                if mesh_table.get("trim") is False else "")
+        _in_range(built.mesh, "the mesh", hint)
         task.advance(note="transforms" if transforms else None)
         built = _apply_transforms(built, transforms)
         if transforms:
+            _in_range(built.mesh, "the transformed mesh")
             task.advance()
     from dataclasses import replace
 
@@ -151,10 +219,43 @@ def _build_surface(design: Design, mesh_table: Mapping, task: Task) -> Built:
         method = mesh_table.get("method", "pq")
         if not isinstance(method, str) or method not in MESH_METHODS:
             raise _unknown("mesh.method", method, MESH_METHODS)
-        if method == "pq":
-            _check_budget(len(rulings), mesh_table.get("rows", 20))
+        _check_budget(len(rulings), mesh_table, method)
         built = MESH_METHODS[method](rulings, mesh_table, ctx)
     return built
+
+
+def _in_range(mesh: Any, what: str, hint: str = "") -> None:
+    """Refuse a mesh that is empty, all degenerate, or beyond the coordinate range.
+
+    A build never ends with a mesh that has nothing to fabricate: no faces, or
+    only faces without area (the design's features below float64 resolution at
+    its size), or coordinates outside what the analysis and the file formats
+    hold faithfully (:func:`ruledmesh.normalise.check_range`).  The message
+    passes on what the mesher said about the parts it could not mesh.
+    """
+    from .analysis.faces import degenerate_faces, face_normals
+    from .normalise import check_range, unit_frame
+
+    v = np.asarray(mesh.vertices, dtype=np.float64)
+    said = "; ".join(str(w) for w in mesh.info.get("warnings", [])[:2])
+    said = f" ({said})" if said else ""
+    if mesh.n_faces == 0:
+        raise GeometryError(f"{what} has no faces: nothing of the design could be meshed"
+                            f"{said}{hint}")
+    if not np.all(np.isfinite(v)):
+        raise GeometryError(f"{what} has NaN or infinite coordinates; check the numbers of "
+                            "the design (an angle, a scale, a far axis point)")
+    check_range(v, what)
+    _, area = face_normals(mesh)
+    extent = float(np.linalg.norm(np.ptp(v, axis=0)))
+    # Cheap first: one face of real area (relative to the whole) settles it.
+    if area.max() > 1e-6 * extent * extent:
+        return
+    centre, scale = unit_frame(v)
+    if np.all(degenerate_faces(mesh.with_vertices((v - centre) / scale))):
+        raise GeometryError(f"every one of the {mesh.n_faces} faces of {what} has no area: the "
+                            f"design's features are below float64 resolution at its size "
+                            f"({extent:.3g} across); bring its parts to comparable sizes{said}")
 
 
 def _apply_transforms(built: Built, transforms: list) -> Built:
@@ -170,21 +271,45 @@ def _apply_transforms(built: Built, transforms: list) -> Built:
 
 
 # Refuse builds whose estimated peak memory exceeds this, before allocating anything.
-MAX_BUILD_BYTES = 8 * 2**30
+MAX_BUILD_BYTES = _budget.MAX_BUILD_BYTES
 
 
-def _check_budget(generators: int, rows: Any) -> None:
-    """Refuse a §4.3 grid of ``generators x (rows + 1)`` points too large to build."""
-    from .rulings import BUILD_BYTES_PER_GRID_POINT
+def _count(table: Mapping, key: str, default: int) -> int | None:
+    """``table[key]`` when it is a usable count, else ``None`` (the mesher reports it)."""
+    value = table.get(key, default)
+    if isinstance(value, bool) or not isinstance(value, int) or value < 0:
+        return None
+    return value
 
-    if isinstance(rows, bool) or not isinstance(rows, int) or rows < 1:
-        return  # the mesher reports a malformed value itself
-    need = generators * (rows + 1) * BUILD_BYTES_PER_GRID_POINT
-    if need > MAX_BUILD_BYTES:
-        raise DesignError(
-            f"{generators} generators x {rows + 1} rows would need about {need / 2**30:.1f} GiB "
-            f"of memory (limit {MAX_BUILD_BYTES / 2**30:.0f} GiB); reduce the rows or the "
-            "generator count", "mesh.rows")
+
+def _check_budget(generators: int, mesh_table: Mapping, method: str) -> None:
+    """Refuse a grid too large to build, from every count that multiplies it.
+
+    §4.3: ``generators x (rows + 1) x (1 + 2 extend)``; hybrid:
+    ``(generators - 1)(midpoints + 1) + 1`` columns ``x (divisions + 1)``.
+    """
+    if method == "pq":
+        rows = _count(mesh_table, "rows", 20)
+        extend = mesh_table.get("extend", "auto")
+        if rows is None or rows < 1:
+            return
+        factor = 1.0
+        what = f"{generators} generators x {rows + 1} rows"
+        if isinstance(extend, (int, float)) and not isinstance(extend, bool) and 0 < extend <= 1e3:
+            factor = 1.0 + 2.0 * float(extend)
+            what += f" x (1 + 2 x extend {extend:g})"
+        _budget.check_budget(generators * (rows + 1) * factor, _budget.PQ_BYTES_PER_GRID_POINT,
+                             what, "reduce the rows, the extension or the generator count",
+                             "mesh.rows", DesignError)
+    elif method == "hybrid":
+        mid, div = _count(mesh_table, "midpoints", 1), _count(mesh_table, "divisions", 8)
+        if mid is None or div is None:
+            return
+        columns = (generators - 1) * (mid + 1) + 1
+        _budget.check_budget(columns * (div + 1), _budget.HYBRID_BYTES_PER_NODE,
+                             f"{columns} columns ({generators} generators, {mid} midpoints) x "
+                             f"{div + 1} rows", "reduce the divisions, the midpoints or the "
+                             "generator count", "mesh.divisions", DesignError)
 
 
 def curve_kinks(curve) -> np.ndarray:

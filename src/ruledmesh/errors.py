@@ -8,7 +8,10 @@ into a one-line message and exit code 2.
 
 from __future__ import annotations
 
+import unicodedata
+
 __all__ = [
+    "printable",
     "RuledMeshError",
     "DesignError",
     "ParameterError",
@@ -16,6 +19,40 @@ __all__ = [
     "ExportError",
     "RuledMeshWarning",
 ]
+
+
+# Longest user-supplied text (a key, a name, a value) echoed in a message.
+MAX_ECHO = 80
+# Longest message as a whole: one line a terminal can still show.
+MAX_MESSAGE = 2000
+
+
+def printable(text: str, limit: int | None = MAX_ECHO) -> str:
+    """``text`` safe to print on one line: control characters escaped, cut with an ellipsis.
+
+    Newlines, tabs, terminal escapes and invisible format characters (such as the
+    right-to-left override U+202E) are shown as Python escapes (``\\n``, ``\\u202e``),
+    so a message stays one line and reads the same in every terminal.
+
+    >>> printable("a\\nb\\u202e")
+    'a\\\\nb\\\\u202e'
+    >>> printable("x" * 100, 10)
+    'xxxxxxxxx…'
+    """
+    text = str(text)
+    if limit is not None and len(text) > limit:
+        text = text[:max(limit - 1, 0)] + "…"
+    if text.isprintable():
+        return text
+    out = []
+    for ch in text:
+        if ch.isprintable() or (ch == " "):
+            out.append(ch)
+        elif unicodedata.category(ch) in ("Zs",):
+            out.append(" ")
+        else:
+            out.append(ch.encode("unicode_escape").decode("ascii"))
+    return "".join(out)
 
 
 class RuledMeshError(Exception):
@@ -44,10 +81,10 @@ class _FieldError(RuledMeshError, ValueError):
     def _format(self) -> str:
         parts = []
         if self.source:
-            parts.append(self.source)
+            parts.append(printable(self.source, 240))
         if self.field:
-            parts.append(self.field)
-        parts.append(self.detail)
+            parts.append(printable(self.field, 240))
+        parts.append(printable(self.detail, MAX_MESSAGE))
         return ": ".join(parts)
 
     def with_source(self, source: str) -> "_FieldError":

@@ -43,15 +43,18 @@ from typing import Any, Mapping
 import numpy as np
 
 from ._validation import check_bool, check_int, check_keys, check_points
+from .budget import HYBRID_BYTES_PER_NODE, MAX_BUILD_BYTES, gib
 from .errors import DesignError, GeometryError, ParameterError
 from .mesh import FaceKind, Mesh
+from .normalise import normalised
 from .registry import BuildContext, Built, mesh_method
 from .tolerances import DEFAULT, Tolerances
 
 __all__ = ["hybrid_mesh", "hybrid_grid", "orient_generators", "checkerboard_faces"]
 
-# Grid nodes above which a build is refused up front (memory), as in pq.py.
-MAX_GRID_NODES = 40_000_000
+# Grid nodes above which a build is refused up front (memory): the measured
+# peak per node against the one build budget (ruledmesh.budget).
+MAX_GRID_NODES = MAX_BUILD_BYTES // HYBRID_BYTES_PER_NODE
 
 
 # --------------------------------------------------------------------------- geometry
@@ -417,6 +420,7 @@ def _repair(V: np.ndarray, faces: list[np.ndarray], members: np.ndarray, member_
 
 
 # --------------------------------------------------------------------------- public
+@normalised  # meshes in a unit frame: results do not depend on scale
 def hybrid_mesh(a: Any, b: Any, *, midpoints: int = 1, divisions: int = 8, flip: bool = False,
                 orient: bool = True, tol: Tolerances = DEFAULT) -> Mesh:
     """Hybrid mesh of planar quads and triangles from any set of generators (§4.1).
@@ -491,8 +495,11 @@ def hybrid_mesh(a: Any, b: Any, *, midpoints: int = 1, divisions: int = 8, flip:
     m, n, k = len(a), midpoints + 1, divisions
     C = (m - 1) * n
     if (C + 1) * (k + 1) > MAX_GRID_NODES:
-        raise ParameterError(f"expected at most {MAX_GRID_NODES} grid nodes, got "
-                             f"{(C + 1) * (k + 1)} ({m} generators x {n} columns x {k + 1} rows)",
+        need = gib((C + 1) * (k + 1) * HYBRID_BYTES_PER_NODE)
+        raise ParameterError(f"expected at most {MAX_GRID_NODES:,} grid nodes, got "
+                             f"{(C + 1) * (k + 1):,} ({m} generators x {n} columns x {k + 1} "
+                             f"rows), about {need} of memory (limit {gib(MAX_BUILD_BYTES)}); "
+                             "reduce the divisions, the midpoints or the generator count",
                              "divisions")
     reversed_ = orient_generators(a, b) if orient else np.zeros(m, bool)
     A = np.where(reversed_[:, None], b, a)

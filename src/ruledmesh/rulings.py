@@ -884,10 +884,11 @@ def from_csv(path: str | os.PathLike, *, tol: Tolerances = DEFAULT) -> Rulings:
         The file cannot be read or a row is malformed; the message names the
         file and the line number, e.g. ``lines.csv: line 4: expected 6 numbers, got 5``.
     """
+    from ._files import MAX_CSV_BYTES, read_capped
+
     name = os.fspath(path)
     try:
-        with open(name, encoding="utf-8") as fh:
-            text = fh.read()
+        text = read_capped(name, MAX_CSV_BYTES, "a CSV table of lines").decode("utf-8")
     except (OSError, UnicodeDecodeError) as exc:
         raise DesignError(f"cannot read the file: {exc.strerror or exc}", None, name) from None
     rows = []
@@ -1032,8 +1033,14 @@ def rulings_from_spec(spec: Mapping, curves: Mapping[str, Curve], *, path: str =
             if not isinstance(fname, str) or not fname:
                 raise E(f"expected a file name, got {describe(fname)}", f"{path}.file")
             full = os.path.join(os.fspath(base_dir), fname)
-            if not os.path.isfile(full):
+            from ._files import not_a_regular_file
+
+            if not os.path.exists(full):
                 raise E(f'no such file "{fname}" (looked in {os.fspath(base_dir)})',
+                        f"{path}.file")
+            kind = not_a_regular_file(full)
+            if kind is not None:
+                raise E(f'"{fname}" is {kind}, not a CSV table of lines; give a regular file',
                         f"{path}.file")
             rulings = from_csv(full)
             _too_many(len(rulings), "lines (rows)", f"{path}.file", E)

@@ -30,7 +30,6 @@ import numpy as np
 
 from ..mesh import FaceKind, Mesh
 from ..tolerances import DEFAULT, Tolerances
-from . import faces as F
 from .circularity import quad_circularity, quad_parallelogram
 
 __all__ = ["check_guarantee", "format_guarantee", "quad_trapezoid"]
@@ -108,8 +107,9 @@ def _properties(text: str) -> list[str]:
 def _measure(prop: str, mesh: Mesh, quads: np.ndarray, tol: Tolerances):
     """(figure name, worst value, tolerance) of one property, or None if not measurable."""
     if prop == "planar":
-        values = F.planarity(mesh)
-        return "planarity", values, tol.planarity
+        from .planar import face_planarity, planarity_tolerance
+
+        return "planarity", face_planarity(mesh), planarity_tolerance(mesh, tol)
     if prop not in ("parallelograms", "trapezoids", "isosceles trapezoids", "circular"):
         return None
     if prop == "circular":

@@ -12,6 +12,8 @@ Figures (relative ones are divided by the bounding-box diagonal):
 * ``guarantee_check`` (when a construction states a ``guarantee``): each
   promised property measured (:mod:`.guarantees`); a promise the figures do
   not confirm becomes a warning;
+* ``t_junctions``: vertices inside an edge of a neighbouring face (:mod:`.conformity`),
+  with a warning;
 * ``matches_design`` (with a reference surface): False, with a warning, when
   closeness or coverage is far off (the mesh is not one of that design).
 
@@ -33,7 +35,7 @@ from ..tolerances import DEFAULT, Tolerances
 from . import faces as F
 
 __all__ = ["KIND_NOUNS", "METRIC_HOOKS", "MISMATCH", "analyze", "format_summary", "format_table",
-           "kind_counts"]
+           "kind_counts", "strict_json"]
 
 # The words every report, the command line and the docs use for face counts.
 KIND_NOUNS = {
@@ -52,6 +54,10 @@ KIND_NOUNS = {
 # meshes near torsal lines) and coverage 0.73 (compounds covering part of the patch); a
 # skew mesh measured against the torus design gives 0.62 and 0.43.
 MISMATCH: dict[str, Any] = {"closeness": 0.1, "coverage": (0.5, 2.0)}
+# A mesh of the design (close to it) that covers less than this share of the designed
+# patch's area gets a warning saying how much; the bundled designs cover 0.93 (the
+# hybrid mesh of crossing lines) and more.
+COVERAGE_WARN = 0.9
 
 # Extra figures from other modules: name -> fn(mesh) -> dict or None (None: not applicable).
 # Modules in _HOOK_MODULES register themselves here when imported.
@@ -93,7 +99,9 @@ def kind_counts(counts: Mapping[str, int]) -> str:
 
 def _planarity(plan: np.ndarray, mesh: Mesh, tol: Tolerances) -> dict[str, Any]:
     """Planarity figures; faces exact (to rounding) told apart from those within a tolerance."""
-    ptol = max(float(mesh.info.get("planarity_tolerance", tol.planarity)), tol.planarity)
+    from .planar import planarity_tolerance
+
+    ptol = planarity_tolerance(mesh, tol)
     exact = plan <= tol.planarity
     within = ~exact & (plan <= ptol)
     return {
@@ -157,9 +165,14 @@ def analyze(mesh: Mesh, reference=None, extras: Mapping[str, Any] | None = None,
         raise GeometryError(f"the mesh has no faces ({mesh.n_vertices} vertices); "
                             "nothing to analyse")
     _load_hooks()
+    # The figures are taken on a copy in a unit frame (a power-of-two scale: exact),
+    # so they do not depend on the scale of the mesh, and products of lengths never
+    # overflow; absolute figures are scaled back.  Whatever still overflows (areas
+    # of a mesh near 1e308) becomes null in the report, not a numpy warning.
+    work, scale = _unit_copy(mesh)
     names = ["faces"] + ["closeness"] * (reference is not None) + list(METRIC_HOOKS)
-    with stages(progress, "analyse", names) as task:
-        report = _figures(mesh, tol)
+    with stages(progress, "analyse", names) as task, np.errstate(all="ignore"):
+        report = _scaled_back(_figures(work, tol), scale)
         task.advance(note=names[1] if len(names) > 1 else None)
         if reference is not None:
             report.update(_closeness(mesh, reference, report["area"]["total"]))
@@ -168,20 +181,73 @@ def analyze(mesh: Mesh, reference=None, extras: Mapping[str, Any] | None = None,
             # Hooks that compare with the smooth surface take it as ``reference``,
             # only when a comparison was asked for (it tessellates the surface anew).
             takes_ref = compare and "reference" in inspect.signature(hook).parameters
-            value = hook(mesh, reference=reference) if takes_ref else hook(mesh)
+            value = hook(mesh, reference=reference) if takes_ref else hook(work)
             if value is not None:
                 report[name] = value
             task.advance(note=(list(METRIC_HOOKS) + [None])[k + 1])
     if extras:
         report.update(dict(extras))
-    report["warnings"] = _warnings(mesh, report, tol)
+    report["warnings"] = _warnings(work, report, tol)
+    return strict_json(report)
+
+
+def _unit_copy(mesh: Mesh) -> tuple[Mesh, float]:
+    """``mesh`` moved to the origin and scaled by a power of two to unit size (:func:`unit_frame`)."""
+    from ..normalise import unit_frame
+
+    v = mesh.vertices
+    if not v.size or not np.all(np.isfinite(v)):
+        return mesh, 1.0
+    centre, scale = unit_frame(v)
+    return mesh.with_vertices((v - centre) / scale), scale
+
+
+def _scaled_back(report: dict[str, Any], scale: float) -> dict[str, Any]:
+    """The absolute figures of a report taken in the unit frame, in the mesh's units."""
+    if scale == 1.0:
+        return report
+    report["diagonal"] *= scale
+    report["area"] = {k: v * scale * scale for k, v in report["area"].items()}
+    report["edge_length"] = {k: v * scale for k, v in report["edge_length"].items()}
     return report
+
+
+def strict_json(report: dict[str, Any]) -> dict[str, Any]:
+    """``report`` with every NaN or infinite number replaced by ``None`` (JSON ``null``).
+
+    The dotted paths of the replaced figures are listed in ``report["non_finite"]``
+    and named in a warning, so the report stays strict JSON (RFC 8259 has no NaN)
+    and says what it could not measure.
+    """
+    bad: list[str] = []
+
+    def clean(value: Any, path: str) -> Any:
+        if isinstance(value, (float, np.floating)):
+            if not np.isfinite(value):
+                bad.append(path)
+                return None
+            return float(value)
+        if isinstance(value, Mapping):
+            return {k: clean(v, f"{path}.{k}" if path else str(k)) for k, v in value.items()}
+        if isinstance(value, (list, tuple)):
+            return [clean(v, f"{path}[{i}]") for i, v in enumerate(value)]
+        return value
+
+    out = clean(report, "")
+    if bad:
+        shown = ", ".join(bad[:6]) + (f" and {len(bad) - 6} more" if len(bad) > 6 else "")
+        out["non_finite"] = bad
+        out.setdefault("warnings", []).append(
+            f"{len(bad)} figures are beyond float64 (overflow or 0/0) and are null: {shown}")
+    return out
 
 
 def _figures(mesh: Mesh, tol: Tolerances) -> dict[str, Any]:
     """The figures every mesh has: counts, planarity, convexity, sizes, angles."""
     diag = mesh.diagonal() or 1.0
-    plan = F.planarity(mesh)
+    from .planar import face_planarity
+
+    plan = face_planarity(mesh)
     convex = F.convexity(mesh, tol.convexity)
     normals, areas = F.face_normals(mesh)
     angles = F.corner_angles(mesh)
@@ -203,8 +269,17 @@ def _figures(mesh: Mesh, tol: Tolerances) -> dict[str, Any]:
         "min_angle_deg": float(angles.min()) if angles.size else 0.0,
         "quality": _quality(mesh, tol),
         "euler_characteristic": mesh.euler_characteristic(len(edges)),
+        "t_junctions": _t_junctions(mesh),
     }
     return report
+
+
+def _t_junctions(mesh: Mesh) -> dict[str, Any]:
+    """T-junctions (:mod:`.conformity`): how many, and the first few ``[vertex, a, b]``."""
+    from .conformity import t_junctions
+
+    found = t_junctions(mesh)
+    return {"count": int(len(found)), "first": found[:5].tolist()}
 
 
 def _closeness(mesh: Mesh, reference, mesh_area: float) -> dict[str, Any]:
@@ -237,6 +312,18 @@ def _design_mismatch(report: Mapping[str, Any]) -> list[str]:
     return why
 
 
+def _low_coverage(report: Mapping[str, Any], explained: bool) -> str | None:
+    """A warning when the mesh covers less than :data:`COVERAGE_WARN` of the designed patch."""
+    cov = report.get("coverage")
+    if not cov or cov["ratio"] is None or cov["ratio"] >= COVERAGE_WARN:
+        return None
+    why = ("the warnings above say which parts were left out" if explained else
+           "parts of the designed patch have no faces (a notched or untrimmed border, rows "
+           "that end short of the generators' ends, or faces dropped as degenerate)")
+    return (f"the mesh covers {cov['ratio']:.1%} of the designed patch (mesh area "
+            f"{cov['mesh_area']:.4g}, patch {cov['patch_area']:.4g}): {why}")
+
+
 def _warnings(mesh: Mesh, report: dict[str, Any], tol: Tolerances) -> list[str]:
     """Warnings from the figures; adds ``guarantee_check`` and ``matches_design``."""
     from .guarantees import check_guarantee, format_guarantee
@@ -251,6 +338,12 @@ def _warnings(mesh: Mesh, report: dict[str, Any], tol: Tolerances) -> list[str]:
     if mesh.n_faces and 1.0 - share["quads"] > 0.3 and not said:
         warnings.append(f"{1.0 - share['quads']:.0%} of the area is not in quads "
                         f"(by kind: {_shares(share['by_kind'])})")
+    tj = report["t_junctions"]
+    if tj["count"]:
+        v, a, b = tj["first"][0]
+        warnings.append(f"{tj['count']} T-junctions: vertex {v} lies inside the edge {a}-{b} of a "
+                        "neighbouring face (conforming by connectivity, not geometrically: "
+                        "welding or smoothing in another program would open a gap there)")
     if report["quality"]["degenerate_faces"]:
         warnings.append(f"{report['quality']['degenerate_faces']} faces have no area")
     if report["planarity"]["above_tolerance"]:
@@ -262,6 +355,9 @@ def _warnings(mesh: Mesh, report: dict[str, Any], tol: Tolerances) -> list[str]:
         if why:
             warnings.append("the mesh does not match the design: " + ", ".join(why)
                             + " (is --design the file this mesh was built from?)")
+        low = _low_coverage(report, bool(mesh.info.get("warnings")))
+        if low and report["closeness"]["vertices_max"] <= MISMATCH["closeness"]:
+            warnings.append(low)
     if isinstance(report.get("guarantee"), str):
         check = check_guarantee(report["guarantee"], mesh, tol)
         report["guarantee_check"] = check

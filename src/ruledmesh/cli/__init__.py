@@ -87,7 +87,7 @@ def main(argv: Sequence[str] | None = None) -> int:
 
     Exit codes: 0 success, 2 bad input (design file, parameters, files),
     3 an internal error (a bug: please report it with ``--debug`` output),
-    130 interrupted.
+    130 interrupted, 141 the reader of stdout went away (``| head``).
     """
     parser = build_parser()
     args = parser.parse_args(argv)
@@ -96,16 +96,23 @@ def main(argv: Sequence[str] | None = None) -> int:
         return 2
     try:
         return _run(args)
+    except BrokenPipeError:
+        return _broken_pipe()
     except RuledMeshError as exc:
         if args.debug:
             raise
-        print(f"ruledmesh: error: {exc}", file=sys.stderr)
+        _say(f"ruledmesh: error: {exc}")
+        return 2
+    except RecursionError:  # a design nested too deep for any reader; never a traceback
+        if args.debug:
+            raise
+        _say("ruledmesh: error: the input is nested too deeply to be read")
         return 2
     except OSError as exc:
         if args.debug:
             raise
         where = f"{_published_name(exc.filename)}: " if exc.filename else ""
-        print(f"ruledmesh: error: {where}{exc.strerror or exc}", file=sys.stderr)
+        _say(f"ruledmesh: error: {where}{exc.strerror or exc}")
         return 2
     except KeyboardInterrupt:
         print("ruledmesh: interrupted", file=sys.stderr)
@@ -118,9 +125,33 @@ def main(argv: Sequence[str] | None = None) -> int:
     except Exception as exc:  # a bug: one line, not a traceback, unless --debug
         if args.debug:
             raise
-        print(f"ruledmesh: internal error: {type(exc).__name__}: {exc} "
-              "(run with --debug and report it)", file=sys.stderr)
+        _say(f"ruledmesh: internal error: {type(exc).__name__}: {exc} "
+             "(run with --debug and report it)")
         return 3
+
+
+def _say(message: str) -> None:
+    """One line on stderr: control characters escaped, bounded (see :func:`printable`)."""
+    from ..errors import MAX_MESSAGE, printable
+
+    print(printable(message, MAX_MESSAGE), file=sys.stderr)
+
+
+def _broken_pipe() -> int:
+    """The reader of stdout went away (``ruledmesh examples | head``): end quietly.
+
+    Later writes (the interpreter flushes stdout at exit) go to the null device, so
+    Python prints no "Exception ignored" either.  Exit code 141 is what a shell reports
+    for a process ended by SIGPIPE.
+    """
+    import os
+
+    try:
+        devnull = os.open(os.devnull, os.O_WRONLY)
+        os.dup2(devnull, sys.stdout.fileno())
+    except (OSError, ValueError):  # stdout replaced by an object without a descriptor
+        pass
+    return 141
 
 
 if __name__ == "__main__":  # pragma: no cover

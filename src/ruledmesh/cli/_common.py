@@ -145,6 +145,11 @@ def _existing(typed: str, what: str) -> Path:
                 where = "" if str(parent) == "." else f" in {parent}"
                 hint = f" (did you mean {' or '.join(near)}{where}?)"
         raise InputError(f"{typed}: file not found; check the path{hint}")
+    from .._files import not_a_regular_file
+
+    special = not_a_regular_file(path)
+    if special is not None:  # /dev/zero, a pipe, a terminal: never opened
+        raise InputError(f"{typed}: this is {special}, not {what}; give a regular file")
     if not os.access(path, os.R_OK):
         raise InputError(f"{typed}: cannot be read (permission denied)")
     return path
@@ -212,13 +217,17 @@ def read_source(typed: str, progress: Progress | None = None) -> Source:
         readable = ", ".join(sorted(READERS))
         raise InputError(f"{typed}: this is {kind or 'a file of unknown kind'}; ruledmesh reads "
                          f"meshes ({readable}) and design files (.toml)")
+    from .._files import MAX_MESH_BYTES, FileRefused, read_capped
     from ..errors import ParameterError
     from ..io import _module
 
     with (progress or SILENT).task(f"read {typed}"):
         try:
             # Content decides the reader: an OBJ saved as .txt is still read as OBJ.
-            mesh = _module(ext, READERS, "read").loadb(path.read_bytes())
+            data = read_capped(path, MAX_MESH_BYTES, "a mesh file")
+            mesh = _module(ext, READERS, "read").loadb(data)
+        except FileRefused as exc:
+            raise InputError(f"{typed}: {exc.strerror}") from None
         except ParameterError as exc:
             raise InputError(f"{typed}: cannot be read as a {ext} mesh: {exc.detail}") from None
     if mesh.n_faces == 0:

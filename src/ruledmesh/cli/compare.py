@@ -8,7 +8,9 @@ import sys
 # (label, report path, format)
 ROWS = [
     ("faces", ("faces",), "{:d}"),
-    ("triangle share", ("triangle_share",), "{:.1%}"),
+    # Users read a share as a share of the surface: the area first, the count labelled.
+    ("area in triangles", ("quality", "area_share", "triangles"), "{:.1%}"),
+    ("triangles (of the faces)", ("triangle_share",), "{:.1%}"),
     ("max planarity", ("planarity", "max"), "{:.2e}"),
     ("closeness (max, centroids)", ("closeness", "centroids_max"), "{:.2e}"),
     ("closeness (mean, centroids)", ("closeness", "centroids_mean"), "{:.2e}"),
@@ -23,8 +25,8 @@ def add_parser(sub) -> None:
         "compare",
         help="mesh one design with the PQ and the hybrid method and compare",
         description="Build the rulings of a design file once and mesh them with the §4.3 PQ "
-                    "method and the §4.1 hybrid HP-patch method; print faces, share of "
-                    "triangles, max planarity, closeness to the smooth surface, coverage and "
+                    "method and the §4.1 hybrid HP-patch method; print faces, the share of "
+                    "the area in triangles and of the faces that are triangles, max planarity, closeness to the smooth surface, coverage and "
                     "min angle for both. Options of the design's [mesh] table that belong to "
                     "one method are passed to it.",
         epilog="examples:\n"
@@ -62,7 +64,8 @@ def compare(design, rows=None, divisions=None, midpoints=None) -> dict:
     -------
     dict
         ``{"pq": report, "hybrid": report}`` (see :func:`ruledmesh.analysis.report.analyze`),
-        each with ``triangle_share`` added.
+        each with ``triangle_share`` (the share of the faces that are triangles)
+        added; the share of the area is the report's ``quality.area_share.triangles``.
     """
     from ..analysis.report import analyze
     from ..design import Design, build_design

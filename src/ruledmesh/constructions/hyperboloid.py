@@ -138,5 +138,14 @@ def _build(table: Mapping, mesh_table: Mapping, ctx: BuildContext) -> Built:
     guarantee = ("isosceles trapezoids, circular" if a == b else "trapezoids")
     if style is HyperboloidStyle.GENERATORS:
         guarantee += "; diagonals are generators of both reguli"
-    return Built(mesh, one_sheet_hyperboloid(a, b, c, float(z.min()), float(z.max())), None,
+    reach = float(np.abs(z).max())
+    if reach < height * (1 - 1e-9):
+        # The crossings of the generators fix the parallels: the last one below
+        # `height` ends the mesh.  The reference stays the designed patch, so the
+        # coverage says how much is missing, and this warning says why.
+        warnings.append(f"the generator crossings reach |z| = {reach:.6g}, not the height "
+                        f"{height:g}: z = c tan(2 pi k / u) for whole k; set height = {reach:.6g} "
+                        "or change u or c to cover the patch")
+        mesh = mesh.with_info(warnings=warnings)
+    return Built(mesh, one_sheet_hyperboloid(a, b, c, -height, height), None,
                  {"guarantee": guarantee})

@@ -180,16 +180,18 @@ def unroll(mesh: Mesh, *, require_planar: bool = True, tol: Tolerances = DEFAULT
     dist = np.abs(np.einsum("ij,ij->i", rel, normal[face]))
     out = np.maximum.reduceat(dist, off[:-1]) / longest
     if require_planar:
-        # A small face far from the origin carries rounding noise of its absolute
-        # coordinates, not of its size: allow that floor on top of the tolerance.
-        reach = np.maximum.reduceat(np.abs(p).max(axis=1), off[:-1])
-        floor = 64 * np.finfo(np.float64).eps * reach / longest
-        bent = np.flatnonzero(out > tol.planarity + floor)
+        # The rule the analysis reports by (ruledmesh.analysis.planar): what build
+        # calls planar, fabricate cuts; triangles are planar by definition.
+        from ..analysis.planar import bent_faces, planarity_tolerance
+
+        is_bent, plan = bent_faces(mesh, tol)
+        bent = np.flatnonzero(is_bent)
         if bent.size:
+            worst = int(bent[np.argmax(np.nan_to_num(plan[bent], nan=np.inf))])
             raise GeometryError(
-                f"{bent.size} faces are not planar to {tol.planarity:g} (worst: face "
-                f"{int(bent[np.argmax(out[bent])])}, {float(out.max()):.3g} of its longest edge); "
-                "a bent panel cannot be cut flat")
+                f"{bent.size} faces are not planar to {planarity_tolerance(mesh, tol):g} "
+                f"(worst: face {worst}, planarity {float(plan[worst]):.3g}, as "
+                "`ruledmesh analyze` measures it); a bent panel cannot be cut flat")
     return Unrolled(pts, off, origin, np.stack([e1, e2], axis=1), out)
 
 

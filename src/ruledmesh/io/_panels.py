@@ -6,7 +6,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..analysis.faces import face_normals, polygon_planarity
+from ..analysis.faces import face_normals
+from ..analysis.planar import face_planarity
 from ..errors import ParameterError
 from ..fabricate.labels import panel_labels
 from ..mesh import FaceKind, Mesh
@@ -30,8 +31,9 @@ class PanelData:
     area : (F,) float64
         Face areas in the mesh unit squared.
     planarity : (F,) float64
-        Largest distance of a corner from the face's best-fit plane divided by
-        the face's diameter (0 for an exactly planar panel).
+        The planarity ``ruledmesh analyze`` reports
+        (:func:`ruledmesh.analysis.planar.face_planarity`: quads by their
+        diagonals, larger polygons by the best-fit plane, triangles 0).
     """
 
     label: np.ndarray
@@ -54,4 +56,4 @@ def panel_data(mesh: Mesh) -> PanelData:
     _, area = face_normals(mesh.with_vertices(mesh.vertices - centre))
     labels = np.array([k.label for k in FaceKind])
     return PanelData(panel_labels(mesh.n_faces), labels[mesh.face_kind], area,
-                     polygon_planarity(mesh))
+                     face_planarity(mesh))

@@ -4,8 +4,8 @@ Each face becomes one Rhino Mesh object named by its panel label (``P0``,
 ``P1``, ... as on the fabrication sheets and schedules), on the layer of its
 kind, ``ruledmesh-<kind>``, with the user strings ``ruledmesh.label``,
 ``ruledmesh.kind``, ``ruledmesh.area`` (mesh unit squared),
-``ruledmesh.planarity`` (corner distance from the best-fit plane over the
-diameter) and ``ruledmesh.face`` (face index).  With ``panels="joined"``
+``ruledmesh.planarity`` (the planarity `ruledmesh analyze` reports: quads by their diagonals,
+others by the best-fit plane, triangles 0) and ``ruledmesh.face`` (face index).  With ``panels="joined"``
 each face kind is one mesh object instead, with the user string
 ``ruledmesh.face_of``: the source face of every Rhino mesh face, comma
 separated, so the polygons can be recovered.  The model unit system is the

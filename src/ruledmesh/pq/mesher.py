@@ -10,6 +10,7 @@ from .._validation import check_bool, check_float, check_int, check_points, desc
 from ..errors import GeometryError, ParameterError
 from ..hop import coplanarity
 from ..mesh import Mesh
+from ..normalise import normalised
 from ..tolerances import DEFAULT, Tolerances
 from .assemble import assemble
 from .pairing import pair_triangles
@@ -182,6 +183,7 @@ def _listed(ks: np.ndarray) -> str:
     return ", ".join(f"{k}-{k + 1}" for k in ks[:8].tolist()) + (" ..." if ks.size > 8 else "")
 
 
+@normalised  # meshes in a unit frame: results do not depend on scale
 def pq_mesh(a, b, rows: int = 20, primary: int | str = "middle", option: int = 0,
             extend: float | str = "auto", trim: bool = True, *, max_extend: float = 20.0,
             creases=None, crease_generators=None, planarity_tolerance: float | None = None,
@@ -330,11 +332,25 @@ def _checked(a, b, rows, primary, option, extend, trim, max_extend, planarity_to
     max_extend = check_float(max_extend, "max_extend", lo=0.0, hi=1e3)
     ptol = tol.planarity if planarity_tolerance is None else check_float(
         planarity_tolerance, "planarity_tolerance", lo=0.0, hi=0.1)
-    if m * (rows + 1) > MAX_GRID_POINTS:
-        need = m * (rows + 1) * BYTES_PER_GRID_POINT / 2**30
-        raise GeometryError(f"{m} generators x {rows + 1} rows would need at least "
-                            f"{need:.1f} GiB; reduce the generator count or the rows")
+    _check_grid_budget(m, rows, extend)
     return a, b, _Args(rows, p, middle, option, extend, trim, max_extend, max(ptol, tol.planarity))
+
+
+def _check_grid_budget(m: int, rows: int, extend: float | str) -> None:
+    """Refuse, before any allocation, a grid beyond the build budget (GeometryError).
+
+    A numeric ``extend`` continues the division by ``extend`` primary lengths on
+    both sides: ``rows (1 + 2 extend)`` rows.  ``"auto"`` is checked per run
+    once the row maps say how far it reaches (:func:`.runs.mesh_run`).
+    """
+    height = (rows + 1) * (1.0 + 2.0 * (0.0 if isinstance(extend, str) else float(extend)))
+    if m * height > MAX_GRID_POINTS:
+        need = m * height * BYTES_PER_GRID_POINT / 2**30
+        shown = f"{rows + 1} rows" + ("" if isinstance(extend, str) or not extend
+                                      else f" x (1 + 2 x extend {float(extend):g})")
+        raise GeometryError(f"{m} generators x {shown} would need about {need:.1f} GiB "
+                            f"(limit {MAX_GRID_POINTS * BYTES_PER_GRID_POINT / 2**30:.0f} GiB); "
+                            "reduce the generator count, the rows or the extension")
 
 
 def _patch_scale(a: np.ndarray, b: np.ndarray, d: np.ndarray, tol: Tolerances) -> float:

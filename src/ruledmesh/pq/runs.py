@@ -20,6 +20,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from ..budget import MAX_BUILD_BYTES, PQ_BYTES_PER_GRID_POINT
 from ..errors import GeometryError
 from ..hop import crossing_maps
 from ..tolerances import Tolerances
@@ -37,9 +38,10 @@ from .maps import (
 __all__ = ["MAX_GRID_POINTS", "Division", "Run", "carrier", "mesh_run"]
 
 # Grid points (generators x rows) above which a build is refused up front, with
-# the memory it would need, instead of running out of memory half-way.
-MAX_GRID_POINTS = 60_000_000
-BYTES_PER_GRID_POINT = 96
+# the memory it would need, instead of running out of memory half-way: the
+# measured peak per point (ruledmesh.budget) against the one build budget.
+BYTES_PER_GRID_POINT = PQ_BYTES_PER_GRID_POINT
+MAX_GRID_POINTS = MAX_BUILD_BYTES // PQ_BYTES_PER_GRID_POINT
 
 
 @dataclass(frozen=True)

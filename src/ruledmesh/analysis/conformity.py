@@ -1,0 +1,73 @@
+"""T-junctions: vertices lying inside an edge of a neighbouring face.
+
+A mesh can be conforming by connectivity (every edge shared by at most two
+faces, no face listing a vertex it does not own) and still not geometrically:
+a vertex of one face may sit in the middle of another face's edge, which then
+appears twice as a border edge of the mesh.  Fabricated panels still fit there,
+but the long edge meets two short ones, and a mesh processor that welds or
+smooths will tear or kink it.  Such an edge is always used by one face only, so
+only those edges are searched (with a k-d tree, not against every vertex).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from ..mesh import Mesh
+
+__all__ = ["t_junctions"]
+
+
+def _single_edges(mesh: Mesh) -> np.ndarray:
+    """(B, 2) int64: the edges used by exactly one face."""
+    nxt = np.arange(mesh.face_indices.size) + 1
+    nxt[mesh.face_offsets[1:] - 1] = mesh.face_offsets[:-1]
+    lo = np.minimum(mesh.face_indices, mesh.face_indices[nxt])
+    hi = np.maximum(mesh.face_indices, mesh.face_indices[nxt])
+    if lo.size == 0:
+        return np.zeros((0, 2), np.int64)
+    key, count = np.unique(lo * np.int64(mesh.n_vertices) + hi, return_counts=True)
+    key = key[count == 1]
+    return np.stack([key // mesh.n_vertices, key % mesh.n_vertices], axis=1)
+
+
+def t_junctions(mesh: Mesh, tol: float = 1e-9) -> np.ndarray:
+    """Vertices lying strictly inside a border edge of the mesh.
+
+    Parameters
+    ----------
+    mesh : Mesh
+    tol : float
+        Distance from the edge, relative to its length, within which a vertex
+        counts as on it.
+
+    Returns
+    -------
+    (k, 3) int64
+        Rows ``(vertex, edge start, edge end)``, sorted.
+    """
+    from scipy.spatial import cKDTree
+
+    edges = _single_edges(mesh)
+    used = np.unique(mesh.face_indices)
+    if edges.size == 0 or used.size == 0:
+        return np.zeros((0, 3), np.int64)
+    v = mesh.vertices
+    p, q = v[edges[:, 0]], v[edges[:, 1]]
+    length = np.linalg.norm(q - p, axis=1)
+    tree = cKDTree(v[used])
+    near = tree.query_ball_point(0.5 * (p + q), 0.5 * length * (1 + tol))
+    counts = np.fromiter((len(n) for n in near), np.int64, len(near))
+    if counts.sum() == 0:
+        return np.zeros((0, 3), np.int64)
+    e = np.repeat(np.arange(len(edges)), counts)
+    w = used[np.concatenate([np.asarray(n, np.int64) for n in near if n])]
+    keep = (w != edges[e, 0]) & (w != edges[e, 1])
+    e, w = e[keep], w[keep]
+    d = q[e] - p[e]
+    L2 = np.maximum(length[e] ** 2, 1e-300)
+    t = np.einsum("ij,ij->i", v[w] - p[e], d) / L2
+    off = np.linalg.norm(v[w] - p[e] - t[:, None] * d, axis=1)
+    inside = (t > tol) & (t < 1 - tol) & (off <= tol * length[e])
+    out = np.stack([w[inside], edges[e[inside], 0], edges[e[inside], 1]], axis=1)
+    return np.unique(out, axis=0) if out.size else np.zeros((0, 3), np.int64)

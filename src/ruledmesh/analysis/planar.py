@@ -1,0 +1,58 @@
+"""Which faces are planar: the one rule that build, analyze, fabricate and the exports share.
+
+The measure is :func:`ruledmesh.analysis.faces.planarity` (the paper's for quads:
+the distance between the diagonal lines over the mean diagonal; the best-fit plane
+for larger polygons; 0 for triangles, which are planar by definition).  It is taken
+on a copy of the mesh moved to the origin and scaled by a power of two, so it does
+not depend on where the mesh lies or how large it is, and a face is *bent* when it
+exceeds :func:`planarity_tolerance`.  Because every tool asks this module, the
+report of ``ruledmesh build`` and the refusal of ``ruledmesh fabricate`` cannot
+disagree about a face.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from ..mesh import Mesh
+from ..tolerances import DEFAULT, Tolerances
+
+__all__ = ["bent_faces", "face_planarity", "planarity_tolerance"]
+
+
+def face_planarity(mesh: Mesh) -> np.ndarray:
+    """(F,) float64: the planarity of every face, measured in the mesh's unit frame.
+
+    Triangles are 0.  Non-finite coordinates give NaN for their faces.
+    """
+    from ..normalise import unit_frame
+    from .faces import planarity
+
+    v = mesh.vertices
+    if v.size and np.all(np.isfinite(v)):
+        centre, scale = unit_frame(v)
+        mesh = mesh.with_vertices((v - centre) / scale)
+    with np.errstate(all="ignore"):
+        return planarity(mesh)
+
+
+def planarity_tolerance(mesh: Mesh, tol: Tolerances = DEFAULT) -> float:
+    """The planarity a face of ``mesh`` may have: ``tol.planarity``, or the mesh's own.
+
+    A mesh built with ``[mesh] planarity_tolerance`` (nearly developable strips)
+    records it in ``info["planarity_tolerance"]``; it is never below ``tol.planarity``.
+    """
+    return max(float(mesh.info.get("planarity_tolerance", tol.planarity)), tol.planarity)
+
+
+def bent_faces(mesh: Mesh, tol: Tolerances = DEFAULT) -> tuple[np.ndarray, np.ndarray]:
+    """Faces that are not planar within :func:`planarity_tolerance`.
+
+    Returns
+    -------
+    bent : (F,) bool
+    planarity : (F,) float64
+        The measure of every face (:func:`face_planarity`).
+    """
+    plan = face_planarity(mesh)
+    return ~(plan <= planarity_tolerance(mesh, tol)), plan
