@@ -56,13 +56,13 @@ import subprocess
 import sys
 import tempfile
 import time
+import tomllib
 from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
 import numpy as np
-import tomllib
 from scipy.spatial import cKDTree
 
 ROOT = Path(__file__).resolve().parents[1]

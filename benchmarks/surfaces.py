@@ -21,8 +21,8 @@ planar trapezoids and there would be nothing to optimise.
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from dataclasses import dataclass, field
-from typing import Callable
 
 import numpy as np
 

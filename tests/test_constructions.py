@@ -111,7 +111,8 @@ def test_prism_pyramid_torsal_planar_with_members_on_lines(n, layers, rnd):
         for line in np.unique(mesh.member_id):
             seg = mesh.vertices[mesh.members[mesh.member_id == line]]
             d = seg[:, 1] - seg[:, 0]
-            assert np.linalg.norm(np.cross(d, d[0]), axis=1).max() <= 1e-12 * np.linalg.norm(d[0]) * np.linalg.norm(d, axis=1).max()
+            scale = np.linalg.norm(d[0]) * np.linalg.norm(d, axis=1).max()
+            assert np.linalg.norm(np.cross(d, d[0]), axis=1).max() <= 1e-12 * scale
 
 
 def test_torsal_polyhedron_refuses_straight_polygon():

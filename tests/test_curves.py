@@ -1,5 +1,6 @@
 """Director curves: exact lengths, plane roots, sweeps, specs, properties."""
 
+import itertools
 import math
 
 import numpy as np
@@ -32,7 +33,7 @@ def _numeric_length(c, a=0.0, b=1.0):
     breaks = np.unique(np.concatenate([c._breaks(), [a, b]]))
     breaks = breaks[(breaks >= a) & (breaks <= b)]
     return sum(quad(lambda x: np.linalg.norm(c.derivative(x)), lo, hi, epsabs=0, epsrel=1e-13,
-                    limit=200)[0] for lo, hi in zip(breaks[:-1], breaks[1:]))
+                    limit=200)[0] for lo, hi in itertools.pairwise(breaks))
 
 
 # --- exact values ----------------------------------------------------------

@@ -19,7 +19,6 @@ from __future__ import annotations
 import os
 
 import numpy as np
-import pytest
 from hypothesis import HealthCheck, assume, given, settings
 from hypothesis import strategies as st
 
@@ -306,9 +305,11 @@ KINDS = {
 ONE_DIRECTION = {"strips": (None, None), "prism": ("u", None), "pyramid": ("u", None),
                  "torsal-polyhedron": ("u", None)}
 
+CATALOGUE_KINDS = tuple(sorted(KINDS))
+
 
 @st.composite
-def catalogue_designs(draw, kinds=tuple(sorted(KINDS))):
+def catalogue_designs(draw, kinds=CATALOGUE_KINDS):
     kind = draw(st.sampled_from(kinds))
     surface = {"kind": kind, **draw(KINDS[kind])}
     keys = ONE_DIRECTION.get(kind, ("u", "v"))
@@ -399,8 +400,8 @@ def test_fuzz_malformed_values_in_examples(example, pick, junk):
         node = node[k]
     node[path[-1]] = junk
     try:
-        text = dumps(data)
-    except Exception:                       # values TOML cannot hold (e.g. None)
+        dumps(data)
+    except Exception:  # noqa: BLE001 -                     # values TOML cannot hold (e.g. None)
         assume(False)
     built = _build(data)
     if built is not None:

@@ -10,10 +10,10 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-from hypothesis import HealthCheck, given, settings, strategies as st
+from hypothesis import HealthCheck, given, settings
+from hypothesis import strategies as st
 
-from ruledmesh.analysis.faces import (area_shares, convexity, degenerate_faces, face_min_angles,
-                                      planarity)
+from ruledmesh.analysis.faces import area_shares, convexity, degenerate_faces, face_min_angles, planarity
 from ruledmesh.design import build_design, parse_design
 from ruledmesh.mesh import FaceKind
 from ruledmesh.pq import pq_mesh

@@ -36,8 +36,9 @@ its tangent plane).
 
 from __future__ import annotations
 
+from collections.abc import Mapping
 from dataclasses import dataclass
-from typing import Any, Mapping
+from typing import Any
 
 import numpy as np
 
@@ -127,10 +128,10 @@ def compound_net(seed: Any, u_steps: Any = (), v_steps: Any = ()) -> tuple[np.nd
     I, J = len(us) + 1, len(vs) + 1
     P = np.full((I + 1, J + 1, 3), np.nan)
     P[:2, :2] = seed
-    for i, (lam, sig, tau) in enumerate(us):          # a loop over generators, not faces
-        P[i + 2, 0], P[i + 2, 1] = c1_step(P[i, 0], P[i + 1, 0], P[i, 1], P[i + 1, 1], lam, sig, tau)
-    for j, (lam, sig, tau) in enumerate(vs):
-        P[0, j + 2], P[1, j + 2] = c1_step(P[0, j], P[0, j + 1], P[1, j], P[1, j + 1], lam, sig, tau)
+    for k, (lam, sig, tau) in enumerate(us):          # a loop over generators, not faces
+        P[k + 2, 0], P[k + 2, 1] = c1_step(P[k, 0], P[k + 1, 0], P[k, 1], P[k + 1, 1], lam, sig, tau)
+    for k, (lam, sig, tau) in enumerate(vs):
+        P[0, k + 2], P[1, k + 2] = c1_step(P[0, k], P[0, k + 1], P[1, k], P[1, k + 1], lam, sig, tau)
     gap = 0.0
     # Inner corners, one anti-diagonal at a time (each needs its left and lower neighbours).
     for s in range(2, I + J - 1):

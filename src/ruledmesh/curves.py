@@ -340,7 +340,7 @@ class Curve:
     def __eq__(self, other: object) -> bool:
         if type(other) is not type(self):
             return NotImplemented
-        return self._key() == other._key()  # type: ignore[attr-defined]
+        return self._key() == other._key()
 
     def __hash__(self) -> int:
         return hash(self._key())
@@ -801,7 +801,7 @@ class Arc(Curve):
         object.__setattr__(self, "end_angle", a1)
 
     @classmethod
-    def through(cls, start: Any, mid: Any, end: Any) -> "Arc":
+    def through(cls, start: Any, mid: Any, end: Any) -> Arc:
         """The arc from ``start`` through ``mid`` to ``end``.
 
         Raises
@@ -831,7 +831,7 @@ class Arc(Curve):
 
     @classmethod
     def from_center(cls, center: Any, radius: float, normal: Any, start_angle: float,
-                    end_angle: float, x_axis: Any = None) -> "Arc":
+                    end_angle: float, x_axis: Any = None) -> Arc:
         """The arc about ``center`` in the plane with ``normal``; angles in degrees.
 
         ``x_axis`` (the direction of angle 0) defaults to a fixed direction
@@ -866,7 +866,7 @@ class Arc(Curve):
         return (self.radius * w ** order) * (np.cos(ak)[..., None] * x + np.sin(ak)[..., None] * y)
 
     def _level_grid(self):
-        return np.linspace(0.0, 1.0, max(9, int(math.ceil(abs(self.end_angle - self.start_angle) / 10.0)) + 1))
+        return np.linspace(0.0, 1.0, max(9, math.ceil(abs(self.end_angle - self.start_angle) / 10.0) + 1))
 
     def length(self) -> float:
         return self.radius * abs(self._sweep_rad)
@@ -947,7 +947,7 @@ class BSpline(Curve):
         object.__setattr__(self, "knots", _frozen(knots))
 
     @classmethod
-    def interpolate(cls, points: Any, degree: int = 3) -> "BSpline":
+    def interpolate(cls, points: Any, degree: int = 3) -> BSpline:
         """The B-spline through ``points`` at chord-length parameters.
 
         Parameters
@@ -969,14 +969,20 @@ class BSpline(Curve):
         spl = make_interp_spline(x, pts, k=degree)
         return cls(np.asarray(spl.c), degree, np.asarray(spl.t))
 
+    @property
+    def _knot_vector(self) -> np.ndarray:
+        # __post_init__ always sets the knots; the None is only the constructor's default
+        assert self.knots is not None
+        return self.knots
+
     @cached_property
     def _spline(self) -> _SciBSpline:
-        return _SciBSpline(self.knots, self.control_points, self.degree, extrapolate=True)
+        return _SciBSpline(self._knot_vector, self.control_points, self.degree, extrapolate=True)
 
     @property
     def _domain(self) -> tuple[float, float]:
         n = len(self.control_points)
-        return float(self.knots[self.degree]), float(self.knots[n])
+        return float(self._knot_vector[self.degree]), float(self._knot_vector[n])
 
     def _eval(self, u):
         t0, t1 = self._domain
@@ -990,7 +996,7 @@ class BSpline(Curve):
 
     def _breaks(self):
         t0, t1 = self._domain
-        k = np.unique(self.knots)
+        k = np.unique(self._knot_vector)
         k = k[(k >= t0) & (k <= t1)]
         u = (k - t0) / (t1 - t0)
         u[0], u[-1] = 0.0, 1.0
@@ -1011,8 +1017,8 @@ class BSpline(Curve):
 
     def to_spec(self) -> dict:
         spec = {"type": "bspline", "degree": self.degree, "points": _as_list(self.control_points)}
-        if not np.array_equal(self.knots, _default_knots(len(self.control_points), self.degree)):
-            spec["knots"] = _as_list(self.knots)
+        if not np.array_equal(self._knot_vector, _default_knots(len(self.control_points), self.degree)):
+            spec["knots"] = _as_list(self._knot_vector)
         return spec
 
 
@@ -1073,7 +1079,7 @@ class Helix(Curve):
         return out
 
     def _level_grid(self):
-        return np.linspace(0.0, 1.0, max(17, int(math.ceil(32 * self.turns)) + 1))
+        return np.linspace(0.0, 1.0, max(17, math.ceil(32 * self.turns) + 1))
 
     def length(self) -> float:
         return self.turns * math.hypot(2.0 * math.pi * self.radius, self.pitch)
@@ -1185,8 +1191,8 @@ def curve_from_spec(spec: Mapping, path: str) -> Curve:
                                        "x_axis") if k in spec]
             if "points" in spec:
                 if center_keys:
-                    raise E(f"give either points (start, through, end) or center/radius/normal/"
-                            f"angles, not both", f"{path}.{center_keys[0]}")
+                    raise E("give either points (start, through, end) or center/radius/normal/"
+                            "angles, not both", f"{path}.{center_keys[0]}")
                 p = pts("points")
                 if len(p) != 3:
                     raise E(f"expected 3 points (start, through, end), got {len(p)}",

@@ -11,17 +11,17 @@ from __future__ import annotations
 
 import os
 import tomllib
+from collections.abc import Mapping
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Any, Mapping
+from typing import Any
 
 import numpy as np
 
 from ._validation import check_keys, describe, near_miss
 from .errors import DesignError, RuledMeshError
 from .progress import SILENT, Progress, Task, stages
-from .registry import (MESH_METHODS, SURFACE_KINDS, TRANSFORMS, BuildContext, Built,
-                       load_plugins)
+from .registry import MESH_METHODS, SURFACE_KINDS, TRANSFORMS, BuildContext, Built, load_plugins
 
 __all__ = ["Design", "load_design", "parse_design", "build_design", "build_file"]
 

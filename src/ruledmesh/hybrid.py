@@ -38,7 +38,9 @@ degenerate faces only, which are rare).
 
 from __future__ import annotations
 
-from typing import Any, Mapping
+import itertools
+from collections.abc import Mapping
+from typing import Any
 
 import numpy as np
 
@@ -240,8 +242,8 @@ def _merge_coincident(V: np.ndarray, faces: list[np.ndarray], radius: float,
         rows.append(comp[fid] + n_groups)
         cols.append(verts)
         n_groups += int(comp.max()) + 1
-    rows, cols = np.concatenate(rows), np.concatenate(cols)
-    inc = csr_matrix((np.ones(len(cols)), (cols, rows)), shape=(n, n_groups))
+    group, vertex = np.concatenate(rows), np.concatenate(cols)
+    inc = csr_matrix((np.ones(len(vertex)), (vertex, group)), shape=(n, n_groups))
     share = np.asarray(inc[pairs[:, 0]].multiply(inc[pairs[:, 1]]).sum(axis=1)).ravel() > 0
     pairs = pairs[share]
     if len(pairs) == 0:
@@ -273,6 +275,7 @@ def _fan(V: np.ndarray, poly: list[int]) -> list[list[int]]:
         score = signed.min() if np.all(signed > 0) else signed.min() - 1e300
         if score > best_score:
             best, best_score = tri, score
+    assert best is not None  # every start vertex gives a fan; the first one always wins over -inf
     return best.tolist()
 
 
@@ -404,7 +407,7 @@ def _repair(V: np.ndarray, faces: list[np.ndarray], members: np.ndarray, member_
                 path = [p] + chain + [q]
                 if members[h, 0] == q:
                     path = path[::-1]
-                out_m += list(zip(path[:-1], path[1:]))
+                out_m += list(itertools.pairwise(path))
                 out_id += [member_id[h]] * (len(path) - 1)
                 members[h] = -1
                 changed = True

@@ -135,7 +135,7 @@ class _Pchip:
     interp: Any
 
     @classmethod
-    def of(cls, u: np.ndarray, sigma: np.ndarray, dsigma: np.ndarray | None = None) -> "_Pchip":
+    def of(cls, u: np.ndarray, sigma: np.ndarray, dsigma: np.ndarray | None = None) -> _Pchip:
         """PCHIP of the samples, or, given exact slopes ``dsigma`` (implicit
         differentiation of the correspondence), the cubic Hermite interpolant:
         fourth order, so the surface hardly depends on the sampling."""
@@ -400,7 +400,7 @@ def between(c1: Curve, c2: Curve, count: int, distribution: Distribution | str =
         raise ParameterError('only used with distribution "director-plane"', "director_plane")
     if directrix is not None and dist is not Distribution.LINEAR_DIRECTRIX:
         raise ParameterError('only used with distribution "linear-directrix"', "directrix")
-    info = {"distribution": dist.value, "warnings": []}
+    info: dict[str, Any] = {"distribution": dist.value, "warnings": []}
     if dist is Distribution.PARAMETER:
         return _curve_rulings(c1, _Identity(), c2, _Identity(), count, info, tol)
     if dist is Distribution.ARC_LENGTH:
@@ -457,11 +457,11 @@ def _director_plane(c1: Curve, c2: Curve, count: int, normal: np.ndarray, info: 
     grid, k = _dense_grid(count)
     s = lo + grid * (hi - lo) if forward else hi - grid * (hi - lo)
     sig = []
-    for name, c, lev in zip(("c1", "c2"), (c1, c2), levels):
+    for name, lev in zip(("c1", "c2"), levels):
         roots = lev.roots(float(s[0]))
         if len(roots) == 0:  # only by rounding at a range end
             raise GeometryError(f"director-plane: the first plane n . x = {s[0]:g} misses {name}")
-        u, ok, end = lev.follow(s, float(roots[0]))
+        u, _ok, end = lev.follow(s, float(roots[0]))
         if end is not None:
             raise _ended("director-plane", name, end, k, count,
                          ": the planes n . x = s meet it more than once (or not at all) over "
@@ -518,7 +518,7 @@ class _PencilAngle:
         xm = grid[i]
         if approach(lo) < 0 < approach(hi):
             xm = brentq(approach, lo, hi, xtol=1e-16, rtol=8.9e-16)
-        rmin = float(self.radius(curve._eval(np.float64(xm))))
+        rmin = float(self.radius(curve._eval(np.asarray(xm, dtype=np.float64))))
         if rmin <= tol.degenerate * curve._size:
             raise GeometryError(
                 f"linear-directrix: {name} meets the directrix d at u = {xm:.6g}: "
@@ -584,7 +584,7 @@ def _linear_directrix(c1: Curve, c2: Curve, count: int, d: np.ndarray, info: dic
             "linear-directrix: the plane through the directrix d and a_0 (generator 0) does not "
             "meet c2")
     v0, j0 = min(starts)
-    sig2, ok, end = lev2.follow(theta1 + j0 * np.pi, v0)
+    sig2, _ok, end = lev2.follow(theta1 + j0 * np.pi, v0)
     if end is not None:
         raise _ended("linear-directrix", "c2", end, k, count,
                      ": the planes through d and the points of c1 stop meeting c2 along one "
@@ -701,7 +701,7 @@ def three_directrices(c1: Curve, c2: Curve, c3: Curve, count: int, *,
         x = candidates[0]
     sol = np.empty((len(grid), 3))
     sol[0] = x
-    a_param = lambda g: float(arc1.value(np.array(g)))  # noqa: E731
+    a_param = lambda g: float(arc1.value(np.array(g)))
     for i in range(1, len(grid)):
         # continue from grid[i-1] to grid[i] with step halving; a secant predictor
         g0, g1 = grid[i - 1], grid[i]
@@ -882,7 +882,8 @@ def from_csv(path: str | os.PathLike, *, tol: Tolerances = DEFAULT) -> Rulings:
         with open(name, encoding="utf-8") as fh:
             text = fh.read()
     except (OSError, UnicodeDecodeError) as exc:
-        raise DesignError(f"cannot read the file: {exc.strerror or exc}", None, name) from None
+        reason = exc.strerror if isinstance(exc, OSError) and exc.strerror else exc
+        raise DesignError(f"cannot read the file: {reason}", None, name) from None
     rows = []
     first = True
     for number, line in enumerate(text.splitlines(), start=1):

@@ -22,7 +22,8 @@ there is nothing to measure, and a table of zeros would read as a result.
 from __future__ import annotations
 
 import inspect
-from typing import Any, Mapping
+from collections.abc import Mapping
+from typing import Any
 
 import numpy as np
 
@@ -183,7 +184,7 @@ def _figures(mesh: Mesh, tol: Tolerances) -> dict[str, Any]:
     diag = mesh.diagonal() or 1.0
     plan = F.planarity(mesh)
     convex = F.convexity(mesh, tol.convexity)
-    normals, areas = F.face_normals(mesh)
+    _normals, areas = F.face_normals(mesh)
     angles = F.corner_angles(mesh)
     edges = mesh.edges()
     lengths = np.linalg.norm(mesh.vertices[edges[:, 1]] - mesh.vertices[edges[:, 0]], axis=1)
@@ -191,7 +192,7 @@ def _figures(mesh: Mesh, tol: Tolerances) -> dict[str, Any]:
     report: dict[str, Any] = {
         "vertices": mesh.n_vertices,
         "faces": mesh.n_faces,
-        "members": int(len(mesh.members)),
+        "members": len(mesh.members),
         "kinds": mesh.count_kinds(),
         "valences": {str(int(k)): int(c) for k, c in zip(*np.unique(mesh.valences, return_counts=True))},
         "finite": finite,

@@ -10,10 +10,21 @@ seeds a few vectorised Gauss-Newton steps on ``|S(u, t) - p|^2`` with
 from __future__ import annotations
 
 from dataclasses import dataclass, field
+from typing import Protocol
 
 import numpy as np
 
-__all__ = ["RuledReference"]
+__all__ = ["RuledPatch", "RuledReference"]
+
+
+class RuledPatch(Protocol):
+    """What :class:`RuledReference` needs of a smooth surface patch ``0 <= u, t <= 1``."""
+
+    def point(self, u: np.ndarray, t: np.ndarray) -> np.ndarray: ...
+
+    def partials(self, u: np.ndarray, t: np.ndarray) -> tuple[np.ndarray, np.ndarray]: ...
+
+    def area(self) -> float: ...
 
 
 @dataclass(frozen=True, eq=False)
@@ -28,7 +39,7 @@ class RuledReference:
         Grid resolution of the seeding samples per direction.
     """
 
-    surface: object
+    surface: RuledPatch
     samples: int = 64
     _cache: dict = field(default_factory=dict, repr=False)
 

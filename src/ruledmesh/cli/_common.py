@@ -110,7 +110,7 @@ def file_kind(path: Path) -> str | None:
     for name, test in _BINARY_KINDS:
         if test(head):
             return name
-    if len(head) >= 84 and b"\0" in head[:84] and not head[:5].lower() == b"solid":
+    if len(head) >= 84 and b"\0" in head[:84] and head[:5].lower() != b"solid":
         return "a binary STL mesh" if path.suffix.lower() == ".stl" else None
     try:
         text = head.decode("utf-8")

@@ -113,7 +113,7 @@ def run(args) -> int:
 
     reports = compare(load_design(check_design_file(args.design)), args.rows, args.divisions, args.midpoints)
     if args.json:
-        json.dump({m: {k: v for k, v in r.items()} for m, r in reports.items()}, sys.stdout,
+        json.dump({m: dict(r.items()) for m, r in reports.items()}, sys.stdout,
                   indent=2, default=str)
         sys.stdout.write("\n")
     else:

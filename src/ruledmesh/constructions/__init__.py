@@ -33,7 +33,7 @@ from .helicoid import helicoid_mesh
 from .hyperbolic_paraboloid import hyperbolic_paraboloid_mesh
 from .hyperboloid import hyperboloid_mesh
 from .moulding import moulding_mesh, pipe_mesh
-from .quadrics import elliptic_paraboloid_mesh, ellipsoid_mesh, two_sheet_hyperboloid_mesh
+from .quadrics import ellipsoid_mesh, elliptic_paraboloid_mesh, two_sheet_hyperboloid_mesh
 from .rotational import rotational_mesh
 from .strips import parallel_edge_strips, similar_strips
 from .translational import translational_mesh

@@ -32,8 +32,8 @@ def grid_quads(nu: int, nv: int, wrap_u: bool = False, wrap_v: bool = False) -> 
     """
     iu = np.arange(nu if wrap_u else nu - 1)
     jv = np.arange(nv if wrap_v else nv - 1)
-    i, j = np.meshgrid(iu, jv, indexing="ij")
-    i, j = i.ravel(), j.ravel()
+    gi, gj = np.meshgrid(iu, jv, indexing="ij")
+    i, j = gi.ravel(), gj.ravel()
     i1 = (i + 1) % nu
     j1 = (j + 1) % nv
     return np.stack([i * nv + j, i1 * nv + j, i1 * nv + j1, i * nv + j1], axis=1).astype(np.int64)

@@ -15,7 +15,7 @@ inversion of a torus mesh in a sphere, circular again (§2.3).
 
 from __future__ import annotations
 
-from typing import Mapping
+from collections.abc import Mapping
 
 import numpy as np
 
@@ -209,7 +209,7 @@ def _build_canal(table: Mapping, mesh_table: Mapping, ctx: BuildContext) -> Buil
     if f.has("radius"):
         radii = np.full(len(spine), f.float("radius", lo=0.0, lo_open=True))
     else:
-        given = f.floats("radii", positive=True)
+        given = f.floats("radii", Fields.REQUIRED, positive=True)
         if given.size == 2 and len(spine) != 2:
             # From the first to the last sphere, linear in arc length along the spine.
             arc = np.concatenate([[0.0], np.cumsum(np.linalg.norm(np.diff(spine, axis=0), axis=1))])

@@ -7,7 +7,7 @@ mesh's members.  These polyhedra *are* the surfaces (no smooth reference).
 
 from __future__ import annotations
 
-from typing import Mapping
+from collections.abc import Mapping
 
 import numpy as np
 

@@ -17,7 +17,7 @@ family as the two profiles).
 
 from __future__ import annotations
 
-from typing import Mapping
+from collections.abc import Mapping
 
 import numpy as np
 

@@ -19,8 +19,8 @@ paper that turns the orthogonal grid of a right HP into any other.
 
 from __future__ import annotations
 
+from collections.abc import Mapping
 from enum import Enum
-from typing import Mapping
 
 import numpy as np
 

@@ -16,8 +16,8 @@ an isosceles trapezoid (circular).  The generators are the mesh's members.
 
 from __future__ import annotations
 
+from collections.abc import Mapping
 from enum import Enum
-from typing import Mapping
 
 import numpy as np
 
@@ -101,8 +101,8 @@ def hyperboloid_mesh(a: float, c: float, height: float, u: int, v: int | None = 
         rho = 1.0 / np.cos(ang)
         # Cell diagonals: (m, p)-(m+1, p+1) on the first regulus, (m+1, p)-(m, p+1) on the second.
         nv = len(p)
-        m, q = np.meshgrid(np.arange(u), np.arange(nv - 1), indexing="ij")
-        m, q = m.ravel(), q.ravel()
+        gm, gq = np.meshgrid(np.arange(u), np.arange(nv - 1), indexing="ij")
+        m, q = gm.ravel(), gq.ravel()
         m1 = (m + 1) % u
         members = np.concatenate([np.stack([m * nv + q, m1 * nv + q + 1], axis=1),
                                   np.stack([m1 * nv + q, m * nv + q + 1], axis=1)])

@@ -21,7 +21,7 @@ an exact torus.
 
 from __future__ import annotations
 
-from typing import Mapping
+from collections.abc import Mapping
 
 import numpy as np
 
@@ -215,7 +215,7 @@ def _build_pipe(table: Mapping, mesh_table: Mapping, ctx: BuildContext) -> Built
     spine = profile_from_spec(f.raw("spine", Fields.REQUIRED), "surface.spine").sample(u)
     radius = f.float("radius", Fields.REQUIRED, lo=0.0, lo_open=True)
     try:
-        mesh = pipe_mesh(spine, radius, v, normal=f.vector("normal", None, nonzero=True))
+        mesh = pipe_mesh(spine, radius, v, normal=f.optional_vector("normal", nonzero=True))
     except GeometryError as exc:
         raise DesignError(str(exc), "surface.spine") from None
     return Built(mesh, pipe_of_polyline(spine, radius), None,

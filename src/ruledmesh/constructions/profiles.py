@@ -18,9 +18,10 @@ Analytic profiles are sampled uniformly in their parameter with the count the
 
 from __future__ import annotations
 
+from collections.abc import Callable, Mapping
 from dataclasses import dataclass
 from enum import Enum
-from typing import Any, Callable, Mapping
+from typing import Any
 
 import numpy as np
 

@@ -11,7 +11,7 @@ meshes circular.  Poles become triangles.
 
 from __future__ import annotations
 
-from typing import Mapping
+from collections.abc import Mapping
 
 import numpy as np
 

@@ -18,10 +18,12 @@ whole surface, not only the meshed patch.
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from dataclasses import dataclass
-from typing import Callable
 
 import numpy as np
+
+from ..errors import GeometryError
 
 __all__ = [
     "ImplicitSurface",
@@ -92,6 +94,8 @@ class ImplicitSurface:
         points = np.asarray(points, dtype=np.float64).reshape(-1, 3)
         if self.exact is not None:
             return self.exact(points)
+        if self.value is None or self.gradient is None:
+            raise GeometryError("the implicit surface has neither a distance nor a value and gradient")
         return newton_distance(self.value, self.gradient, points)
 
     def area(self) -> float | None:

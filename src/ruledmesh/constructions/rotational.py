@@ -8,7 +8,7 @@ become poles where the quads turn into triangles.
 
 from __future__ import annotations
 
-from typing import Mapping
+from collections.abc import Mapping
 
 import numpy as np
 

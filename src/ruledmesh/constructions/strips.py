@@ -10,7 +10,7 @@ have parallel edges without being similar).
 
 from __future__ import annotations
 
-from typing import Mapping
+from collections.abc import Mapping
 
 import numpy as np
 

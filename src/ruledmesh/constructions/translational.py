@@ -8,11 +8,12 @@ is translated along it.
 
 from __future__ import annotations
 
-from typing import Mapping
+from collections.abc import Mapping
 
 import numpy as np
 
 from .._validation import check_points
+from ..errors import ParameterError
 from ..registry import BuildContext, Built, surface_kind
 from ._grid import grid_mesh
 from ._spec import Fields, mesh_counts
@@ -51,14 +52,17 @@ class TranslationalPatch:
     """
 
     def __init__(self, p: Profile, q: Profile):
+        if p.derivative is None or q.derivative is None:
+            raise ParameterError("expected analytic profiles (a polyline has no derivative)", "p")
         self.p, self.q = p, q
+        self._dp, self._dq = p.derivative, q.derivative
         self._q0 = q.point(np.zeros(1))[0]
 
     def point(self, u, t):
         return self.p.point(np.asarray(u)) + self.q.point(np.asarray(t)) - self._q0
 
     def partials(self, u, t):
-        return self.p.derivative(np.asarray(u)), self.q.derivative(np.asarray(t))
+        return self._dp(np.asarray(u)), self._dq(np.asarray(t))
 
     def area(self) -> float:
         return parametric_area(self.partials, (0.0, 1.0), (0.0, 1.0))

@@ -149,7 +149,7 @@ def fabricate(mesh: Mesh, folder: str | os.PathLike, *, sheet: tuple[float, floa
         write_atomic(folder / name, data)
         written.append(name)
 
-    unit = mesh.units if not unit else unit
+    unit = unit if unit else mesh.units
     progress = progress or SILENT
     # Not a ``with``: the caller closes what an error leaves open (TerminalProgress.close).
     task = stages(progress, "fabricate", ["unroll", "hot wire", "layout", "labels", "classes"])

@@ -10,12 +10,12 @@ Hops input it comes from.  All components share the outputs of
 from __future__ import annotations
 
 import json
+import tomllib
 from collections.abc import Callable, Mapping
 from dataclasses import replace
 from typing import Any
 
 import numpy as np
-import tomllib
 
 from ..errors import DesignError, ParameterError
 from .geometry import (

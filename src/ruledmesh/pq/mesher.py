@@ -79,7 +79,7 @@ def _cut_at(run: Run, primary: int, m: int) -> tuple[int | None, int | None]:
     bad = (run.failing >= 2) & (run.failing >= _RESTART_SHARE * np.maximum(run.on_patch, 1))
     right = [k for k in np.flatnonzero(bad) if k >= primary + 3 and m - k >= 3]
     left = [k for k in np.flatnonzero(bad) if k <= primary - 3 and k >= 2]
-    return (right[0] if right else None), (left[-1] if left else None)
+    return (int(right[0]) if right else None), (int(left[-1]) if left else None)
 
 
 def _uniform_t(rows: int) -> np.ndarray:

@@ -159,7 +159,7 @@ def closest_parallel_offset(vertices: np.ndarray, edges: np.ndarray, normals: np
     scale = abs(distance)
     residual = np.inf
     steps = 0
-    for steps in range(1, max_steps + 1):
+    for steps in range(1, max_steps + 1):  # noqa: B007 - the count is returned
         r1 = q - Q @ x - C.T @ lam
         r2 = -(C @ x)
         dx = lu.solve(np.concatenate([r1, r2]))
