@@ -6,10 +6,10 @@ import numpy as np
 import pytest
 
 from ruledmesh.analysis.triangles import compare_tessellations
-from ruledmesh.constructions.reference import ImplicitSurface
 from ruledmesh.errors import DesignError, GeometryError, ParameterError
 from ruledmesh.mesh import Mesh
 from ruledmesh.rulings import from_csv
+from ruledmesh.surfaces import ImplicitSurface
 
 
 def test_csv_not_utf8_names_the_decoding_error(tmp_path):

@@ -351,7 +351,7 @@ def compound_mesh(P: Any, midpoints: int = 1, divisions: int = 8, border: str = 
 
 # --------------------------------------------------------------------------- design files
 _SURFACE_KEYS = ("kind", "seed", "u_steps", "v_steps")
-_MESH_KEYS = ("midpoints", "divisions", "border")
+MESH_KEYS = ("midpoints", "divisions", "border")
 
 
 @surface_kind("compound-hp")
@@ -359,7 +359,7 @@ def build_compound(surface: Mapping[str, Any], mesh_table: Mapping[str, Any],
                    ctx: BuildContext, tol: Tolerances = DEFAULT) -> Built:
     """Design-file builder for ``[surface] kind = "compound-hp"``."""
     check_keys(surface, _SURFACE_KEYS, "surface", err=DesignError)
-    check_keys(mesh_table, _MESH_KEYS, "mesh", err=DesignError)
+    check_keys(mesh_table, MESH_KEYS, "mesh", err=DesignError)
     if "seed" not in surface:
         raise DesignError("missing: the first two generators [[a0, b0], [a1, b1]]", "surface.seed")
     seed = surface["seed"]
@@ -416,7 +416,7 @@ class CompoundReference:
     """
 
     def __init__(self, P: np.ndarray):
-        from .analysis.surface import RuledReference
+        from .surfaces import RuledReference
 
         self._ref = RuledReference(CompoundSurface(np.asarray(P, dtype=np.float64)))
 

@@ -73,7 +73,7 @@ def _unit(v: np.ndarray) -> np.ndarray:
     return v / np.linalg.norm(v)
 
 
-def _perpendicular(axis: np.ndarray) -> np.ndarray:
+def perpendicular(axis: np.ndarray) -> np.ndarray:
     """A deterministic unit vector perpendicular to ``axis``.
 
     Projects the coordinate axis least aligned with ``axis``, so the same axis
@@ -124,7 +124,7 @@ class _LiesInLevel(Exception):
     """The level function equals the target everywhere (curve in the plane)."""
 
 
-class _Level:
+class LevelSet:
     """A continuous scalar function ``g`` on [0, 1] cut into monotone pieces.
 
     Parameters
@@ -527,9 +527,9 @@ class Curve:
         return u
 
     # --- planes ----------------------------------------------------------------
-    def _plane_level(self, unit_normal: np.ndarray, tol: Tolerances) -> _Level:
+    def _plane_level(self, unit_normal: np.ndarray, tol: Tolerances) -> LevelSet:
         n = unit_normal
-        return _Level(lambda u: self._eval(np.asarray(u, dtype=np.float64)) @ n,
+        return LevelSet(lambda u: self._eval(np.asarray(u, dtype=np.float64)) @ n,
                       lambda u: self._deriv(np.asarray(u, dtype=np.float64), 1) @ n,
                       np.concatenate([self._level_grid(), self._breaks()]),
                       tol.degenerate * self._size)
@@ -839,7 +839,7 @@ class Arc(Curve):
         """
         normal = check_vector(normal, "normal", nonzero=True)
         if x_axis is None:
-            x_axis = _perpendicular(normal)
+            x_axis = perpendicular(normal)
         return cls(center, radius, normal, x_axis, start_angle, end_angle)
 
     @cached_property
@@ -1060,7 +1060,7 @@ class Helix(Curve):
     @cached_property
     def _frame(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         a = _unit(self.axis)
-        x = _perpendicular(a)
+        x = perpendicular(a)
         return a, x, np.cross(a, x)
 
     def _eval(self, u):

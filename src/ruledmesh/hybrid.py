@@ -542,13 +542,13 @@ def hybrid_mesh(a: Any, b: Any, *, midpoints: int = 1, divisions: int = 8, flip:
 
 
 # --------------------------------------------------------------------------- design files
-_MESH_KEYS = ("method", "midpoints", "divisions", "flip", "orient")
+MESH_KEYS = ("method", "midpoints", "divisions", "flip", "orient")
 
 
 @mesh_method("hybrid")
 def build_hybrid(rulings, table: Mapping[str, Any], ctx: BuildContext) -> Built:
     """Design-file builder for ``[mesh] method = "hybrid"``."""
-    check_keys(table, _MESH_KEYS, "mesh", err=DesignError)
+    check_keys(table, MESH_KEYS, "mesh", err=DesignError)
     midpoints = check_int(table.get("midpoints", 1), "mesh.midpoints", lo=0, hi=10_000,
                           err=DesignError)
     divisions = check_int(table.get("divisions", 8), "mesh.divisions", lo=1, hi=1_000_000,
@@ -559,7 +559,7 @@ def build_hybrid(rulings, table: Mapping[str, Any], ctx: BuildContext) -> Built:
                        orient=orient)
     reference = None
     if getattr(rulings, "surface", None) is not None:
-        from .analysis.surface import RuledReference
+        from .surfaces import RuledReference
 
         reference = RuledReference(rulings.surface)
     extras = {"hybrid": {"triangles": int(np.count_nonzero(mesh.face_kind == FaceKind.TRIANGLE)),

@@ -62,7 +62,7 @@ class FaceKind(IntEnum):
             ) from None
 
 
-def _offsets_from_valences(valences: np.ndarray) -> np.ndarray:
+def offsets_from_valences(valences: np.ndarray) -> np.ndarray:
     offsets = np.zeros(len(valences) + 1, dtype=np.int64)
     np.cumsum(valences, out=offsets[1:])
     return offsets
@@ -183,7 +183,7 @@ class Mesh:
         else:
             faces = list(faces)
             val = np.fromiter((len(f) for f in faces), dtype=np.int64, count=len(faces))
-            off = _offsets_from_valences(val)
+            off = offsets_from_valences(val)
             idx = (np.concatenate([np.asarray(f, np.int64) for f in faces])
                    if faces else np.zeros(0, np.int64))
         return cls.from_arrays(vertices, off, idx, face_kind, **kwargs)
@@ -341,7 +341,7 @@ class Mesh:
         mask = np.asarray(mask, dtype=bool)
         val = self.valences[mask]
         keep = np.repeat(mask, self.valences)
-        return replace(self, face_offsets=_offsets_from_valences(val),
+        return replace(self, face_offsets=offsets_from_valences(val),
                        face_indices=self.face_indices[keep], face_kind=self.face_kind[mask])
 
     def compact(self) -> Mesh:
@@ -397,7 +397,7 @@ class Mesh:
         ok_face = val >= 3
         keep &= ok_face[face_of]
         mem_ok = self.members[:, 0] != self.members[:, 1]
-        return replace(self, face_offsets=_offsets_from_valences(val[ok_face]),
+        return replace(self, face_offsets=offsets_from_valences(val[ok_face]),
                        face_indices=idx[keep], face_kind=self.face_kind[ok_face],
                        members=self.members[mem_ok], member_id=self.member_id[mem_ok])
 

@@ -97,8 +97,8 @@ PLUGINS = [
     "ruledmesh.pq",
     "ruledmesh.hybrid",
     "ruledmesh.compound",
-    "ruledmesh.constructions",
-    "ruledmesh.transforms",
+    "ruledmesh.design.catalogue",
+    "ruledmesh.design.transforms",
 ]
 
 _loaded = False

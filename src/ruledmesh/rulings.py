@@ -53,7 +53,7 @@ from ._validation import (
     check_vector,
     describe,
 )
-from .curves import BSpline, Curve, _Level, _perpendicular
+from .curves import BSpline, Curve, LevelSet, perpendicular
 from .errors import DesignError, GeometryError, ParameterError
 from .tolerances import DEFAULT, Tolerances
 
@@ -118,7 +118,7 @@ def _arc_sigma(curve: Curve, count: int) -> Any:
     exact = _ArcLength(curve)
     if not isinstance(curve, BSpline):
         return exact
-    grid, _ = _dense_grid(count)
+    grid, _ = dense_grid(count)
     values = exact.value(grid)
     speed = curve._speed(values)
     if np.all(speed > 1e-12 * curve.length()):
@@ -323,7 +323,7 @@ def _check_generators(a: np.ndarray, b: np.ndarray, what: str, tol: Tolerances) 
             f"{np.array2string(a[i], precision=6, separator=', ')}")
 
 
-def _dense_grid(count: int) -> tuple[np.ndarray, int]:
+def dense_grid(count: int) -> tuple[np.ndarray, int]:
     """A dense u grid holding the ``count`` generator parameters at every k-th node."""
     k = max(1, math.ceil(_DENSE / (count - 1)))
     return np.linspace(0.0, 1.0, k * (count - 1) + 1), k
@@ -454,7 +454,7 @@ def _director_plane(c1: Curve, c2: Curve, count: int, normal: np.ndarray, info: 
             f"[{lo1:g}, {hi1:g}] on c1 and [{lo2:g}, {hi2:g}] on c2")
     # sweep in the direction that runs along c1 from its start
     forward = levels[0].values[-1] >= levels[0].values[0]
-    grid, k = _dense_grid(count)
+    grid, k = dense_grid(count)
     s = lo + grid * (hi - lo) if forward else hi - grid * (hi - lo)
     sig = []
     for name, lev in zip(("c1", "c2"), levels):
@@ -488,7 +488,7 @@ class _PencilAngle:
     def __init__(self, d: np.ndarray):
         self.d0 = d[0]
         self.e = (d[1] - d[0]) / np.linalg.norm(d[1] - d[0])
-        self.p = _perpendicular(self.e)
+        self.p = perpendicular(self.e)
         self.q = np.cross(self.e, self.p)
 
     def xy(self, pts: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -503,7 +503,7 @@ class _PencilAngle:
         x, y = self.xy(pts)
         return np.hypot(x, y)
 
-    def level(self, curve: Curve, name: str, tol: Tolerances) -> _Level:
+    def level(self, curve: Curve, name: str, tol: Tolerances) -> LevelSet:
         grid = np.unique(np.concatenate([curve._level_grid(), curve._breaks()]))
         # the closest approach to d, polished between the neighbours of the
         # nearest sample (there the pencil angle jumps by pi)
@@ -544,13 +544,13 @@ class _PencilAngle:
             dx, dy = self.xy(curve._deriv(u, 1) + self.d0)
             return (x * dy - y * dx) / (x * x + y * y)
 
-        return _Level(g, dg, grid, tol.degenerate)
+        return LevelSet(g, dg, grid, tol.degenerate)
 
 
 def _linear_directrix(c1: Curve, c2: Curve, count: int, d: np.ndarray, info: dict,
                       tol: Tolerances) -> Rulings:
     pencil = _PencilAngle(d)
-    grid, k = _dense_grid(count)
+    grid, k = dense_grid(count)
     arc1 = _arc_sigma(c1, count)
     sig1 = arc1.value(grid)
     pts1 = c1._eval(sig1)
@@ -687,7 +687,7 @@ def three_directrices(c1: Curve, c2: Curve, c3: Curve, count: int, *,
     c3 = _check_curve(c3, "c3")
     count = check_int(count, "count", lo=2)
     size = max(c1._size, c2._size, c3._size)
-    grid, k = _dense_grid(count)
+    grid, k = dense_grid(count)
     arc1 = _arc_sigma(c1, count)
     sig1 = arc1.value(grid)
     pts1 = c1._eval(sig1)

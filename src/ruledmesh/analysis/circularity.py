@@ -11,8 +11,10 @@ through three well-spread vertices; triangles are circular by definition.
 A *parallelogram* quad has ``p0 - p1 + p2 - p3 = 0`` (its diagonals bisect each
 other); the measure is that vector's length over the mean diagonal length.
 
-Both register with :data:`ruledmesh.analysis.report.METRIC_HOOKS` and appear
-in ``ruledmesh analyze`` for meshes with quads.
+Both appear in ``ruledmesh analyze`` for meshes with quads (the report
+registers :func:`circularity_report` and :func:`parallelogram_report`); the
+measures themselves depend on the mesh only, so the meshers and transforms
+may use them.
 """
 
 from __future__ import annotations
@@ -21,7 +23,6 @@ import numpy as np
 
 from ..mesh import Mesh
 from ..tolerances import DEFAULT, Tolerances
-from .report import METRIC_HOOKS
 
 __all__ = ["circle_through", "quad_circularity", "circularity", "quad_parallelogram",
            "parallelogram", "circularity_report", "parallelogram_report"]
@@ -168,6 +169,3 @@ def parallelogram_report(mesh: Mesh, tol: Tolerances = DEFAULT) -> dict | None:
             "above_tolerance": int(np.count_nonzero(m > tol.planarity)),
             "all_quads": bool(np.all(m <= tol.planarity))}
 
-
-METRIC_HOOKS["circularity"] = circularity_report
-METRIC_HOOKS["parallelogram"] = parallelogram_report

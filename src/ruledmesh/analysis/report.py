@@ -57,12 +57,17 @@ MISMATCH: dict[str, Any] = {"closeness": 0.1, "coverage": (0.5, 2.0)}
 # Extra figures from other modules: name -> fn(mesh) -> dict or None (None: not applicable).
 # Modules in _HOOK_MODULES register themselves here when imported.
 METRIC_HOOKS: dict[str, Any] = {}
-_HOOK_MODULES = ["ruledmesh.analysis.circularity", "ruledmesh.analysis.triangles"]
+_HOOK_MODULES = ["ruledmesh.analysis.triangles"]
 
 
 def _load_hooks() -> None:
     import importlib
 
+    # circularity is a measure the transforms use too: it does not import the report
+    from .circularity import circularity_report, parallelogram_report
+
+    METRIC_HOOKS.setdefault("circularity", circularity_report)
+    METRIC_HOOKS.setdefault("parallelogram", parallelogram_report)
     for name in _HOOK_MODULES:
         try:
             importlib.import_module(name)

@@ -213,12 +213,12 @@ def read_source(typed: str, progress: Progress | None = None) -> Source:
         raise InputError(f"{typed}: this is {kind or 'a file of unknown kind'}; ruledmesh reads "
                          f"meshes ({readable}) and design files (.toml)")
     from ..errors import ParameterError
-    from ..io import _module
+    from ..io import format_module
 
     with (progress or SILENT).task(f"read {typed}"):
         try:
             # Content decides the reader: an OBJ saved as .txt is still read as OBJ.
-            mesh = _module(ext, READERS, "read").loadb(path.read_bytes())
+            mesh = format_module(ext, READERS, "read").loadb(path.read_bytes())
         except ParameterError as exc:
             raise InputError(f"{typed}: cannot be read as a {ext} mesh: {exc.detail}") from None
     if mesh.n_faces == 0:

@@ -1,7 +1,8 @@
 """Surfaces with exact PQ analogues (paper §2-§3), one module per family.
 
-Importing this package registers every design-file kind with
-:mod:`ruledmesh.registry` (see ``docs/design-reference.md``):
+The maths only: arrays and numbers in, a :class:`~ruledmesh.mesh.Mesh` out.
+The design-file kinds (see ``docs/design-reference.md``) are read by
+:mod:`ruledmesh.design.catalogue`, which calls these functions:
 
 ==========================  ===============================  =========================
 kind                        function                         every face

@@ -9,7 +9,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..mesh import FaceKind, Mesh, _offsets_from_valences
+from ..mesh import FaceKind, Mesh, offsets_from_valences
 
 __all__ = ["grid_quads", "grid_mesh", "polyline_members"]
 
@@ -99,7 +99,7 @@ def grid_mesh(points: np.ndarray, *, wrap_u: bool = False, wrap_v: bool = False,
            else np.asarray(member_id, np.int64))
     real = mem[:, 0] != mem[:, 1]
     mem, mid = mem[real], mid[real]
-    mesh = Mesh(verts.copy(), _offsets_from_valences(valence), q[keep], kinds, mem, mid, {},
+    mesh = Mesh(verts.copy(), offsets_from_valences(valence), q[keep], kinds, mem, mid, {},
                 dict(info or {}))
     return mesh.compact()
 

@@ -51,7 +51,7 @@ def build_pq(rulings, table: Mapping[str, Any], ctx: BuildContext) -> Built:
         rulings, mesh = _refined(rulings, mesh, options)
     reference = None
     if getattr(rulings, "surface", None) is not None:
-        from ..analysis.surface import RuledReference
+        from ..surfaces import RuledReference
 
         reference = RuledReference(rulings.surface)
     return Built(mesh.with_info(source=ctx.source), reference, rulings)
@@ -80,12 +80,12 @@ def _refined(rulings, mesh, options: dict):
     from dataclasses import replace
 
     from ..analysis.faces import area_shares
-    from ..rulings import _dense_grid
+    from ..rulings import dense_grid
 
     surface = getattr(rulings, "surface", None)
     if surface is None or rulings.info.get("distribution") == "lines":
         return rulings, mesh
-    grid, _ = _dense_grid(len(rulings.u))
+    grid, _ = dense_grid(len(rulings.u))
     best = (area_shares(mesh)["quads"], rulings, mesh)
     user = len(rulings.u) - int(rulings.info.get("inserted", 0))
     start = len(rulings.u)

@@ -18,10 +18,10 @@ from typing import Any
 
 import numpy as np
 
-from ._validation import check_keys, describe, near_miss
-from .errors import DesignError, RuledMeshError
-from .progress import SILENT, Progress, Task, stages
-from .registry import MESH_METHODS, SURFACE_KINDS, TRANSFORMS, BuildContext, Built, load_plugins
+from .._validation import check_keys, describe, near_miss
+from ..errors import DesignError, RuledMeshError
+from ..progress import SILENT, Progress, Task, stages
+from ..registry import MESH_METHODS, SURFACE_KINDS, TRANSFORMS, BuildContext, Built, load_plugins
 
 __all__ = ["Design", "load_design", "parse_design", "build_design", "build_file"]
 
@@ -77,7 +77,7 @@ def load_design(path: str | os.PathLike) -> Design:
     A relative ``examples/NAME.toml`` that does not exist here is the bundled
     example of that name (:func:`ruledmesh.bundled.resolve`).
     """
-    from .bundled import resolve
+    from ..bundled import resolve
 
     path = resolve(path)
     try:
@@ -100,7 +100,7 @@ def _table(data: Mapping, key: str, required: bool = False) -> Mapping:
 
 def _build(design: Design, progress: Progress) -> Built:
     data = design.data
-    from .units import unit_of
+    from ..units import unit_of
 
     units = unit_of(data.get("units"), "units", err=DesignError)
     load_plugins()
@@ -135,8 +135,8 @@ def _build_surface(design: Design, mesh_table: Mapping, task: Task) -> Built:
     else:
         if "rulings" not in data:
             raise DesignError("expected a [rulings] table (with [curves.*]) or a [surface] table", "rulings")
-        from .curves import curve_from_spec
-        from .rulings import rulings_from_spec
+        from ..curves import curve_from_spec
+        from ..rulings import rulings_from_spec
 
         curves_table = _table(data, "curves")
         curves = {}
@@ -175,7 +175,7 @@ MAX_BUILD_BYTES = 8 * 2**30
 
 def _check_budget(generators: int, rows: Any) -> None:
     """Refuse a §4.3 grid of ``generators x (rows + 1)`` points too large to build."""
-    from .rulings import BUILD_BYTES_PER_GRID_POINT
+    from ..rulings import BUILD_BYTES_PER_GRID_POINT
 
     if isinstance(rows, bool) or not isinstance(rows, int) or rows < 1:
         return  # the mesher reports a malformed value itself
@@ -193,7 +193,7 @@ def curve_kinks(curve) -> np.ndarray:
     Polyline corners, and knots of a B-spline repeated ``degree`` times (every
     interior knot of a degree-1 spline).
     """
-    from .curves import BSpline, Polyline
+    from ..curves import BSpline, Polyline
 
     if isinstance(curve, Polyline):
         return np.asarray(curve._knots[1:-1], dtype=float)
