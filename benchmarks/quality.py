@@ -394,8 +394,8 @@ def reference_of(design: Path, n_ref: int = REF_GENERATORS, rows: int = REF_ROWS
     lines it evaluates the rulings' smooth surface at ``n_ref`` parameters.
     Designs with ``[[transform]]`` tables are not supported (None).
     """
-    from ruledmesh.curves import curve_from_spec
     from ruledmesh.design import load_design
+    from ruledmesh.design.curves import curve_from_spec
     from ruledmesh.rulings import rulings_from_spec
 
     d = load_design(design)

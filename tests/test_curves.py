@@ -9,7 +9,8 @@ from hypothesis import HealthCheck, assume, given, settings
 from hypothesis import strategies as st
 from scipy.integrate import quad
 
-from ruledmesh.curves import Arc, BSpline, Helix, Line, Polyline, curve_from_spec
+from ruledmesh.curves import Arc, BSpline, Helix, Line, Polyline
+from ruledmesh.design.curves import curve_from_spec
 from ruledmesh.errors import DesignError, GeometryError, ParameterError
 
 SPLINE = BSpline([[0, 0, 0], [3, 1, 0], [6, -1, 0], [10, 0, 0]], 3)

@@ -17,14 +17,15 @@ level has at most one root, so ``brentq`` finds it; a touch shows up as a
 piece end within tolerance of the level; a branch *ends* where the sweep
 passes a piece end at which ``g`` turns back, or an end of the curve.
 
-``curve_from_spec`` reads the ``[curves.*]`` tables of a design file and
-``Curve.to_spec`` writes them back (``curve_from_spec(c.to_spec(), p) == c``).
+:func:`ruledmesh.design.curves.curve_from_spec` reads the ``[curves.*]`` tables
+of a design file and ``Curve.to_spec`` writes them back
+(``curve_from_spec(c.to_spec(), p) == c``).
 """
 
 from __future__ import annotations
 
 import math
-from collections.abc import Callable, Mapping
+from collections.abc import Callable
 from dataclasses import dataclass, fields
 from enum import Enum
 from functools import cached_property
@@ -36,16 +37,13 @@ from scipy.interpolate import make_interp_spline
 from scipy.optimize import brentq
 
 from ._validation import (
-    check_bool,
-    check_choice,
     check_float,
     check_int,
-    check_keys,
     check_points,
     check_vector,
     describe,
 )
-from .errors import DesignError, GeometryError, ParameterError
+from .errors import GeometryError, ParameterError
 from .tolerances import DEFAULT, Tolerances
 
 __all__ = [
@@ -56,7 +54,6 @@ __all__ = [
     "BSpline",
     "Helix",
     "CurveType",
-    "curve_from_spec",
 ]
 
 # Gauss-Legendre nodes per arc-length piece; with pieces no longer than half a
@@ -359,7 +356,7 @@ class Curve:
         return np.linspace(0.0, 1.0, 65)
 
     def to_spec(self) -> dict:
-        """A design-file table that :func:`curve_from_spec` reads back to an equal curve."""
+        """A design-file table that :func:`~ruledmesh.design.curves.curve_from_spec` reads back."""
         raise NotImplementedError
 
     # --- evaluation --------------------------------------------------------
@@ -1094,140 +1091,3 @@ class Helix(Curve):
         return {"type": "helix", "center": _as_list(self.center), "axis": _as_list(self.axis),
                 "radius": self.radius, "pitch": self.pitch, "turns": self.turns,
                 "start_angle": self.start_angle}
-
-
-# --------------------------------------------------------------------------
-# design-file tables
-# --------------------------------------------------------------------------
-
-_KEYS = {
-    CurveType.LINE: ("type", "points"),
-    CurveType.POLYLINE: ("type", "points"),
-    CurveType.ARC: ("type", "points", "center", "radius", "normal", "start_angle", "end_angle",
-                    "x_axis"),
-    CurveType.BSPLINE: ("type", "points", "degree", "knots", "interpolate"),
-    CurveType.HELIX: ("type", "center", "axis", "radius", "pitch", "turns", "start_angle"),
-}
-
-
-def _require(spec: Mapping, key: str, path: str, what: str) -> Any:
-    if key not in spec:
-        raise DesignError(f"missing; expected {what}", f"{path}.{key}")
-    return spec[key]
-
-
-def curve_from_spec(spec: Mapping, path: str) -> Curve:
-    """Build a curve from a design file's ``[curves.<name>]`` table.
-
-    Parameters
-    ----------
-    spec : Mapping
-        E.g. ``{"type": "bspline", "degree": 3, "points": [[0, 0, 0], ...]}``.
-        Types and keys:
-
-        * ``line``: ``points`` (2 points);
-        * ``polyline``: ``points`` (>= 2);
-        * ``arc``: ``points`` (start, through, end) or ``center``, ``radius``,
-          ``normal``, ``start_angle``, ``end_angle`` (degrees) and optional
-          ``x_axis`` (direction of angle 0);
-        * ``bspline``: ``points`` (control points), ``degree`` (1..5, default
-          3), optional ``knots``; or ``interpolate = true`` to pass through
-          ``points``;
-        * ``helix``: ``center``, ``axis``, ``radius``, ``pitch``, ``turns``,
-          optional ``start_angle`` (degrees, default 0).
-    path : str
-        The table's dotted path, e.g. ``"curves.c1"``, prefixed to errors.
-
-    Returns
-    -------
-    Curve
-
-    Raises
-    ------
-    DesignError
-        With the full dotted field path, e.g.
-        ``curves.c1.degree: expected an integer >= 1 and <= 5, got 7``.
-
-    Examples
-    --------
-    >>> c = curve_from_spec({"type": "line", "points": [[0, 0, 0], [3, 4, 0]]}, "curves.c1")
-    >>> c.length()
-    5.0
-    >>> curve_from_spec(c.to_spec(), "curves.c1") == c
-    True
-    """
-    if not isinstance(spec, Mapping):
-        raise DesignError(f"expected a table, got {describe(spec)}", path)
-    kind = check_choice(_require(spec, "type", path, "one of " + " | ".join(
-        f'"{t.value}"' for t in CurveType)), CurveType, f"{path}.type", err=DesignError)
-    check_keys(spec, _KEYS[kind], path, err=DesignError)
-    E = DesignError
-
-    def pts(key: str, **kw: Any) -> np.ndarray:
-        return check_points(_require(spec, key, path, "a list of points [x, y, z]"),
-                            f"{path}.{key}", err=E, **kw)
-
-    def vec(key: str, nonzero: bool = False) -> np.ndarray:
-        return check_vector(_require(spec, key, path, "[x, y, z]"), f"{path}.{key}",
-                            nonzero=nonzero, err=E)
-
-    def num(key: str, default: Any = None, **kw: Any) -> float:
-        value = spec.get(key, default) if default is not None else _require(spec, key, path, "a number")
-        return check_float(value, f"{path}.{key}", err=E, **kw)
-
-    # constructor parameter -> design key, for re-attributing ParameterErrors
-    rename: dict[str, str] = {}
-    try:
-        if kind is CurveType.LINE:
-            p = pts("points")
-            if len(p) != 2:
-                raise E(f"expected 2 points, got {len(p)}", f"{path}.points")
-            rename = {"p0": "points", "p1": "points"}
-            return Line(p[0], p[1])
-        if kind is CurveType.POLYLINE:
-            return Polyline(pts("points", min_count=2))
-        if kind is CurveType.ARC:
-            center_keys = [k for k in ("center", "radius", "normal", "start_angle", "end_angle",
-                                       "x_axis") if k in spec]
-            if "points" in spec:
-                if center_keys:
-                    raise E("give either points (start, through, end) or center/radius/normal/"
-                            "angles, not both", f"{path}.{center_keys[0]}")
-                p = pts("points")
-                if len(p) != 3:
-                    raise E(f"expected 3 points (start, through, end), got {len(p)}",
-                            f"{path}.points")
-                rename = {"start": "points", "mid": "points", "end": "points"}
-                return Arc.through(p[0], p[1], p[2])
-            if not center_keys:
-                raise E("missing; expected points (start, through, end) or center, radius, "
-                        "normal, start_angle, end_angle", f"{path}.points")
-            x_axis = vec("x_axis", nonzero=True) if "x_axis" in spec else None
-            return Arc.from_center(vec("center"), num("radius", lo=0.0, lo_open=True),
-                                   vec("normal", nonzero=True), num("start_angle"),
-                                   num("end_angle"), x_axis)
-        if kind is CurveType.BSPLINE:
-            degree = check_int(spec.get("degree", 3), f"{path}.degree", lo=1, hi=5, err=E)
-            interp = check_bool(spec.get("interpolate", False), f"{path}.interpolate", err=E)
-            p = pts("points")
-            if len(p) < degree + 1:
-                raise E(f"a degree-{degree} B-spline needs at least {degree + 1} points, "
-                        f"got {len(p)}", f"{path}.points")
-            if interp:
-                if "knots" in spec:
-                    raise E("knots cannot be given with interpolate = true", f"{path}.knots")
-                return BSpline.interpolate(p, degree)
-            knots = None
-            if "knots" in spec:
-                knots = spec["knots"]
-                if isinstance(knots, (str, Mapping)):
-                    raise E(f"expected a list of numbers, got {describe(knots)}", f"{path}.knots")
-            rename = {"control_points": "points"}
-            return BSpline(p, degree, knots)
-        # helix
-        return Helix(vec("center"), vec("axis", nonzero=True), num("radius", lo=0.0, lo_open=True),
-                     num("pitch"), num("turns", lo=0.0, lo_open=True),
-                     num("start_angle", default=0.0))
-    except ParameterError as exc:
-        field = rename.get(exc.field or "", exc.field or "")
-        raise DesignError(exc.detail, f"{path}.{field}" if field else path) from None

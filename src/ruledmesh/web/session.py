@@ -718,7 +718,7 @@ def _curve_polylines(design: Mapping) -> tuple[list[str], list[int], np.ndarray]
 
     Curves that do not build are left out (the build reports their errors).
     """
-    from ..curves import curve_from_spec
+    from ..design.curves import curve_from_spec
 
     names: list[str] = []
     counts: list[int] = []
