@@ -36,17 +36,14 @@ its tangent plane).
 
 from __future__ import annotations
 
-from collections.abc import Mapping
 from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
 
-from ._validation import check_int, check_keys, check_points, describe
-from .errors import DesignError, GeometryError, ParameterError
+from ._validation import check_int, check_points, describe
+from .errors import GeometryError, ParameterError
 from .mesh import FaceKind, Mesh
-from .registry import BuildContext, Built, surface_kind
-from .tolerances import DEFAULT, Tolerances
 
 __all__ = ["c1_step", "compound_net", "c1_residual", "compound_mesh", "CompoundSurface",
            "CompoundReference"]
@@ -123,8 +120,8 @@ def compound_net(seed: Any, u_steps: Any = (), v_steps: Any = ()) -> tuple[np.nd
     if seed.shape != (2, 2, 3):
         raise ParameterError(f"expected two generators [[a0, b0], [a1, b1]], got {seed.shape[0]}",
                              "seed")
-    us = _steps(u_steps, "u_steps")
-    vs = _steps(v_steps, "v_steps")
+    us = check_steps(u_steps, "u_steps")
+    vs = check_steps(v_steps, "v_steps")
     I, J = len(us) + 1, len(vs) + 1
     P = np.full((I + 1, J + 1, 3), np.nan)
     P[:2, :2] = seed
@@ -157,7 +154,7 @@ def compound_net(seed: Any, u_steps: Any = (), v_steps: Any = ()) -> tuple[np.nd
     return P, gap
 
 
-def _steps(value: Any, name: str, err: type = ParameterError) -> np.ndarray:
+def check_steps(value: Any, name: str, err: type = ParameterError) -> np.ndarray:
     """``value`` as an (n, 3) array of ``(lambda, sigma, tau)`` with ``lambda > 0``."""
     expected = f"expected a list of [lambda, sigma, tau] triples, got {describe(value)}"
     try:
@@ -347,64 +344,6 @@ def compound_mesh(P: Any, midpoints: int = 1, divisions: int = 8, border: str = 
     mesh = Mesh(X, offsets, faces, kinds, members.astype(np.int64), member_id.astype(np.int64),
                 {"u": (x / nu).ravel(), "t": (y / nv).ravel()}, info)
     return mesh.compact()
-
-
-# --------------------------------------------------------------------------- design files
-_SURFACE_KEYS = ("kind", "seed", "u_steps", "v_steps")
-MESH_KEYS = ("midpoints", "divisions", "border")
-
-
-@surface_kind("compound-hp")
-def build_compound(surface: Mapping[str, Any], mesh_table: Mapping[str, Any],
-                   ctx: BuildContext, tol: Tolerances = DEFAULT) -> Built:
-    """Design-file builder for ``[surface] kind = "compound-hp"``."""
-    check_keys(surface, _SURFACE_KEYS, "surface", err=DesignError)
-    check_keys(mesh_table, MESH_KEYS, "mesh", err=DesignError)
-    if "seed" not in surface:
-        raise DesignError("missing: the first two generators [[a0, b0], [a1, b1]]", "surface.seed")
-    seed = surface["seed"]
-    try:
-        arr = np.asarray(seed, dtype=np.float64)
-    except (TypeError, ValueError):
-        arr = None
-    if arr is None or arr.shape != (2, 2, 3):
-        raise DesignError(f"expected two generators [[a0, b0], [a1, b1]], got {describe(seed)}",
-                          "surface.seed")
-    check_points(arr.reshape(4, 3), "surface.seed", err=DesignError)
-    steps = {}
-    for key in ("u_steps", "v_steps"):
-        value = surface.get(key, [])
-        if not isinstance(value, list):
-            raise DesignError(f"expected a list of [lambda, sigma, tau], got {describe(value)}",
-                              f"surface.{key}")
-        for k, row in enumerate(value):
-            if not isinstance(row, list) or len(row) != 3:
-                raise DesignError(f"expected [lambda, sigma, tau], got {describe(row)}",
-                                  f"surface.{key}[{k}]")
-        steps[key] = _steps(value, f"surface.{key}", err=DesignError)
-    midpoints = check_int(mesh_table.get("midpoints", 1), "mesh.midpoints", lo=0, hi=10_000,
-                          err=DesignError)
-    divisions = check_int(mesh_table.get("divisions", 8), "mesh.divisions", lo=1, hi=100_000,
-                          err=DesignError)
-    border = mesh_table.get("border", "notched")
-    if border not in ("notched", "triangles"):
-        raise DesignError(f'expected "notched" or "triangles", got {describe(border)}',
-                          "mesh.border")
-    P, gap = compound_net(arr, steps["u_steps"], steps["v_steps"])
-    mesh = compound_mesh(P, midpoints, divisions, border)
-    c1 = c1_residual(P)
-    scale = float(np.linalg.norm(np.ptp(P.reshape(-1, 3), axis=0))) or 1.0
-    warnings = []
-    if c1["max"] > tol.planarity * 1e3:
-        warnings.append(f"compound: tangent planes differ along a joint by {c1['max']:.2e} "
-                        "(sine of the angle)")
-    I, J = P.shape[0] - 1, P.shape[1] - 1
-    extras = {"c1": {"max_sine": c1["max"], "joints": c1["joints"],
-                     "corner_gap": gap / scale, "patches": [I, J],
-                     "free_numbers": 12 + 3 * (I - 1) + 3 * (J - 1),
-                     "net_numbers": 3 * (I + 1) * (J + 1)}}
-    mesh = mesh.with_info(source=ctx.source, warnings=warnings)
-    return Built(mesh, CompoundReference(P), None, extras)
 
 
 class CompoundReference:

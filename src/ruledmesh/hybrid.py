@@ -39,15 +39,13 @@ degenerate faces only, which are rare).
 from __future__ import annotations
 
 import itertools
-from collections.abc import Mapping
 from typing import Any
 
 import numpy as np
 
-from ._validation import check_bool, check_int, check_keys, check_points
-from .errors import DesignError, GeometryError, ParameterError
+from ._validation import check_bool, check_int, check_points
+from .errors import GeometryError, ParameterError
 from .mesh import FaceKind, Mesh
-from .registry import BuildContext, Built, mesh_method
 from .tolerances import DEFAULT, Tolerances
 
 __all__ = ["hybrid_mesh", "hybrid_grid", "orient_generators", "checkerboard_faces"]
@@ -539,30 +537,3 @@ def hybrid_mesh(a: Any, b: Any, *, midpoints: int = 1, divisions: int = 8, flip:
                 members.astype(np.int64), member_id.astype(np.int64),
                 {"t": t, "generator": gen, "u": col / n}, info)
     return mesh.compact()
-
-
-# --------------------------------------------------------------------------- design files
-MESH_KEYS = ("method", "midpoints", "divisions", "flip", "orient")
-
-
-@mesh_method("hybrid")
-def build_hybrid(rulings, table: Mapping[str, Any], ctx: BuildContext) -> Built:
-    """Design-file builder for ``[mesh] method = "hybrid"``."""
-    check_keys(table, MESH_KEYS, "mesh", err=DesignError)
-    midpoints = check_int(table.get("midpoints", 1), "mesh.midpoints", lo=0, hi=10_000,
-                          err=DesignError)
-    divisions = check_int(table.get("divisions", 8), "mesh.divisions", lo=1, hi=1_000_000,
-                          err=DesignError)
-    flip = check_bool(table.get("flip", False), "mesh.flip", err=DesignError)
-    orient = check_bool(table.get("orient", True), "mesh.orient", err=DesignError)
-    mesh = hybrid_mesh(rulings.a, rulings.b, midpoints=midpoints, divisions=divisions, flip=flip,
-                       orient=orient)
-    reference = None
-    if getattr(rulings, "surface", None) is not None:
-        from .surfaces import RuledReference
-
-        reference = RuledReference(rulings.surface)
-    extras = {"hybrid": {"triangles": int(np.count_nonzero(mesh.face_kind == FaceKind.TRIANGLE)),
-                         "quads": int(np.count_nonzero(mesh.face_kind == FaceKind.QUAD)),
-                         "collapsed_faces": mesh.info["collapsed_faces"]}}
-    return Built(mesh.with_info(source=ctx.source), reference, rulings, extras)

@@ -95,8 +95,7 @@ TRANSFORMS: dict[str, Callable[[Built, Mapping, str], Built]] = {}
 # Modules that register builders when imported; a module not yet written is skipped.
 PLUGINS = [
     "ruledmesh.pq",
-    "ruledmesh.hybrid",
-    "ruledmesh.compound",
+    "ruledmesh.design.meshers",
     "ruledmesh.design.catalogue",
     "ruledmesh.design.transforms",
 ]

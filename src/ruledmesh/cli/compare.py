@@ -66,8 +66,8 @@ def compare(design, rows=None, divisions=None, midpoints=None) -> dict:
     """
     from ..analysis.report import analyze
     from ..design import Design, build_design
+    from ..design.meshers import HYBRID_MESH_KEYS as HYBRID_KEYS
     from ..errors import DesignError
-    from ..hybrid import MESH_KEYS as HYBRID_KEYS
     from ..pq import MESH_KEYS as PQ_KEYS
 
     if "rulings" not in design.data:
