@@ -4,7 +4,7 @@ Every public function validates its inputs once, here, and the maths below it
 trusts them.  Each helper takes the parameter's ``name`` (a dotted field path
 for design files) and the error class to raise, so the same checks serve the
 Python API (:class:`~ruledmesh.errors.ParameterError`) and the design-file
-reader (:class:`~ruledmesh.errors.DesignError`).
+reader of :mod:`ruledmesh.design` (its own error class).
 """
 
 from __future__ import annotations

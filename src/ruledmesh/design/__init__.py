@@ -23,7 +23,7 @@ from ..errors import DesignError, RuledMeshError
 from ..progress import SILENT, Progress, Task, stages
 from ..registry import MESH_METHODS, SURFACE_KINDS, TRANSFORMS, BuildContext, Built, load_plugins
 
-__all__ = ["Design", "load_design", "parse_design", "build_design", "build_file"]
+__all__ = ["Design", "load_design", "parse_design", "design_from_tables", "build_design", "build_file"]
 
 TOP_LEVEL = ("curves", "rulings", "mesh", "surface", "transform", "name", "description", "units")
 
@@ -64,6 +64,18 @@ def parse_design(text: str, source: str = "<design>", base_dir: str | os.PathLik
         data = tomllib.loads(text)
     except tomllib.TOMLDecodeError as exc:
         raise DesignError(f"invalid TOML: {exc}", None, source) from None
+    return design_from_tables(data, source, base_dir)
+
+
+def design_from_tables(data: Mapping[str, Any], source: str = "<dict>",
+                       base_dir: str | os.PathLike = ".") -> Design:
+    """A :class:`Design` from tables already parsed (a dict shaped like the TOML file).
+
+    Raises
+    ------
+    DesignError
+        For unknown top-level tables, naming ``source``.
+    """
     try:
         check_keys(data, TOP_LEVEL, "", err=DesignError)
     except DesignError as exc:
