@@ -396,7 +396,7 @@ def reference_of(design: Path, n_ref: int = REF_GENERATORS, rows: int = REF_ROWS
     """
     from ruledmesh.design import load_design
     from ruledmesh.design.curves import curve_from_spec
-    from ruledmesh.rulings import rulings_from_spec
+    from ruledmesh.design.rulings import rulings_from_spec
 
     d = load_design(design)
     data = d.data

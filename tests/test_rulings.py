@@ -7,15 +7,14 @@ import pytest
 from scipy.integrate import dblquad
 
 from ruledmesh.curves import Arc, BSpline, Line, Polyline
+from ruledmesh.design.rulings import from_csv, rulings_from_spec
 from ruledmesh.errors import DesignError, GeometryError, ParameterError
 from ruledmesh.rulings import (
     Distribution,
     Rulings,
     between,
     conoid,
-    from_csv,
     from_lines,
-    rulings_from_spec,
     three_directrices,
 )
 

@@ -6,9 +6,9 @@ import numpy as np
 import pytest
 
 from ruledmesh.analysis.triangles import compare_tessellations
+from ruledmesh.design.rulings import from_csv
 from ruledmesh.errors import DesignError, GeometryError, ParameterError
 from ruledmesh.mesh import Mesh
-from ruledmesh.rulings import from_csv
 from ruledmesh.surfaces import ImplicitSurface
 
 

@@ -13,8 +13,9 @@ Constructors, one per way the paper gives a ruled surface:
   directrix ``d`` (the planes through ``d`` cut both curves);
 * :func:`three_directrices`: the lines meeting three curves (§5, general case);
 * :func:`conoid`: one curve, a line directrix and a director plane (§5.1);
-* :func:`from_lines` / :func:`from_csv`: explicit generators;
-* :func:`rulings_from_spec`: the ``[rulings]`` table of a design file.
+* :func:`from_lines`: explicit generators (a CSV file of them is read by
+  :func:`ruledmesh.design.rulings.from_csv`, the ``[rulings]`` table of a design
+  file by :func:`ruledmesh.design.rulings.rulings_from_spec`).
 
 The smooth reference surface.  For curve-based rulings ``A(u) = c1(sigma1(u))``
 lies exactly on c1 (likewise B on c2); only the correspondence ``sigma`` is
@@ -35,8 +36,6 @@ given lines is then followed rather than smoothed over.
 from __future__ import annotations
 
 import math
-import os
-from collections.abc import Mapping
 from dataclasses import dataclass, field
 from enum import Enum
 from typing import Any
@@ -48,13 +47,12 @@ from scipy.optimize import brentq
 from ._validation import (
     check_choice,
     check_int,
-    check_keys,
     check_points,
     check_vector,
     describe,
 )
 from .curves import BSpline, Curve, LevelSet, perpendicular
-from .errors import DesignError, GeometryError, ParameterError
+from .errors import GeometryError, ParameterError
 from .tolerances import DEFAULT, Tolerances
 
 __all__ = [
@@ -65,8 +63,8 @@ __all__ = [
     "three_directrices",
     "conoid",
     "from_lines",
-    "from_csv",
-    "rulings_from_spec",
+    "check_line",
+    "MAX_GENERATORS",
 ]
 
 # dense samples of a numerically found correspondence (PCHIP nodes)
@@ -412,11 +410,12 @@ def between(c1: Curve, c2: Curve, count: int, distribution: Distribution | str =
                                                            nonzero=True), info, tol)
     if directrix is None:
         raise ParameterError('required with distribution "linear-directrix"', "directrix")
-    d = _check_line(directrix, "directrix")
+    d = check_line(directrix, "directrix")
     return _linear_directrix(c1, c2, count, d, info, tol)
 
 
-def _check_line(value: Any, name: str, err: type = ParameterError) -> np.ndarray:
+def check_line(value: Any, name: str, err: type = ParameterError) -> np.ndarray:
+    """(2, 3) float64: two distinct points of a line, checked, errors naming ``name``."""
     d = check_points(value, name, err=err)
     if len(d) != 2:
         raise err(f"expected 2 points of the line, got {len(d)}", name)
@@ -783,7 +782,7 @@ def conoid(curve: Curve, directrix: Any, director_plane: Any, count: int, *,
         d is parallel to the director plane, or the curve meets d.
     """
     curve = _check_curve(curve, "curve")
-    d = _check_line(directrix, "directrix")
+    d = check_line(directrix, "directrix")
     n = check_vector(director_plane, "director_plane", nonzero=True)
     count = check_int(count, "count", lo=2)
     n = n / np.linalg.norm(n)
@@ -857,71 +856,9 @@ def from_lines(lines: Any, *, tol: Tolerances = DEFAULT) -> Rulings:
     return Rulings(a, b, u, surface, {"distribution": "lines", "warnings": []})
 
 
-def _is_number(text: str) -> bool:
-    try:
-        float(text)
-    except ValueError:
-        return False
-    return True
-
-
-def from_csv(path: str | os.PathLike, *, tol: Tolerances = DEFAULT) -> Rulings:
-    """Rulings from a CSV file with rows ``x0,y0,z0,x1,y1,z1``.
-
-    A first line that is not numeric is a header; blank lines and lines
-    starting with ``#`` are skipped.
-
-    Raises
-    ------
-    DesignError
-        The file cannot be read or a row is malformed; the message names the
-        file and the line number, e.g. ``lines.csv: line 4: expected 6 numbers, got 5``.
-    """
-    name = os.fspath(path)
-    try:
-        with open(name, encoding="utf-8") as fh:
-            text = fh.read()
-    except (OSError, UnicodeDecodeError) as exc:
-        reason = exc.strerror if isinstance(exc, OSError) and exc.strerror else exc
-        raise DesignError(f"cannot read the file: {reason}", None, name) from None
-    rows = []
-    first = True
-    for number, line in enumerate(text.splitlines(), start=1):
-        stripped = line.strip()
-        if not stripped or stripped.startswith("#"):
-            continue
-        cells = [c.strip() for c in stripped.split(",")]
-        try:
-            values = [float(c) for c in cells]
-        except ValueError:
-            if first:
-                first = False
-                continue  # header
-            # The cell's position, not its text: the message must not echo a file's content.
-            bad = next(k for k, c in enumerate(cells, start=1) if not _is_number(c))
-            raise DesignError(f"expected 6 numbers separated by commas; cell {bad} is not a "
-                              "number", f"line {number}", name) from None
-        first = False
-        if len(values) != 6:
-            raise DesignError(f"expected 6 numbers (x0,y0,z0,x1,y1,z1), got {len(values)}",
-                              f"line {number}", name)
-        if not all(math.isfinite(v) for v in values):
-            raise DesignError("expected finite numbers, got NaN or infinity", f"line {number}",
-                              name)
-        rows.append(values)
-    if len(rows) < 2:
-        raise DesignError(f"expected at least 2 lines (rows), got {len(rows)}", None, name)
-    try:
-        return from_lines(np.asarray(rows).reshape(-1, 2, 3), tol=tol)
-    except GeometryError as exc:
-        raise GeometryError(f"{name}: {exc}") from None
-
-
 # --------------------------------------------------------------------------
-# design files
+# limits
 # --------------------------------------------------------------------------
-
-_SOURCES = ("between", "lines", "file", "conoid")
 
 # Most generators a design may ask for.  Measured peak memory of ``ruledmesh
 # build`` (mesh, analysis against the smooth surface, export) is about 1 KiB per
@@ -930,154 +867,3 @@ _SOURCES = ("between", "lines", "file", "conoid")
 # out-of-memory kill halfway through.
 MAX_GENERATORS = 100_000
 BUILD_BYTES_PER_GRID_POINT = 1024
-
-
-def _too_many(n: int, what: str, where: str, err: type = DesignError) -> None:
-    """Refuse ``n`` generators above :data:`MAX_GENERATORS`, saying what they would need."""
-    if n > MAX_GENERATORS:
-        need = n * 21 * BUILD_BYTES_PER_GRID_POINT / 2**30
-        raise err(f"expected at most {MAX_GENERATORS} {what}, got {n}: meshing them would need "
-                  f"about {need:.1f} GiB of memory at the default 20 rows "
-                  f"(~{BUILD_BYTES_PER_GRID_POINT} bytes per generator and row)", where)
-_RULINGS_KEYS = ("between", "distribution", "director_plane", "directrix", "count", "lines",
-                 "file", "conoid")
-
-
-def rulings_from_spec(spec: Mapping, curves: Mapping[str, Curve], *, path: str = "rulings",
-                      base_dir: str | os.PathLike = ".") -> Rulings:
-    """Build rulings from the ``[rulings]`` table of a design file.
-
-    Parameters
-    ----------
-    spec : Mapping
-        Exactly one of ``between`` (two or three curve names), ``lines``
-        (list of ``[[x, y, z], [x, y, z]]``), ``file`` (CSV, relative to
-        ``base_dir``) or ``conoid`` (table ``curve``, ``directrix``,
-        ``director_plane``); with ``between`` of two curves ``distribution``
-        (default ``"arc-length"``) and its ``director_plane`` or
-        ``directrix``; ``count`` (>= 3) with ``between`` and ``conoid``.
-    curves : Mapping[str, Curve]
-        The design's ``[curves.*]``, by name.
-    path : str
-        Dotted path of the table for error messages.
-    base_dir : path
-        Directory that ``file`` is relative to.
-
-    Raises
-    ------
-    DesignError
-        With the dotted field path, e.g. ``rulings.count: expected an integer
-        >= 3, got "forty"`` or ``rulings.between: no curve named "c3"
-        (defined: c1, c2)``.
-    GeometryError
-        The table is well formed but the generators cannot be built.
-    """
-    E = DesignError
-    if not isinstance(spec, Mapping):
-        raise E(f"expected a table, got {describe(spec)}", path)
-    check_keys(spec, _RULINGS_KEYS, path, err=E)
-    given = [k for k in _SOURCES if k in spec]
-    if not given:
-        raise E("expected one of between, lines, file or conoid", path)
-    if len(given) > 1:
-        raise E(f"give only one of between, lines, file or conoid; also got {given[0]}",
-                f"{path}.{given[1]}")
-    source = given[0]
-
-    def refuse(*keys: str, why: str) -> None:
-        for key in keys:
-            if key in spec:
-                raise E(f"not used {why}", f"{path}.{key}")
-
-    def curve(name: Any, where: str) -> Curve:
-        if not isinstance(name, str):
-            raise E(f"expected the name of a [curves.*] table, got {describe(name)}", where)
-        if name not in curves:
-            defined = ", ".join(curves) if curves else "none"
-            raise E(f'no curve named "{name}" (defined: {defined})', where)
-        return curves[name]
-
-    def count() -> int:
-        if "count" not in spec:
-            raise E("missing; expected an integer >= 3 (the number of generators)",
-                    f"{path}.count")
-        n = check_int(spec["count"], f"{path}.count", lo=3, err=E)
-        _too_many(n, "generators", f"{path}.count", E)
-        return n
-
-    try:
-        if source in ("lines", "file"):
-            refuse("count", "distribution", "director_plane", "directrix",
-                   why=f"with {source} (the generators are given)")
-            if source == "lines":
-                raw = spec["lines"]
-                try:
-                    arr = np.asarray(raw, dtype=np.float64)
-                except (TypeError, ValueError):
-                    arr = None
-                if arr is None or arr.ndim != 3 or arr.shape[1:] != (2, 3) or len(arr) < 2:
-                    raise E("expected at least 2 lines [[x, y, z], [x, y, z]], got "
-                            f"{describe(raw)}", f"{path}.lines")
-                if not np.all(np.isfinite(arr)):
-                    raise E("expected finite coordinates, got NaN or infinity", f"{path}.lines")
-                _too_many(len(arr), "lines", f"{path}.lines", E)
-                return from_lines(arr)
-            fname = spec["file"]
-            if not isinstance(fname, str) or not fname:
-                raise E(f"expected a file name, got {describe(fname)}", f"{path}.file")
-            full = os.path.join(os.fspath(base_dir), fname)
-            if not os.path.isfile(full):
-                raise E(f'no such file "{fname}" (looked in {os.fspath(base_dir)})',
-                        f"{path}.file")
-            rulings = from_csv(full)
-            _too_many(len(rulings), "lines (rows)", f"{path}.file", E)
-            return rulings
-
-        if source == "conoid":
-            refuse("distribution", "director_plane", "directrix",
-                   why="with conoid (give directrix and director_plane inside the conoid table)")
-            table = spec["conoid"]
-            cpath = f"{path}.conoid"
-            if not isinstance(table, Mapping):
-                raise E(f"expected a table {{ curve, directrix, director_plane }}, got "
-                        f"{describe(table)}", cpath)
-            check_keys(table, ("curve", "directrix", "director_plane"), cpath, err=E)
-            for key in ("curve", "directrix", "director_plane"):
-                if key not in table:
-                    raise E("missing", f"{cpath}.{key}")
-            c = curve(table["curve"], f"{cpath}.curve")
-            d = _check_line(table["directrix"], f"{cpath}.directrix", err=E)
-            n = check_vector(table["director_plane"], f"{cpath}.director_plane", nonzero=True,
-                             err=E)
-            return conoid(c, d, n, count())
-
-        names = spec["between"]
-        bpath = f"{path}.between"
-        if isinstance(names, str) or not isinstance(names, (list, tuple)) or len(names) not in (2, 3):
-            raise E(f"expected two or three curve names, got {describe(names)}", bpath)
-        cs = [curve(nm, bpath) for nm in names]
-        if len(cs) == 3:
-            refuse("distribution", "director_plane", "directrix",
-                   why="with three directrices (the lines meeting all three are the generators)")
-            return three_directrices(cs[0], cs[1], cs[2], count())
-        dist = check_choice(spec.get("distribution", "arc-length"), Distribution,
-                            f"{path}.distribution", err=E)
-        plane = directrix = None
-        if dist is Distribution.DIRECTOR_PLANE:
-            refuse("directrix", why='with distribution "director-plane"')
-            if "director_plane" not in spec:
-                raise E('missing; expected the normal [x, y, z] of the director plane for '
-                        'distribution "director-plane"', f"{path}.director_plane")
-            plane = check_vector(spec["director_plane"], f"{path}.director_plane", nonzero=True,
-                                 err=E)
-        elif dist is Distribution.LINEAR_DIRECTRIX:
-            refuse("director_plane", why='with distribution "linear-directrix"')
-            if "directrix" not in spec:
-                raise E('missing; expected two points [[x, y, z], [x, y, z]] of the line d for '
-                        'distribution "linear-directrix"', f"{path}.directrix")
-            directrix = _check_line(spec["directrix"], f"{path}.directrix", err=E)
-        else:
-            refuse("director_plane", "directrix", why=f'with distribution "{dist.value}"')
-        return between(cs[0], cs[1], count(), dist, director_plane=plane, directrix=directrix)
-    except ParameterError as exc:  # pragma: no cover - inputs are checked above
-        raise E(exc.detail, f"{path}.{exc.field}" if exc.field else path) from None

@@ -147,8 +147,8 @@ def _build_surface(design: Design, mesh_table: Mapping, task: Task) -> Built:
     else:
         if "rulings" not in data:
             raise DesignError("expected a [rulings] table (with [curves.*]) or a [surface] table", "rulings")
-        from ..rulings import rulings_from_spec
         from .curves import curve_from_spec
+        from .rulings import rulings_from_spec
 
         curves_table = _table(data, "curves")
         curves = {}
