@@ -299,7 +299,22 @@ def _repair(V: np.ndarray, faces: list[np.ndarray], members: np.ndarray, member_
     members = rep[members]
     keep_m = members[:, 0] != members[:, 1]
     members, member_id = members[keep_m], member_id[keep_m]
+    quads, tris, dropped = _drop_repeated_corners(quads, tris)
 
+    # Zero-area faces whose corners are distinct but collinear.
+    flat_q, flat_t = _flat(V, quads, tol), _flat(V, tris, tol)
+    if not (flat_q.any() or flat_t.any()):
+        return quads, tris, members, member_id, dropped
+    quads, tris, splits, removed = _remove_flat_faces(V, quads, tris, np.r_[flat_q, flat_t], tol)
+    members, member_id = _split_members(members, member_id, splits)
+    return quads, tris, members, member_id, dropped + removed
+
+
+def _drop_repeated_corners(quads: np.ndarray, tris: np.ndarray) -> tuple[np.ndarray, np.ndarray, int]:
+    """Quads with one repeated corner become triangles; slits and degenerate faces go.
+
+    Returns the (Q', 4) quads, (T', 3) triangles and the number of faces removed.
+    """
     # Quads losing a repeated corner become triangles; slits [A, B, A, D] and
     # faces with fewer than three corners vanish.
     nxt = quads == np.roll(quads, -1, axis=1)
@@ -314,12 +329,18 @@ def _repair(V: np.ndarray, faces: list[np.ndarray], members: np.ndarray, member_
     t_ok = (tris[:, 0] != tris[:, 1]) & (tris[:, 1] != tris[:, 2]) & (tris[:, 2] != tris[:, 0])
     dropped += int((~t_ok).sum())
     tris = tris[t_ok]
+    return quads, tris, dropped
 
-    # Zero-area faces whose corners are distinct but collinear.
-    flat_q, flat_t = _flat(V, quads, tol), _flat(V, tris, tol)
-    if not (flat_q.any() or flat_t.any()):
-        return quads, tris, members, member_id, dropped
 
+def _remove_flat_faces(V: np.ndarray, quads: np.ndarray, tris: np.ndarray, flat: np.ndarray,
+                       tol: Tolerances) -> tuple[np.ndarray, np.ndarray, dict, int]:
+    """Remove the zero-area faces ``flat`` (quads first, then triangles); split their neighbours.
+
+    A neighbour sharing an edge of a flat face gets the flat face's corners that lie on
+    that edge inserted (no T-junctions) and is fanned into triangles.  Returns the quads,
+    the triangles, the splits ``{(p, q): [inserted vertices]}`` and the faces removed.
+    """
+    dropped = 0
     # Rare path: a loop over the collapsed faces and the few neighbours they touch.
     polys: dict[int, list[int]] = {}          # faces edited (ids: quads first, then triangles)
     nq = len(quads)
@@ -344,7 +365,7 @@ def _repair(V: np.ndarray, faces: list[np.ndarray], members: np.ndarray, member_
                     out.append(f)
         return out
 
-    flat_ids = np.nonzero(np.r_[flat_q, flat_t])[0]
+    flat_ids = np.nonzero(flat)[0]
     # Flat faces back to back with the same corners (two triangles across a generator
     # that both neighbours cross at one point) simply vanish together: their other
     # neighbours then share the edges, and splitting by each other would stack faces.
@@ -395,7 +416,12 @@ def _repair(V: np.ndarray, faces: list[np.ndarray], members: np.ndarray, member_
     quads = pad[:nq][keep[:nq]]
     tris = np.concatenate([pad[nq:, :3][keep[nq:]],
                            np.asarray(new_tris, dtype=np.int64).reshape(-1, 3)])
-    # Members along a split edge become chains through the inserted vertices.
+    return quads, tris, splits, dropped
+
+
+def _split_members(members: np.ndarray, member_id: np.ndarray,
+                   splits: dict) -> tuple[np.ndarray, np.ndarray]:
+    """(E', 2) members and (E',) ids with every member along a split edge made a chain."""
     for _ in range(8):
         changed = False
         out_m, out_id = [], []
@@ -414,7 +440,7 @@ def _repair(V: np.ndarray, faces: list[np.ndarray], members: np.ndarray, member_
         ok = members[:, 0] >= 0
         members = np.concatenate([members[ok], np.asarray(out_m, np.int64).reshape(-1, 2)])
         member_id = np.concatenate([member_id[ok], np.asarray(out_id, np.int64)])
-    return quads, tris, members, member_id, dropped
+    return members, member_id
 
 
 # --------------------------------------------------------------------------- public
