@@ -443,6 +443,42 @@ def _split_members(members: np.ndarray, member_id: np.ndarray,
     return members, member_id
 
 
+def _grid_data(n_vertices: int, n: int, k: int, reversed_: np.ndarray) -> dict[str, np.ndarray]:
+    """Per-vertex ``t`` (along the generator as given), ``generator`` (-1 between) and ``u``."""
+    col = np.arange(n_vertices) // (k + 1)
+    v = (np.arange(n_vertices) % (k + 1)) / k
+    on_gen = col % n == 0
+    gen = np.where(on_gen, col // n, -1)
+    t = np.where(on_gen & reversed_[np.maximum(gen, 0)], 1.0 - v, v)
+    return {"t": t, "generator": gen, "u": col / n}
+
+
+def _warnings(dropped: int, bare_gens: list[int]) -> list[str]:
+    out = []
+    if dropped:
+        out.append(f"hybrid: removed {dropped} collapsed faces where generators meet "
+                   "(shared end points or crossings at division points)")
+    if bare_gens:
+        out.append(f"hybrid: generators {bare_gens}: a segment is not a mesh edge (a "
+                   "neighbouring generator ends inside it or folds onto it); it stays a member")
+    return out
+
+
+def _bare_generators(quads: np.ndarray, tris: np.ndarray, members: np.ndarray,
+                     member_id: np.ndarray, n_vertices: int) -> list[int]:
+    """Generators with a member segment that is no mesh edge.
+
+    Where the end of a neighbour lies inside a generator the strip has zero width along
+    part of it; that part bounds no face and cannot be a chain of mesh edges there.
+    """
+    e = np.concatenate([np.stack([quads, np.roll(quads, -1, axis=1)], axis=2).reshape(-1, 2),
+                        np.stack([tris, np.roll(tris, -1, axis=1)], axis=2).reshape(-1, 2)])
+    e.sort(axis=1)
+    mm = np.sort(members, axis=1)
+    is_edge = np.isin(mm[:, 0] * n_vertices + mm[:, 1], e[:, 0] * n_vertices + e[:, 1])
+    return sorted(set(member_id[~is_edge].tolist()))
+
+
 # --------------------------------------------------------------------------- public
 def hybrid_mesh(a: Any, b: Any, *, midpoints: int = 1, divisions: int = 8, flip: bool = False,
                 orient: bool = True, tol: Tolerances = DEFAULT) -> Mesh:
@@ -524,42 +560,22 @@ def hybrid_mesh(a: Any, b: Any, *, midpoints: int = 1, divisions: int = 8, flip:
     reversed_ = orient_generators(a, b) if orient else np.zeros(m, bool)
     A = np.where(reversed_[:, None], b, a)
     B = np.where(reversed_[:, None], a, b)
-
-    K = k + 1
     X = hybrid_grid(A, B, n, k).reshape(-1, 3)
     quads, tris, vertex = checkerboard_faces(C, k, n, flip)
     members, member_id = _generator_members(vertex, n, k + 1)
     quads, tris, members, member_id, dropped = _repair(X, [quads, tris], members, member_id,
                                                        scale, tol)
 
-    col = np.arange(len(X)) // K
-    v = (np.arange(len(X)) % K) / k
-    on_gen = col % n == 0
-    gen = np.where(on_gen, col // n, -1)
-    t = np.where(on_gen & reversed_[np.maximum(gen, 0)], 1.0 - v, v)
-    faces = np.concatenate([quads.ravel(), tris.ravel()])
-    offsets = np.r_[np.arange(len(quads) + 1) * 4, 4 * len(quads) + np.arange(1, len(tris) + 1) * 3]
-    kinds = np.r_[np.full(len(quads), FaceKind.QUAD), np.full(len(tris), FaceKind.TRIANGLE)]
-    warnings: list[str] = []
-    if dropped:
-        warnings.append(f"hybrid: removed {dropped} collapsed faces where generators meet "
-                        "(shared end points or crossings at division points)")
-    # Where the end of a neighbour lies inside a generator the strip has zero width along
-    # part of it; that part bounds no face and cannot be a chain of mesh edges there.
-    e = np.concatenate([np.stack([quads, np.roll(quads, -1, axis=1)], axis=2).reshape(-1, 2),
-                        np.stack([tris, np.roll(tris, -1, axis=1)], axis=2).reshape(-1, 2)])
-    e.sort(axis=1)
-    mm = np.sort(members, axis=1)
-    size = len(X)
-    is_edge = np.isin(mm[:, 0] * size + mm[:, 1], e[:, 0] * size + e[:, 1])
-    bare_gens = sorted(set(member_id[~is_edge].tolist())) if not flip else []
-    if bare_gens:
-        warnings.append(f"hybrid: generators {bare_gens}: a segment is not a mesh edge (a "
-                        "neighbouring generator ends inside it or folds onto it); it stays a member")
+    bare_gens = [] if flip else _bare_generators(quads, tris, members, member_id, len(X))
+    warnings = _warnings(dropped, bare_gens)
     info = {"construction": "hybrid", "midpoints": midpoints, "divisions": divisions,
             "flip": flip, "reversed_generators": np.nonzero(reversed_)[0].tolist(),
             "collapsed_faces": dropped, "bare_generators": bare_gens, "warnings": warnings}
-    mesh = Mesh(X, offsets.astype(np.int64), faces.astype(np.int64), kinds.astype(np.uint8),
-                members.astype(np.int64), member_id.astype(np.int64),
-                {"t": t, "generator": gen, "u": col / n}, info)
+    faces = np.concatenate([quads.ravel(), tris.ravel()]).astype(np.int64)
+    offsets = np.r_[np.arange(len(quads) + 1) * 4,
+                    4 * len(quads) + np.arange(1, len(tris) + 1) * 3].astype(np.int64)
+    kinds = np.r_[np.full(len(quads), FaceKind.QUAD),
+                  np.full(len(tris), FaceKind.TRIANGLE)].astype(np.uint8)
+    mesh = Mesh(X, offsets, faces, kinds, members.astype(np.int64), member_id.astype(np.int64),
+                _grid_data(len(X), n, k, reversed_), info)
     return mesh.compact()
