@@ -194,3 +194,18 @@ def test_the_checker_sees_relative_and_lazy_imports(tmp_path):
     assert ("analysis", ("faces",)) in found
     assert _resolve("analysis", ["faces"]) == ["analysis.faces"]
     assert _layer("pq.mesher") > _layer("rulings") > _layer("mesh") > _layer("errors")
+
+
+#: The longest a function of src/ruledmesh may be, docstring included (house style: few over 60).
+MAX_FUNCTION_LINES = 100
+
+
+def test_no_function_is_longer_than_the_limit():
+    long = []
+    for path in _sources():
+        for node in ast.walk(ast.parse(path.read_text(encoding="utf-8"))):
+            if isinstance(node, (ast.FunctionDef, ast.AsyncFunctionDef)):
+                lines = node.end_lineno - node.lineno + 1
+                if lines > MAX_FUNCTION_LINES:
+                    long.append(f"ruledmesh.{_module_name(path)}.{node.name}: {lines} lines")
+    assert not long, f"functions over {MAX_FUNCTION_LINES} lines:\n" + "\n".join(long)
