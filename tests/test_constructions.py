@@ -1,6 +1,6 @@
 """Catalogue constructions (paper §2-§3): each kind's invariant, over its parameters.
 
-Invariants (constructions.md §5): every face planar to 1e-12; vertices on the
+Invariants: every face planar to 1e-12; vertices on the
 analytic surface to 1e-10 relative (checked with the test's own implicit
 equation, not the library's reference); circular kinds circular to 1e-10;
 translational kinds parallelograms.  The predicates come from

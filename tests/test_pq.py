@@ -1,4 +1,4 @@
-"""Invariants of the §4.3 PQ mesher (constructions.md §1-3)."""
+"""Invariants of the §4.3 PQ mesher (paper §4.3)."""
 
 import numpy as np
 import pytest

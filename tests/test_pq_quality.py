@@ -135,7 +135,7 @@ def test_example_quality_does_not_regress(name, share, angle):
 
 
 def test_two_bspline_director_curves_51_by_30():
-    """The issue's first surface: 55 % of the area was in triangles; generators are added
+    """The first quality surface: 55 % of the area was in triangles; generators are added
     where the rows need them and the share falls under a quarter."""
     c1 = [[0.0, 1.34, -1.68], [2.5, -1.44, -0.62], [5.0, 1.66, -0.92], [7.5, -2.19, 0.96],
           [10.0, 1.63, -1.61]]

@@ -35,6 +35,7 @@ from typing import Protocol
 import numpy as np
 
 from .errors import GeometryError
+from .tolerances import TINY as _TINY
 
 __all__ = [
     "RuledPatch",
@@ -47,8 +48,6 @@ __all__ = [
     "revolution_of_polyline",
     "pipe_of_polyline",
 ]
-
-_TINY = 1e-300
 
 
 def newton_distance(value: Callable, gradient: Callable, points: np.ndarray,

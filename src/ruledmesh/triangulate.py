@@ -36,6 +36,7 @@ import numpy as np
 
 from ._validation import check_choice
 from .mesh import Mesh
+from .tolerances import TINY as _TINY
 
 __all__ = [
     "QuadSplit",
@@ -50,8 +51,6 @@ __all__ = [
 # Above this valence the Catalan number of templates (1430 for 10) outgrows
 # greedy ear clipping; polygons that large are rare caps, not panels.
 MAX_TEMPLATE_VALENCE = 9
-
-_TINY = 1e-300
 
 
 class QuadSplit(str, Enum):

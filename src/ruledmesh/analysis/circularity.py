@@ -23,11 +23,10 @@ import numpy as np
 
 from ..mesh import Mesh
 from ..tolerances import DEFAULT, Tolerances
+from ..tolerances import TINY as _TINY
 
 __all__ = ["circle_through", "quad_circularity", "circularity", "quad_parallelogram",
            "parallelogram", "circularity_report", "parallelogram_report"]
-
-_TINY = 1e-300
 
 
 def circle_through(a: np.ndarray, b: np.ndarray, c: np.ndarray):

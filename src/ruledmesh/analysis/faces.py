@@ -12,6 +12,7 @@ from __future__ import annotations
 import numpy as np
 
 from ..mesh import Mesh
+from ..tolerances import TINY as _TINY
 
 __all__ = [
     "quad_planarity",
@@ -28,8 +29,6 @@ __all__ = [
     "face_min_angles",
     "area_shares",
 ]
-
-_TINY = 1e-300
 
 
 def quad_diagonal_crossing(corners: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
