@@ -45,7 +45,7 @@ def _build_strips(table: Mapping, mesh_table: Mapping, ctx: BuildContext) -> Bui
     f = Fields(table, "surface", ["polygon", "closed", "scales", "translations", "starts",
                                   "edge_factors"])
     mesh_counts(mesh_table, 1, None)
-    closed = f.bool("closed", False)
+    closed = f.boolean("closed", False)
     poly = f.points("polygon", Fields.REQUIRED, min_count=2)
     if f.has("edge_factors") or f.has("starts"):
         if closed:
@@ -74,7 +74,7 @@ def _build_prism(table: Mapping, mesh_table: Mapping, ctx: BuildContext) -> Buil
     u, _ = mesh_counts(mesh_table, 4, None)
     mesh = prism(f.points("polygon", Fields.REQUIRED, min_count=2),
                  f.vector("direction", [0.0, 0.0, 1.0], nonzero=True), u,
-                 closed=f.bool("closed", False))
+                 closed=f.boolean("closed", False))
     return Built(mesh, None, None, {"guarantee": "parallelograms (prism)"})
 
 
@@ -83,8 +83,8 @@ def _build_pyramid(table: Mapping, mesh_table: Mapping, ctx: BuildContext) -> Bu
     f = Fields(table, "surface", ["polygon", "apex", "closed", "to_apex"])
     u, _ = mesh_counts(mesh_table, 4, None)
     mesh = pyramid(f.points("polygon", Fields.REQUIRED, min_count=2),
-                   f.vector("apex", Fields.REQUIRED), u, closed=f.bool("closed", False),
-                   to_apex=f.bool("to_apex", False))
+                   f.vector("apex", Fields.REQUIRED), u, closed=f.boolean("closed", False),
+                   to_apex=f.boolean("to_apex", False))
     return Built(mesh, None, None, {"guarantee": "trapezoids (pyramid)"})
 
 
@@ -126,7 +126,7 @@ def _build_rotational(table: Mapping, mesh_table: Mapping, ctx: BuildContext) ->
     af = Fields(axis_table, "surface.axis", ["point", "direction"])
     origin = af.vector("point", [0.0, 0.0, 0.0])
     direction = af.vector("direction", [0.0, 0.0, 1.0], nonzero=True)
-    angle = f.float("angle", 360.0, lo=0.0, lo_open=True, hi=360.0)
+    angle = f.number("angle", 360.0, lo=0.0, lo_open=True, hi=360.0)
     if angle == 360.0 and u < 3:
         raise DesignError(f"expected an integer >= 3 for a full turn, got {u}", "mesh.u")
     merid = prof.sample(v)
@@ -154,7 +154,7 @@ def _axes(value, path: str):
         f = Fields(item, f"{path}[{k}]", ["point", "direction", "angle"])
         o.append(f.vector("point", Fields.REQUIRED))
         d.append(f.vector("direction", Fields.REQUIRED, nonzero=True))
-        a.append(f.float("angle", Fields.REQUIRED))
+        a.append(f.number("angle", Fields.REQUIRED))
     return np.array(o), np.array(d), np.array(a)
 
 
@@ -165,7 +165,7 @@ def _build_moulding(table: Mapping, mesh_table: Mapping, ctx: BuildContext) -> B
     prof = profile_from_spec(f.raw("profile", Fields.REQUIRED), "surface.profile")
     o, d, a = _axes(f.raw("axes", Fields.REQUIRED), "surface.axes")
     try:
-        mesh = moulding_mesh(prof.sample(v), o, d, a, closed=f.bool("closed", False))
+        mesh = moulding_mesh(prof.sample(v), o, d, a, closed=f.boolean("closed", False))
     except GeometryError as exc:
         raise DesignError(str(exc), "surface.axes") from None
     return Built(mesh, None, None, {"guarantee": "isosceles trapezoids, circular"})
@@ -176,7 +176,7 @@ def _build_pipe(table: Mapping, mesh_table: Mapping, ctx: BuildContext) -> Built
     f = Fields(table, "surface", ["spine", "radius", "normal"])
     u, v = mesh_counts(mesh_table, 24, 16, min_v=3)
     spine = profile_from_spec(f.raw("spine", Fields.REQUIRED), "surface.spine").sample(u)
-    radius = f.float("radius", Fields.REQUIRED, lo=0.0, lo_open=True)
+    radius = f.number("radius", Fields.REQUIRED, lo=0.0, lo_open=True)
     try:
         mesh = pipe_mesh(spine, radius, v, normal=f.optional_vector("normal", nonzero=True))
     except GeometryError as exc:
@@ -190,8 +190,8 @@ def _build_pipe(table: Mapping, mesh_table: Mapping, ctx: BuildContext) -> Built
 def _build_torus(table: Mapping, mesh_table: Mapping, ctx: BuildContext) -> Built:
     f = Fields(table, "surface", ["R", "r"])
     u, v = mesh_counts(mesh_table, 32, 16, min_u=3, min_v=3)
-    R = f.float("R", Fields.REQUIRED, lo=0.0, lo_open=True)
-    r = f.float("r", Fields.REQUIRED, lo=0.0, lo_open=True)
+    R = f.number("R", Fields.REQUIRED, lo=0.0, lo_open=True)
+    r = f.number("r", Fields.REQUIRED, lo=0.0, lo_open=True)
     if r >= R:
         raise DesignError(f"expected r < R (a ring torus), got r = {r:g}, R = {R:g}", "surface.r")
     return Built(torus_mesh(R, r, u, v), torus(R, r), None,
@@ -221,7 +221,7 @@ def _build_canal(table: Mapping, mesh_table: Mapping, ctx: BuildContext) -> Buil
     if f.has("radius") == f.has("radii"):
         raise DesignError("give either radius (a number) or radii (a list)", "surface.radii")
     if f.has("radius"):
-        radii = np.full(len(spine), f.float("radius", lo=0.0, lo_open=True))
+        radii = np.full(len(spine), f.number("radius", lo=0.0, lo_open=True))
     else:
         given = f.floats("radii", Fields.REQUIRED, positive=True)
         if given.size == 2 and len(spine) != 2:
@@ -258,9 +258,9 @@ def _build_ellipsoid(table: Mapping, mesh_table: Mapping, ctx: BuildContext) -> 
 
 
 def _abc(f: Fields):
-    a = f.float("a", 1.0, lo=0.0, lo_open=True)
-    b = f.float("b", a, lo=0.0, lo_open=True)
-    c = f.float("c", 1.0, lo=0.0, lo_open=True)
+    a = f.number("a", 1.0, lo=0.0, lo_open=True)
+    b = f.number("b", a, lo=0.0, lo_open=True)
+    c = f.number("c", 1.0, lo=0.0, lo_open=True)
     return a, b, c
 
 
@@ -269,7 +269,7 @@ def _build_two_sheets(table: Mapping, mesh_table: Mapping, ctx: BuildContext) ->
     f = Fields(table, "surface", ["a", "b", "c", "height"])
     u, v = mesh_counts(mesh_table, 32, 12, min_u=3)
     a, b, c = _abc(f)
-    height = f.float("height", 3.0 * c, lo=c, lo_open=True)
+    height = f.number("height", 3.0 * c, lo=c, lo_open=True)
     return Built(two_sheet_hyperboloid_mesh(a, b, c, height, u, v),
                  two_sheet_hyperboloid(a, b, c, height), None, {"guarantee": quadric_guarantee(a, b)})
 
@@ -278,9 +278,9 @@ def _build_two_sheets(table: Mapping, mesh_table: Mapping, ctx: BuildContext) ->
 def _build_elliptic_paraboloid(table: Mapping, mesh_table: Mapping, ctx: BuildContext) -> Built:
     f = Fields(table, "surface", ["a", "b", "height"])
     u, v = mesh_counts(mesh_table, 32, 12, min_u=3)
-    a = f.float("a", 1.0, lo=0.0, lo_open=True)
-    b = f.float("b", a, lo=0.0, lo_open=True)
-    height = f.float("height", 1.0, lo=0.0, lo_open=True)
+    a = f.number("a", 1.0, lo=0.0, lo_open=True)
+    b = f.number("b", a, lo=0.0, lo_open=True)
+    height = f.number("height", 1.0, lo=0.0, lo_open=True)
     return Built(elliptic_paraboloid_mesh(a, b, height, u, v),
                  elliptic_paraboloid(a, b, height), None, {"guarantee": quadric_guarantee(a, b)})
 
@@ -289,10 +289,10 @@ def _build_elliptic_paraboloid(table: Mapping, mesh_table: Mapping, ctx: BuildCo
 def _build_hyperboloid(table: Mapping, mesh_table: Mapping, ctx: BuildContext) -> Built:
     f = Fields(table, "surface", ["a", "b", "c", "height", "style"])
     u, v = mesh_counts(mesh_table, 32, 16, min_u=3)
-    a = f.float("a", 1.0, lo=0.0, lo_open=True)
-    b = f.float("b", a, lo=0.0, lo_open=True)
-    c = f.float("c", 1.0, lo=0.0, lo_open=True)
-    height = f.float("height", 2.0, lo=0.0, lo_open=True)
+    a = f.number("a", 1.0, lo=0.0, lo_open=True)
+    b = f.number("b", a, lo=0.0, lo_open=True)
+    c = f.number("c", 1.0, lo=0.0, lo_open=True)
+    height = f.number("height", 2.0, lo=0.0, lo_open=True)
     style = f.choice("style", HyperboloidStyle, "circular")
     if style is HyperboloidStyle.GENERATORS and u < 4:
         raise DesignError(f"expected an integer >= 4 (generators per regulus), got {u}", "mesh.u")
@@ -317,18 +317,18 @@ def _build_hyperboloid(table: Mapping, mesh_table: Mapping, ctx: BuildContext) -
 def _build_hyperbolic_paraboloid(table: Mapping, mesh_table: Mapping, ctx: BuildContext) -> Built:
     f = Fields(table, "surface", ["a", "b", "angle", "size", "style", "fill"])
     u, v = mesh_counts(mesh_table, 16, 16)
-    a = f.float("a", 1.0, lo=0.0, lo_open=True)
+    a = f.number("a", 1.0, lo=0.0, lo_open=True)
     if f.has("angle"):
         if f.has("b"):
             raise DesignError("give either b or angle (b = a tan(angle / 2)), not both",
                               "surface.angle")
-        angle = f.float("angle", lo=0.0, lo_open=True, hi=179.0)
+        angle = f.number("angle", lo=0.0, lo_open=True, hi=179.0)
         b = a * np.tan(np.radians(angle) / 2)
     else:
-        b = f.float("b", 1.0, lo=0.0, lo_open=True)
-    size = f.float("size", 1.0, lo=0.0, lo_open=True)
+        b = f.number("b", 1.0, lo=0.0, lo_open=True)
+    size = f.number("size", 1.0, lo=0.0, lo_open=True)
     style = f.choice("style", HPStyle, "parabolas")
-    fill = f.bool("fill", True)
+    fill = f.boolean("fill", True)
     if style is HPStyle.GENERATORS and min(u, v) < 2:
         raise DesignError(f"expected u, v >= 2 for style \"generators\", got {u}, {v}", "mesh")
     try:
@@ -360,11 +360,11 @@ def _build_hyperbolic_paraboloid(table: Mapping, mesh_table: Mapping, ctx: Build
 def _build_helicoid(table: Mapping, mesh_table: Mapping, ctx: BuildContext) -> Built:
     f = Fields(table, "surface", ["radius", "pitch", "turns"])
     u, v = mesh_counts(mesh_table, 48, 48, min_u=2, min_v=2)
-    radius = f.float("radius", 1.0, lo=0.0, lo_open=True)
-    pitch = f.float("pitch", 1.0)
+    radius = f.number("radius", 1.0, lo=0.0, lo_open=True)
+    pitch = f.number("pitch", 1.0)
     if pitch == 0:
         raise DesignError("expected a non-zero number (0 is a plane), got 0", "surface.pitch")
-    turns = f.float("turns", 1.0, lo=0.0, lo_open=True)
+    turns = f.number("turns", 1.0, lo=0.0, lo_open=True)
     try:
         mesh = helicoid_mesh(radius, pitch, turns, u, v)
     except GeometryError as exc:

@@ -6,7 +6,6 @@ Builders call :class:`Fields` so that every message reads like
 
 from __future__ import annotations
 
-import builtins
 from collections.abc import Mapping
 from typing import Any, ClassVar, overload
 
@@ -63,41 +62,41 @@ class Fields:
             return default, False
         return self.table[key], True
 
-    def float(self, key: str, default: Any = None, **bounds) -> float:
+    def number(self, key: str, default: Any = None, **bounds) -> float:
         value, given = self._get(key, default)
         return check_float(value, self.path(key), err=DesignError, **bounds) if given else value
 
-    def int(self, key: str, default: Any = None, **bounds) -> builtins.int:
+    def integer(self, key: str, default: Any = None, **bounds) -> int:
         value, given = self._get(key, default)
         return check_int(value, self.path(key), err=DesignError, **bounds) if given else value
 
-    def bool(self, key: str, default: Any = None) -> builtins.bool:
+    def boolean(self, key: str, default: Any = None) -> bool:
         value, given = self._get(key, default)
         return check_bool(value, self.path(key), err=DesignError) if given else value
 
-    def vector(self, key: str, default: Any, *, dim: builtins.int = 3,
-               nonzero: builtins.bool = False) -> np.ndarray:
+    def vector(self, key: str, default: Any, *, dim: int = 3,
+               nonzero: bool = False) -> np.ndarray:
         """A ``dim``-vector; ``default`` (never ``None``) when the key is absent."""
         value, given = self._get(key, default)
         if not given:
             return np.asarray(value, dtype=np.float64)
         return check_vector(value, self.path(key), dim=dim, nonzero=nonzero, err=DesignError)
 
-    def optional_vector(self, key: str, *, dim: builtins.int = 3,
-                        nonzero: builtins.bool = False) -> np.ndarray | None:
+    def optional_vector(self, key: str, *, dim: int = 3,
+                        nonzero: bool = False) -> np.ndarray | None:
         """A ``dim``-vector, or ``None`` when the key is absent."""
         return self.vector(key, Fields.REQUIRED, dim=dim, nonzero=nonzero) if key in self.table else None
 
-    def points(self, key: str, default: Any, *, dim: builtins.int = 3,
-               min_count: builtins.int = 1) -> np.ndarray:
+    def points(self, key: str, default: Any, *, dim: int = 3,
+               min_count: int = 1) -> np.ndarray:
         """An ``(n, dim)`` array of points; ``default`` (never ``None``) when the key is absent."""
         value, given = self._get(key, default)
         if not given:
             return np.asarray(value, dtype=np.float64)
         return check_points(value, self.path(key), dim=dim, min_count=min_count, err=DesignError)
 
-    def floats(self, key: str, default: Any, *, count: builtins.int | None = None,
-               positive: builtins.bool = False) -> np.ndarray:
+    def floats(self, key: str, default: Any, *, count: int | None = None,
+               positive: bool = False) -> np.ndarray:
         """A list of numbers (``count`` of them if given); ``default`` (never ``None``) when absent."""
         value, given = self._get(key, default)
         if not given:

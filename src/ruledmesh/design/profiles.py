@@ -48,16 +48,16 @@ def profile_from_spec(spec: Any, path: str, *, dim: int = 3, min_points: int = 2
     if kind == "arc":
         f = Fields(spec, path, ["type", "center", "radius", "start", "end", "plane"])
         c = f.vector("center", [0.0, 0.0, 0.0])
-        r = f.float("radius", Fields.REQUIRED, lo=0.0, lo_open=True)
-        a0 = np.radians(f.float("start", 0.0))
-        a1 = np.radians(f.float("end", 90.0))
+        r = f.number("radius", Fields.REQUIRED, lo=0.0, lo_open=True)
+        a0 = np.radians(f.number("start", 0.0))
+        a1 = np.radians(f.number("end", 90.0))
         if a0 == a1:
             raise DesignError("expected end different from start", f"{path}.end")
         return arc_profile(c, r, a0, a1, *_plane(f, "xy"))
     if kind == "parabola":
         f = Fields(spec, path, ["type", "vertex", "k", "range", "plane"])
         v0 = f.vector("vertex", [0.0, 0.0, 0.0])
-        k = f.float("k", Fields.REQUIRED)
+        k = f.number("k", Fields.REQUIRED)
         s0, s1 = f.floats("range", [-1.0, 1.0], count=2)
         if s0 == s1:
             raise DesignError("expected two different numbers", f"{path}.range")
@@ -65,10 +65,10 @@ def profile_from_spec(spec: Any, path: str, *, dim: int = 3, min_points: int = 2
     if kind == "helix":
         f = Fields(spec, path, ["type", "center", "radius", "pitch", "turns", "start"])
         c = f.vector("center", [0.0, 0.0, 0.0])
-        r = f.float("radius", Fields.REQUIRED, lo=0.0, lo_open=True)
-        pitch = f.float("pitch", Fields.REQUIRED)
-        turns = f.float("turns", 1.0, lo=0.0, lo_open=True)
-        return helix_profile(c, r, pitch, turns, np.radians(f.float("start", 0.0)))
+        r = f.number("radius", Fields.REQUIRED, lo=0.0, lo_open=True)
+        pitch = f.number("pitch", Fields.REQUIRED)
+        turns = f.number("turns", 1.0, lo=0.0, lo_open=True)
+        return helix_profile(c, r, pitch, turns, np.radians(f.number("start", 0.0)))
     raise DesignError(f'expected type "polyline" | "arc" | "parabola" | "helix", got '
                       f'{describe(kind)}', f"{path}.type")
 

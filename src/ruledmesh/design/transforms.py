@@ -67,14 +67,14 @@ def _design_translate(built: Built, table: Mapping, path: str) -> Built:
 def _design_rotate(built: Built, table: Mapping, path: str) -> Built:
     f = _fields(table, path, ["axis", "angle", "center"])
     return _run(built, path, "rotate", axis=f.vector("axis", [0.0, 0.0, 1.0], nonzero=True),
-                angle=f.float("angle", f.REQUIRED), center=f.vector("center", [0.0, 0.0, 0.0]))
+                angle=f.number("angle", f.REQUIRED), center=f.vector("center", [0.0, 0.0, 0.0]))
 
 
 @transform_type("scale")
 def _design_scale(built: Built, table: Mapping, path: str) -> Built:
     f = _fields(table, path, ["factor", "center"])
     raw = f.raw("factor", f.REQUIRED)
-    factors = (f.floats("factor", f.REQUIRED, count=3) if isinstance(raw, list) else f.float("factor"))
+    factors = (f.floats("factor", f.REQUIRED, count=3) if isinstance(raw, list) else f.number("factor"))
     if np.any(np.asarray(factors) == 0):
         raise DesignError("expected non-zero factors", f"{path}.factor")
     return _run(built, path, "scale", factors=factors, center=f.vector("center", [0.0, 0.0, 0.0]))
@@ -84,7 +84,7 @@ def _design_scale(built: Built, table: Mapping, path: str) -> Built:
 def _design_shear(built: Built, table: Mapping, path: str) -> Built:
     keys = ["xy", "xz", "yx", "yz", "zx", "zy"]
     f = _fields(table, path, keys)
-    return _run(built, path, "shear", **{k: f.float(k, 0.0) for k in keys})
+    return _run(built, path, "shear", **{k: f.number(k, 0.0) for k in keys})
 
 
 @transform_type("projective")
@@ -98,4 +98,4 @@ def design_inversion(built: Built, table: Mapping, path: str) -> Built:
     """Invert ``built`` in the sphere of ``table`` (``center``, ``radius``); errors name ``path``."""
     f = _fields(table, path, ["center", "radius"])
     return _run(built, path, "inversion", center=f.vector("center", f.REQUIRED),
-                radius=f.float("radius", f.REQUIRED, lo=0.0, lo_open=True))
+                radius=f.number("radius", f.REQUIRED, lo=0.0, lo_open=True))
