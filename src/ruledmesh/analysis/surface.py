@@ -1,9 +1,116 @@
 """Distances to the smooth ruled surface a mesh was built from.
 
-The smooth reference surfaces live in :mod:`ruledmesh.surfaces` (the meshers
-build them); this module keeps their analysis-side name.
+:class:`RuledReference` wraps a :class:`~ruledmesh.rulings.RuledSurface`
+(``point(u, t)``, ``partials(u, t)``, ``area()``) and measures how far points
+are from the design patch ``0 <= u, t <= 1``: a nearest sample on a fine grid
+seeds a few vectorised Gauss-Newton steps on ``|S(u, t) - p|^2`` with
+``(u, t)`` clamped to the patch.
 """
 
-from ..surfaces import RuledPatch, RuledReference
+from __future__ import annotations
 
-__all__ = ["RuledPatch", "RuledReference"]
+from dataclasses import dataclass, field
+from typing import Protocol
+
+import numpy as np
+
+__all__ = ["RuledReference"]
+
+
+@dataclass(frozen=True, eq=False)
+class RuledReference:
+    """Closeness and area of a smooth ruled surface patch.
+
+    Parameters
+    ----------
+    surface : RuledSurface
+        Has ``point(u, t)``, ``partials(u, t)`` and ``area()``.
+    samples : int
+        Grid resolution of the seeding samples per direction.
+    """
+
+    surface: RuledPatch
+    samples: int = 64
+    _cache: dict = field(default_factory=dict, repr=False)
+
+    def _seed_tree(self):
+        if "tree" not in self._cache:
+            from scipy.spatial import cKDTree
+
+            u = np.linspace(0.0, 1.0, self.samples)
+            t = np.linspace(0.0, 1.0, max(self.samples // 4, 9))
+            uu, tt = np.meshgrid(u, t, indexing="ij")
+            pts = self.surface.point(uu.ravel(), tt.ravel())
+            self._cache["tree"] = (cKDTree(pts), uu.ravel(), tt.ravel())
+        return self._cache["tree"]
+
+    def closest(self, points: np.ndarray, iterations: int = 12,
+                seeds: int = 6) -> tuple[np.ndarray, np.ndarray]:
+        """Parameters ``(u, t)`` of the nearest point of the patch to each point.
+
+        Gauss-Newton runs from the ``seeds`` nearest samples at once and the
+        best result is kept: where the surface passes close to itself (a
+        Pluecker conoid through its double line, a helicoid's turns) the single
+        nearest sample may lie on the other sheet.
+
+        Parameters
+        ----------
+        points : (n, 3) float64
+
+        Returns
+        -------
+        u, t : (n,) float64
+        """
+        tree, us, ts = self._seed_tree()
+        k = min(seeds, len(us))
+        _, nearest = tree.query(points, k=k)
+        nearest = np.asarray(nearest).reshape(len(points), k)
+        u, t = self._descend(np.repeat(points, k, axis=0), us[nearest].ravel(), ts[nearest].ravel(),
+                             iterations)
+        d = np.linalg.norm(self.surface.point(u, t) - np.repeat(points, k, axis=0), axis=1)
+        best = np.argmin(d.reshape(-1, k), axis=1) + k * np.arange(len(points))
+        return u[best], t[best]
+
+    def _descend(self, points: np.ndarray, u: np.ndarray, t: np.ndarray,
+                 iterations: int) -> tuple[np.ndarray, np.ndarray]:
+        """Gauss-Newton on ``|S(u, t) - p|^2`` from ``(u, t)``, clamped to the patch."""
+        for _ in range(iterations):
+            s = self.surface.point(u, t)
+            su, st = self.surface.partials(u, t)
+            r = s - points
+            a = np.einsum("ij,ij->i", su, su)
+            b = np.einsum("ij,ij->i", su, st)
+            c = np.einsum("ij,ij->i", st, st)
+            gu = np.einsum("ij,ij->i", su, r)
+            gt = np.einsum("ij,ij->i", st, r)
+            det = a * c - b * b
+            safe = np.where(np.abs(det) > 1e-300, det, 1.0)
+            du = np.where(np.abs(det) > 1e-300, (c * gu - b * gt) / safe, 0.0)
+            dt = np.where(np.abs(det) > 1e-300, (a * gt - b * gu) / safe, 0.0)
+            u = np.clip(u - du, 0.0, 1.0)
+            t = np.clip(t - dt, 0.0, 1.0)
+        return u, t
+
+    def distance(self, points: np.ndarray) -> np.ndarray:
+        """(n,) float64: distance of each point from the patch."""
+        points = np.asarray(points, dtype=np.float64).reshape(-1, 3)
+        if len(points) == 0:
+            return np.zeros(0)
+        u, t = self.closest(points)
+        return np.linalg.norm(self.surface.point(u, t) - points, axis=1)
+
+    def area(self) -> float:
+        """Area of the smooth patch."""
+        if "area" not in self._cache:
+            self._cache["area"] = float(self.surface.area())
+        return self._cache["area"]
+
+
+class RuledPatch(Protocol):
+    """What :class:`RuledReference` needs of a smooth surface patch ``0 <= u, t <= 1``."""
+
+    def point(self, u: np.ndarray, t: np.ndarray) -> np.ndarray: ...
+
+    def partials(self, u: np.ndarray, t: np.ndarray) -> tuple[np.ndarray, np.ndarray]: ...
+
+    def area(self) -> float: ...
