@@ -32,3 +32,15 @@ def test_implicit_surface_without_distance_or_value_says_so():
     ref = ImplicitSurface("nothing", None, None)
     with pytest.raises(GeometryError, match="neither a distance nor a value and gradient"):
         ref.distance(np.zeros((2, 3)))
+
+
+def test_planarity_of_quads_at_huge_coordinates_does_not_overflow():
+    # products of squared diagonal lengths overflowed (RuntimeWarning) beyond ~1e77; found by
+    # test_fuzz_malformed_values_in_examples on an elliptic paraboloid with a = 1.39e77
+    from ruledmesh.analysis.faces import quad_diagonal_crossing, quad_planarity
+
+    square = np.array([[[0, 0, 0], [1, 0, 0], [1, 1, 0], [0, 1, 0.1]]], float)
+    for size in (1.0, 1e-100, 1e77, 1e150):
+        assert quad_planarity(square * size)[0] == pytest.approx(quad_planarity(square)[0], rel=1e-12)
+        gap = quad_diagonal_crossing(square * size)[2][0]
+        assert gap == pytest.approx(quad_diagonal_crossing(square)[2][0] * size, rel=1e-12)
