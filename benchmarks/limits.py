@@ -20,7 +20,8 @@ import gc
 import math
 import time
 import tracemalloc
-from typing import Callable
+from collections.abc import Callable
+from functools import partial
 
 import numpy as np
 
@@ -126,14 +127,14 @@ def scaling(generators: Callable[[int], tuple[np.ndarray, np.ndarray]], sizes: l
         faces, verts = mesh.n_faces, mesh.n_vertices
         del mesh
         big = faces > 2e6
-        sec, times = median_time(lambda: pq_mesh(a, b, rows=n, trim=True),
+        sec, times = median_time(partial(pq_mesh, a, b, rows=n, trim=True),
                                  min_repeats=1 if big else 3, max_repeats=1 if big else 9,
                                  budget=2.0, warmup=False)
         grid_cols = math.ceil(verts / n)
-        grid_s, _ = median_time(lambda: bilinear_grid(a, b, grid_cols), min_repeats=3, max_repeats=9,
+        grid_s, _ = median_time(partial(bilinear_grid, a, b, grid_cols), min_repeats=3, max_repeats=9,
                                 budget=1.0, warmup=not big)
-        peak = _peak_memory(lambda: pq_mesh(a, b, rows=n, trim=True))
-        grid_peak = _peak_memory(lambda: bilinear_grid(a, b, grid_cols))
+        peak = _peak_memory(partial(pq_mesh, a, b, rows=n, trim=True))
+        grid_peak = _peak_memory(partial(bilinear_grid, a, b, grid_cols))
         points.append({"generators": n, "rows": n, "faces": faces, "vertices": verts,
                        "seconds": sec, "repeats": len(times), "peak_bytes": peak,
                        "bytes_per_face": peak / max(faces, 1), "bilinear_seconds": grid_s,

@@ -6,7 +6,8 @@ For each case (panels of a bundled example at 1:1000, i.e. millimetres, on
 standard sheets with a 3 mm gap) it times ``layout(method="true-shape")``
 (sheet by sheet) and then gives spyrrow's strip packing of the same panels, at
 the sheets' usable height, the same total time (at least the per-sheet
-budget), and 4 seconds (its budget in earlier releases).  ``ratio`` is the sheets' trimmed utilisation (the last sheet counted
+budget), and 4 seconds (its budget in earlier releases).  ``ratio`` is the
+sheets' trimmed utilisation (the last sheet counted
 up to its rightmost panel) over the strip's density (spyrrow's own: panel area
 over the usable strip area, so the sheets' border gap counts against them).
 The shelf packer runs on the same panels for comparison.  Wall times depend on

@@ -16,8 +16,9 @@ from __future__ import annotations
 import multiprocessing as mp
 import time
 import traceback
+from collections.abc import Callable
 from dataclasses import dataclass, field
-from typing import Any, Callable
+from typing import Any
 
 import numpy as np
 
@@ -66,7 +67,7 @@ def _mpfp(V, F, optimization_rounds=50, max_iterations=10):
     st.verbose = False
     st.optimization_rounds = optimization_rounds
     st.max_iterations = max_iterations
-    out = mpfp.make_planar_faces([v for v in V], F.tolist(), [], st)
+    out = mpfp.make_planar_faces(list(V), F.tolist(), [], st)
     return np.asarray(out, dtype=np.float64).reshape(-1, 3)
 
 
@@ -111,11 +112,11 @@ def available() -> tuple[dict[str, str], dict[str, str]]:
     from importlib import metadata
 
     ok, missing = {}, {}
-    for tool, module in dict((p.tool, p.module) for p in PEERS).items():
+    for tool, module in {p.tool: p.module for p in PEERS}.items():
         try:
             importlib.import_module(module)
             ok[tool] = metadata.version(tool)
-        except Exception as exc:  # any import failure means the peer cannot run here
+        except Exception as exc:  # noqa: BLE001 - any import failure means the peer cannot run here
             missing[tool] = (f"{type(exc).__name__}: {exc}".splitlines() or [""])[0]
     return ok, missing
 
@@ -126,7 +127,7 @@ def _child(conn, fn, V, F, kwargs) -> None:
         W = fn(V, F, **kwargs)
         seconds = time.perf_counter() - t0
         conn.send(("ok", np.asarray(W, dtype=np.float64), seconds))
-    except BaseException as exc:  # report any failure of the peer to the parent
+    except BaseException as exc:  # noqa: BLE001 - report any failure of the peer to the parent
         conn.send(("error", (f"{type(exc).__name__}: {exc}".splitlines() or [""])[0],
                    traceback.format_exc(limit=2)))
     finally:

@@ -56,13 +56,13 @@ import subprocess
 import sys
 import tempfile
 import time
+import tomllib
 from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
 import numpy as np
-import tomllib
 from scipy.spatial import cKDTree
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -394,9 +394,9 @@ def reference_of(design: Path, n_ref: int = REF_GENERATORS, rows: int = REF_ROWS
     lines it evaluates the rulings' smooth surface at ``n_ref`` parameters.
     Designs with ``[[transform]]`` tables are not supported (None).
     """
-    from ruledmesh.curves import curve_from_spec
     from ruledmesh.design import load_design
-    from ruledmesh.rulings import rulings_from_spec
+    from ruledmesh.design.curves import curve_from_spec
+    from ruledmesh.design.rulings import rulings_from_spec
 
     d = load_design(design)
     data = d.data

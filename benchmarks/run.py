@@ -45,13 +45,13 @@ GOALS = {
 
 MODES = {
     #          ruledmesh sizes      peer sizes   peer configs   timeout  scaling sizes                  ratio n
-    "tiny": dict(rm=[8, 12], peer=[5], configs="default", timeout=20.0, scaling=[20, 30], ratio=40,
-                 latency_n=20, latency_repeats=3, ratio_repeats=1, peer_surfaces=["skew"]),
-    "quick": dict(rm=[12, 20, 100], peer=[12], configs="default", timeout=15.0, scaling=[45, 141, 447],
-                  ratio=1000, latency_n=100, latency_repeats=20, ratio_repeats=1),
-    "full": dict(rm=[12, 20, 100, 300, 1000], peer=[12, 20, 100], configs="all", timeout=60.0,
-                 scaling=[45, 141, 447, 1414, 4472], ratio=1000, latency_n=100, latency_repeats=50,
-                 ratio_repeats=3),
+    "tiny": {"rm": [8, 12], "peer": [5], "configs": "default", "timeout": 20.0, "scaling": [20, 30], "ratio": 40,
+                 "latency_n": 20, "latency_repeats": 3, "ratio_repeats": 1, "peer_surfaces": ["skew"]},
+    "quick": {"rm": [12, 20, 100], "peer": [12], "configs": "default", "timeout": 15.0, "scaling": [45, 141, 447],
+                  "ratio": 1000, "latency_n": 100, "latency_repeats": 20, "ratio_repeats": 1},
+    "full": {"rm": [12, 20, 100, 300, 1000], "peer": [12, 20, 100], "configs": "all", "timeout": 60.0,
+                 "scaling": [45, 141, 447, 1414, 4472], "ratio": 1000, "latency_n": 100, "latency_repeats": 50,
+                 "ratio_repeats": 3},
 }
 
 
@@ -77,8 +77,9 @@ def machine() -> dict:
     import scipy
 
     load = os.getloadavg() if hasattr(os, "getloadavg") else None
-    return {"nproc": os.cpu_count(), "cpu": cpu, "loadavg_1_5_15": load, "ram_gib": ram, "python": platform.python_version(),
-            "numpy": np.__version__, "scipy": scipy.__version__, "platform": platform.platform()}
+    return {"nproc": os.cpu_count(), "cpu": cpu, "loadavg_1_5_15": load, "ram_gib": ram,
+            "python": platform.python_version(), "numpy": np.__version__, "scipy": scipy.__version__,
+            "platform": platform.platform()}
 
 
 # ---------------------------------------------------------------------- measures
@@ -204,8 +205,8 @@ def plot(result: dict, path: Path) -> str | None:
     colours = dict(zip(tools, plt.get_cmap("tab10").colors))
     fig, axes = plt.subplots(1, 3, figsize=(17, 5.2))
     for m in methods:
-        kw = dict(color=colours[m["tool"]], marker=markers[m["surface"]], alpha=0.8,
-                  s=20 + 8 * math.log2(max(m["size"], 2)), edgecolors="none")
+        kw = {"color": colours[m["tool"]], "marker": markers[m["surface"]], "alpha": 0.8,
+                  "s": 20 + 8 * math.log2(max(m["size"], 2)), "edgecolors": "none"}
         axes[0].scatter(_floor(m["displacement_max"]), _floor(m["planarity_max"]), **kw)
         axes[1].scatter(m["seconds"], _floor(m["planarity_max"]), **kw)
     for ax in axes[:2]:

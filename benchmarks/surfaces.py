@@ -8,7 +8,7 @@ Each surface gives
   with ``n x n`` vertices (what a designer would feed an optimiser); its
   vertices are on the surface, its quads are not planar;
 * ``distance(points)``: distance from the design surface - exact foot points
-  for the two quadrics, :class:`ruledmesh.analysis.surface.RuledReference` for
+  for the two quadrics, :class:`ruledmesh.surfaces.RuledReference` for
   the general skew surface (which measures to the patch ``0 <= u, t <= 1``);
 * ``diagonal``: the bounding-box diagonal of the design patch, the unit of
   every displacement figure.
@@ -21,8 +21,8 @@ planar trapezoids and there would be nothing to optimise.
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from dataclasses import dataclass, field
-from typing import Callable
 
 import numpy as np
 
@@ -159,8 +159,8 @@ def _skew_generators(n: int) -> tuple[np.ndarray, np.ndarray]:
 
 
 def _skew_distance(p: np.ndarray) -> np.ndarray:
-    from ruledmesh.analysis.surface import RuledReference
     from ruledmesh.rulings import between
+    from ruledmesh.surfaces import RuledReference
 
     if "ref" not in _skew_cache:
         c1, c2 = _skew_curves()

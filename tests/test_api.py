@@ -13,47 +13,46 @@ import ruledmesh
 from ruledmesh.cli import main
 
 ROOT = Path(__file__).resolve().parents[1]
-SKEW = ROOT / "examples" / "skew.toml"
 
 
 @pytest.fixture(scope="module")
-def skew():
-    return ruledmesh.build(SKEW)
+def skew(skew_path):
+    return ruledmesh.build(skew_path)
 
 
 @pytest.mark.parametrize("ext", [".obj", ".ply", ".json"])
-def test_round_trip_build_save_load_analyze(skew, tmp_path, ext):
+def test_round_trip_build_save_load_analyze(skew, tmp_path, ext, skew_path):
     path = ruledmesh.save(tmp_path / f"skew{ext}", skew)
     back = ruledmesh.load(path)
     assert back.count_kinds() == skew.count_kinds()
     np.testing.assert_allclose(back.vertices, skew.vertices, rtol=0, atol=1e-12 * skew.diagonal())
     assert np.array_equal(back.face_indices, skew.face_indices)
-    report = ruledmesh.analyze(back, design=SKEW)
+    report = ruledmesh.analyze(back, design=skew_path)
     assert report["planarity"]["max"] <= 1e-12
     assert report["closeness"]["vertices_max"] <= 1e-9
     assert abs(report["coverage"]["ratio"] - 1) < 0.02
 
 
-def test_analyze_is_the_cli_json(skew, tmp_path, capsys):
+def test_analyze_is_the_cli_json(skew, tmp_path, capsys, skew_path):
     obj = ruledmesh.save(tmp_path / "skew.obj", skew)
-    assert main(["analyze", str(obj), "--design", str(SKEW), "--json"]) == 0
+    assert main(["analyze", str(obj), "--design", str(skew_path), "--json"]) == 0
     cli = json.loads(capsys.readouterr().out)
     cli.pop("file")
-    api = ruledmesh.analyze(obj, design=str(SKEW))
+    api = ruledmesh.analyze(obj, design=str(skew_path))
     assert json.loads(json.dumps(api)) == cli
-    assert main(["analyze", str(SKEW), "--json"]) == 0
+    assert main(["analyze", str(skew_path), "--json"]) == 0
     cli = json.loads(capsys.readouterr().out)
     cli.pop("file")
-    assert json.loads(json.dumps(ruledmesh.analyze(SKEW))) == cli
+    assert json.loads(json.dumps(ruledmesh.analyze(skew_path))) == cli
     # Without a design there is nothing to measure closeness against.
     assert "closeness" not in ruledmesh.analyze(skew)
 
 
-def test_build_takes_path_text_and_dict_alike(skew):
+def test_build_takes_path_text_and_dict_alike(skew, skew_path):
     import tomllib
 
-    text = SKEW.read_text()
-    for design in (str(SKEW), text, tomllib.loads(text), "examples/skew.toml"):
+    text = skew_path.read_text()
+    for design in (str(skew_path), text, tomllib.loads(text), "examples/skew.toml"):
         mesh = ruledmesh.build(design)
         assert np.array_equal(mesh.vertices, skew.vertices)
         assert np.array_equal(mesh.face_kind, skew.face_kind)
@@ -79,8 +78,8 @@ def test_bad_designs_fail_with_one_clear_error(design, field):
     assert field in str(info.value) and "\n" not in str(info.value)
 
 
-def test_fabricate_from_a_design(tmp_path, skew):
-    summary = ruledmesh.fabricate(SKEW, tmp_path / "fab", dxf=False)
+def test_fabricate_from_a_design(tmp_path, skew, skew_path):
+    summary = ruledmesh.fabricate(skew_path, tmp_path / "fab", dxf=False)
     assert summary["panels"]["count"] == skew.n_faces
     assert (tmp_path / "fab" / "summary.json").is_file()
 

@@ -2,7 +2,7 @@
 
 No timed assertions: the times depend on the machine.  What is asserted is what
 does not: the surfaces' distances are exact, ruledmesh's rows are planar and on
-the quadrics, and the JSON carries the keys the issue names.
+the quadrics, and the JSON carries the keys docs/benchmarks.md reports.
 """
 
 from __future__ import annotations

@@ -146,7 +146,7 @@ def test_help_examples_work_from_a_wheel_install(wheel_install, tmp_path):
                            check=False, capture_output=True, text=True, env=env, cwd=tmp_path, timeout=60)
     assert Path(where.stdout.strip()).is_relative_to(target), where
     commands = _help_examples()
-    assert ["build", "examples/skew.toml", "-o", "skew.obj"] == commands[0]
+    assert commands[0] == ["build", "examples/skew.toml", "-o", "skew.obj"]
     assert len(commands) >= 8
     failed = {}
     for args in commands:

@@ -55,8 +55,8 @@ def test_compare_table(tmp_path, capsys):
     lines = out.splitlines()
     assert "pq (§4.3)" in lines[0] and "hybrid (§4.1)" in lines[0]
     labels = [ln.split("  ")[0] for ln in lines[1:]]
-    for label in ("faces", "area in triangles", "triangles (of the faces)", "max planarity", "closeness (max, centroids)",
-                  "coverage", "min angle (deg)"):
+    for label in ("faces", "area in triangles", "triangles (of the faces)", "max planarity",
+                  "closeness (max, centroids)", "coverage", "min angle (deg)"):
         assert label in labels
 
 

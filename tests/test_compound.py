@@ -9,8 +9,7 @@ from hypothesis import strategies as st
 
 from ruledmesh.analysis.faces import planarity
 from ruledmesh.cli import main
-from ruledmesh.compound import (CompoundSurface, c1_residual, c1_step, compound_mesh,
-                                compound_net)
+from ruledmesh.compound import CompoundSurface, c1_residual, c1_step, compound_mesh, compound_net
 from ruledmesh.errors import ParameterError
 from ruledmesh.mesh import FaceKind
 

@@ -1,6 +1,6 @@
 """Catalogue constructions (paper §2-§3): each kind's invariant, over its parameters.
 
-Invariants (constructions.md §5): every face planar to 1e-12; vertices on the
+Invariants: every face planar to 1e-12; vertices on the
 analytic surface to 1e-10 relative (checked with the test's own implicit
 equation, not the library's reference); circular kinds circular to 1e-10;
 translational kinds parallelograms.  The predicates come from
@@ -111,7 +111,8 @@ def test_prism_pyramid_torsal_planar_with_members_on_lines(n, layers, rnd):
         for line in np.unique(mesh.member_id):
             seg = mesh.vertices[mesh.members[mesh.member_id == line]]
             d = seg[:, 1] - seg[:, 0]
-            assert np.linalg.norm(np.cross(d, d[0]), axis=1).max() <= 1e-12 * np.linalg.norm(d[0]) * np.linalg.norm(d, axis=1).max()
+            scale = np.linalg.norm(d[0]) * np.linalg.norm(d, axis=1).max()
+            assert np.linalg.norm(np.cross(d, d[0]), axis=1).max() <= 1e-12 * scale
 
 
 def test_torsal_polyhedron_refuses_straight_polygon():

@@ -2,7 +2,7 @@
 
 Each example is built with ``ruledmesh build`` to OBJ and read by meshio (an
 independent reader); the invariants of its kind are checked on what meshio
-returns.  The names the issue fixes (helicoid, hyperboloid styles,
+returns.  The names the design reference fixes (helicoid, hyperboloid styles,
 hyperbolic-paraboloid styles, ellipsoid axes, torus R/r, [mesh] u/v,
 inversion) are built exactly as written there, with Hypothesis over the values.
 """
@@ -107,7 +107,7 @@ def test_every_analytic_example_has_a_reference():
             assert built.reference is not None, path.name
 
 
-# ------------------------------------------- the names the issue fixes, via the CLI
+# ----------------------------- the names the design reference fixes, via the CLI
 @FAST
 @given(radius=st.floats(0.5, 4), pitch=st.floats(0.5, 6), turns=st.floats(0.5, 2),
        u=st.integers(8, 40), v=st.integers(8, 40))

@@ -1,5 +1,6 @@
 """Director curves: exact lengths, plane roots, sweeps, specs, properties."""
 
+import itertools
 import math
 
 import numpy as np
@@ -8,7 +9,8 @@ from hypothesis import HealthCheck, assume, given, settings
 from hypothesis import strategies as st
 from scipy.integrate import quad
 
-from ruledmesh.curves import Arc, BSpline, Helix, Line, Polyline, curve_from_spec
+from ruledmesh.curves import Arc, BSpline, Helix, Line, Polyline
+from ruledmesh.design.curves import curve_from_spec
 from ruledmesh.errors import DesignError, GeometryError, ParameterError
 
 SPLINE = BSpline([[0, 0, 0], [3, 1, 0], [6, -1, 0], [10, 0, 0]], 3)
@@ -32,7 +34,7 @@ def _numeric_length(c, a=0.0, b=1.0):
     breaks = np.unique(np.concatenate([c._breaks(), [a, b]]))
     breaks = breaks[(breaks >= a) & (breaks <= b)]
     return sum(quad(lambda x: np.linalg.norm(c.derivative(x)), lo, hi, epsabs=0, epsrel=1e-13,
-                    limit=200)[0] for lo, hi in zip(breaks[:-1], breaks[1:]))
+                    limit=200)[0] for lo, hi in itertools.pairwise(breaks))
 
 
 # --- exact values ----------------------------------------------------------
@@ -390,7 +392,7 @@ def test_brentq_is_scipys():
 
     from scipy.optimize import brentq as scipy_brentq
 
-    from ruledmesh._roots import brentq
+    from ruledmesh.roots import brentq
 
     rng = np.random.default_rng(3)
     checked = 0

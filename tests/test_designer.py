@@ -169,7 +169,7 @@ def test_export_every_format(tmp_path, ext):
     s = Session(SMALL, tmp_path / "small.toml")
     try:
         path = s.export(ext)
-    except Exception as exc:  # an optional writer package missing: a clear message, no file
+    except Exception as exc:  # noqa: BLE001 - an optional writer package missing: a clear message, no file
         assert "optional package" in str(exc)
         pytest.skip(f"{ext}: {exc}")
     assert path == tmp_path / f"small{ext}" and path.stat().st_size > 0
@@ -248,7 +248,7 @@ def test_http_page_and_api(server, tmp_path):
     assert request(server, "GET", "/../../pyproject.toml")[0] == 404
     assert request(server, "GET", "/api/state", token=False)[0] == 401
     status, _, data = request(server, "POST", "/api/edit", {"changes": [[["mesh", "rows"], 8]]})
-    header, arrays = decode(data)
+    header, _arrays = decode(data)
     assert status == 200 and header["design"]["mesh"]["rows"] == 8
     assert server.session.design["mesh"]["rows"] == 8
     status, ctype, data = request(server, "POST", "/api/edit", {"changes": [[["mesh", "rows"], -1]]})

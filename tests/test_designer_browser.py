@@ -377,7 +377,7 @@ def test_cross_origin_form_and_no_cors_fetch_change_nothing(browser, designer, t
                           "requests": json.dumps(requests)}
 
     class Attacker(http.server.BaseHTTPRequestHandler):
-        def do_GET(self):  # noqa: N802 - stdlib name
+        def do_GET(self):
             body = html.encode()
             self.send_response(200)
             self.send_header("Content-Type", "text/html")

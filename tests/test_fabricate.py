@@ -16,11 +16,17 @@ from hypothesis import strategies as st
 from ruledmesh.analysis.faces import corner_angles, face_areas
 from ruledmesh.cli import main
 from ruledmesh.errors import GeometryError, ParameterError
-from ruledmesh.fabricate import (congruence_classes, edge_schedule, layout, member_schedule,
-                                 node_schedule, panel_statistics, unroll)
+from ruledmesh.fabricate import (
+    congruence_classes,
+    edge_schedule,
+    layout,
+    member_schedule,
+    node_schedule,
+    panel_statistics,
+    unroll,
+)
 from ruledmesh.fabricate.hotwire import gcode, wire_paths
 from ruledmesh.fabricate.output import fabricate
-from ruledmesh.fabricate.sheets import sheet_dxf, sheet_svg
 from ruledmesh.fabricate.unroll import polygon_edges
 from ruledmesh.io import save
 from ruledmesh.mesh import Mesh
@@ -119,7 +125,7 @@ def test_layout_panels_disjoint_and_on_sheet():
                | (hi[ids][:, None] + 0.02 - 1e-12 <= lo[ids][None])).any(axis=2)
         np.fill_diagonal(sep, True)
         assert sep.all()
-    with pytest.raises(ParameterError, match="not fit on a 0.3 x 0.3 sheet .*smallest sheet that fits"):
+    with pytest.raises(ParameterError, match=r"not fit on a 0\.3 x 0\.3 sheet .*smallest sheet that fits"):
         layout(u, sheet=(0.3, 0.3))
 
 

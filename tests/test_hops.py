@@ -8,12 +8,12 @@ import subprocess
 import sys
 import threading
 import time
+import tomllib
 import urllib.request
 from pathlib import Path
 
 import numpy as np
 import pytest
-import tomllib
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
@@ -21,7 +21,7 @@ import ruledmesh
 
 r3 = pytest.importorskip("rhino3dm")
 
-from ruledmesh.hops.server import KEY_HEADER, MAX_BODY, make_server
+from ruledmesh.hops.server import KEY_HEADER, MAX_BODY, make_server  # noqa: E402 - needs rhino3dm
 
 ROOT = Path(__file__).resolve().parents[1]
 SKEW = tomllib.loads((ROOT / "examples" / "skew.toml").read_text())

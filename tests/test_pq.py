@@ -1,8 +1,9 @@
-"""Invariants of the §4.3 PQ mesher (constructions.md §1-3)."""
+"""Invariants of the §4.3 PQ mesher (paper §4.3)."""
 
 import numpy as np
 import pytest
-from hypothesis import HealthCheck, given, settings, strategies as st
+from hypothesis import HealthCheck, given, settings
+from hypothesis import strategies as st
 
 from ruledmesh import GeometryError, ParameterError
 from ruledmesh.analysis.faces import convexity, face_areas, planarity
@@ -75,7 +76,7 @@ def test_hp_mesh_is_all_quads_inside():
     kinds = mesh.count_kinds()
     assert kinds["quad"] == 180 and "split" not in kinds
     # Every quad has one diagonal on a generator: its corners 1 and 3 share a generator.
-    ids, quads = mesh.faces_of_valence(4)
+    _ids, quads = mesh.faces_of_valence(4)
     gen = mesh.vertex_data["generator"]
     assert np.all(gen[quads[:, 1]] == gen[quads[:, 3]])
     assert np.all(np.abs(gen[quads[:, 0]] - gen[quads[:, 2]]) == 2)
@@ -222,7 +223,7 @@ def test_bad_arguments_name_the_parameter():
     with pytest.raises(GeometryError, match="generator 2 has zero length"):
         pq_mesh(A, B2)
     with pytest.raises(ParameterError, match="finite"):
-        pq_mesh(np.where(A == A[0, 0], np.nan, A), B)
+        pq_mesh(np.where(A[0, 0] == A, np.nan, A), B)
 
 
 def test_huge_grid_is_refused_up_front_with_its_memory():

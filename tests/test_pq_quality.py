@@ -10,10 +10,10 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-from hypothesis import HealthCheck, given, settings, strategies as st
+from hypothesis import HealthCheck, given, settings
+from hypothesis import strategies as st
 
-from ruledmesh.analysis.faces import (area_shares, convexity, degenerate_faces, face_min_angles,
-                                      planarity)
+from ruledmesh.analysis.faces import area_shares, convexity, degenerate_faces, face_min_angles, planarity
 from ruledmesh.design import build_design, parse_design
 from ruledmesh.mesh import FaceKind
 from ruledmesh.pq import pq_mesh
@@ -135,7 +135,7 @@ def test_example_quality_does_not_regress(name, share, angle):
 
 
 def test_two_bspline_director_curves_51_by_30():
-    """The issue's first surface: 55 % of the area was in triangles; generators are added
+    """The first quality surface: 55 % of the area was in triangles; generators are added
     where the rows need them and the share falls under a quarter."""
     c1 = [[0.0, 1.34, -1.68], [2.5, -1.44, -0.62], [5.0, 1.66, -0.92], [7.5, -2.19, 0.96],
           [10.0, 1.63, -1.61]]

@@ -6,14 +6,14 @@ import numpy as np
 import pytest
 
 pytest.importorskip("matplotlib")
-from matplotlib import image as mpimg  # noqa: E402
-from matplotlib import colors  # noqa: E402
+from matplotlib import colors
+from matplotlib import image as mpimg
 
-from ruledmesh.cli import main  # noqa: E402
-from ruledmesh.errors import ParameterError  # noqa: E402
-from ruledmesh.io import save  # noqa: E402
-from ruledmesh.mesh import FaceKind, Mesh  # noqa: E402
-from ruledmesh.render import face_values, render, save_render  # noqa: E402
+from ruledmesh.cli import main
+from ruledmesh.errors import ParameterError
+from ruledmesh.io import save
+from ruledmesh.mesh import FaceKind, Mesh
+from ruledmesh.render import face_values, render, save_render
 
 
 def translational_mesh(n=7, m=5):

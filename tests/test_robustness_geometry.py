@@ -21,7 +21,6 @@ from ruledmesh.analysis import planarity
 from ruledmesh.cli import main
 from ruledmesh.design import build_file
 from ruledmesh.io import load
-from ruledmesh.mesh import FaceKind
 
 ROOT = Path(__file__).resolve().parents[1]
 
@@ -29,7 +28,7 @@ ROOT = Path(__file__).resolve().parents[1]
 # ----------------------------------------------------------------- helpers
 def _lines(lines) -> str:
     rows = ",\n  ".join(
-        "[[%r, %r, %r], [%r, %r, %r]]" % (*map(float, a), *map(float, b)) for a, b in lines)
+        "[[{!r}, {!r}, {!r}], [{!r}, {!r}, {!r}]]".format(*map(float, a), *map(float, b)) for a, b in lines)
     return f"[rulings]\nlines = [\n  {rows}\n]\n"
 
 
@@ -109,14 +108,14 @@ def test_torsal_pair_pq_fills_the_strip_with_triangles(tmp_path, capsys):
     lines = [((0, 0, 0), (0, 4, 1)), ((1, 0, 0.5), (1, 4, 0)), ((2, 0, 0), (2, 4, 1)),
              ((2.5, 0, 0.5), (1.5, 4, 0.5)), ((3.5, 0, 0), (3.5, 4, 1)),
              ((4.5, 0, 0.5), (4.5, 4, 0)), ((5.5, 0, 0), (5.5, 4, 1))]
-    mesh, report, _ = expect_mesh(tmp_path, capsys, _lines(lines) + "[mesh]\nrows = 6\n",
+    _mesh, report, _ = expect_mesh(tmp_path, capsys, _lines(lines) + "[mesh]\nrows = 6\n",
                                   warning="torsal strips")
     assert report["kinds"].get("fill", 0) > 0
 
 
 def test_torsal_lines_hybrid_mesh_is_planar_and_conforming(tmp_path, capsys):
     text = (ROOT / "examples" / "hybrid-torsal-lines.toml").read_text()
-    mesh, report, _ = expect_mesh(tmp_path, capsys, text, on_generators=False)
+    _mesh, report, _ = expect_mesh(tmp_path, capsys, text, on_generators=False)
     assert set(report["kinds"]) <= {"quad", "triangle"}
 
 
@@ -144,7 +143,7 @@ CYLINDER = (_curve("c1", 'type = "arc"\ncenter = [0, 0, 0]\nradius = 2\nnormal =
 
 
 def test_cylinder_pq_every_strip_is_a_prism_of_strip_quads(tmp_path, capsys):
-    mesh, report, _ = expect_mesh(tmp_path, capsys, CYLINDER, kinds={"strip"},
+    _mesh, report, _ = expect_mesh(tmp_path, capsys, CYLINDER, kinds={"strip"},
                                   warning="8 torsal strips")
     # each strip a planar rectangle between generators, divided like the rows (20 / 2)
     assert report["faces"] == 8 * 10
@@ -164,7 +163,7 @@ CONE_THROUGH = _lines([((-np.cos(p), -np.sin(p), -1.0), (np.cos(p), np.sin(p), 1
 
 
 def test_cone_apex_at_the_ends_merges_the_apex(tmp_path, capsys):
-    mesh, report, _ = expect_mesh(tmp_path, capsys, CONE_AT_END, kinds={"fill"},
+    mesh, _report, _ = expect_mesh(tmp_path, capsys, CONE_AT_END, kinds={"fill"},
                                   warning="torsal strips")
     apex = np.flatnonzero(np.linalg.norm(mesh.vertices, axis=1) < 1e-12)
     assert len(apex) == 1                          # one apex vertex, no zero-area faces
@@ -173,7 +172,7 @@ def test_cone_apex_at_the_ends_merges_the_apex(tmp_path, capsys):
 
 
 def test_cone_apex_inside_every_generator(tmp_path, capsys):
-    mesh, report, _ = expect_mesh(tmp_path, capsys, CONE_THROUGH, kinds={"fill"},
+    mesh, _report, _ = expect_mesh(tmp_path, capsys, CONE_THROUGH, kinds={"fill"},
                                   warning="torsal strips")
     from ruledmesh.analysis import face_areas
     assert face_areas(mesh).min() > 0
@@ -228,7 +227,7 @@ def test_closed_director_curves(tmp_path, capsys):
             + _curve("c2", 'type = "polyline"\npoints = [[0, 1, 2], [-1, 0, 2], [0, -1, 2], '
                      "[1, 0, 2], [0, 1, 2]]")
             + '[rulings]\nbetween = ["c1", "c2"]\ncount = 17\n[mesh]\nrows = 8\n')
-    mesh, report, built = expect_mesh(tmp_path, capsys, text)
+    _mesh, _report, built = expect_mesh(tmp_path, capsys, text)
     assert np.allclose(built.rulings.a[0], built.rulings.a[-1])
 
 
@@ -302,7 +301,7 @@ def test_linear_directrix_with_several_roots_picks_one_branch(tmp_path, capsys):
                      "pitch = 1\nturns = 2.5")
             + '[rulings]\nbetween = ["c1", "c2"]\ndistribution = "linear-directrix"\n'
             "directrix = [[0, 0, 0], [0, 0, 1]]\ncount = 9\n[mesh]\nrows = 6\n")
-    code, report, err, design, target = build(tmp_path, capsys, text)
+    code, _report, err, _design, _target = build(tmp_path, capsys, text)
     if code == 0:
         expect_mesh(tmp_path, capsys, text)
     else:
@@ -314,7 +313,7 @@ def test_rows_through_infinity_are_dropped_not_emitted(tmp_path, capsys):
     # hyperbolic paraboloid z = x y: all generators parallel to the plane x = 0,
     # so the hops of a far-extended division run off towards infinity
     lines = [((x, 0.0, 0.0), (x, 1.0, x)) for x in np.linspace(-1, 1, 9)]
-    mesh, report, built = expect_mesh(tmp_path, capsys,
+    mesh, _report, built = expect_mesh(tmp_path, capsys,
                                       _lines(lines) + "[mesh]\nrows = 6\nextend = 500\n"
                                       "max_extend = 1000\ntrim = false\n", on_generators=False)
     a = np.asarray(built.rulings.a)
@@ -328,7 +327,7 @@ def test_hops_to_infinity_trimmed(tmp_path, capsys):
     phi = np.concatenate([np.linspace(0, 1.2, 5), np.linspace(1.25, 3.0, 4)])
     lines = [((np.cos(p) - np.sin(p), np.sin(p) + np.cos(p), -1.0),
               (np.cos(p) + np.sin(p), np.sin(p) - np.cos(p), 1.0)) for p in phi]
-    mesh, report, _ = expect_mesh(tmp_path, capsys, _lines(lines)
+    mesh, _report, _ = expect_mesh(tmp_path, capsys, _lines(lines)
                                   + "[mesh]\nrows = 10\nmax_extend = 1000\n")
     v = mesh.vertices                               # on the hyperboloid x^2 + y^2 - z^2 = 1
     assert np.abs(v[:, 0] ** 2 + v[:, 1] ** 2 - v[:, 2] ** 2 - 1).max() < 1e-9
@@ -495,5 +494,5 @@ def test_helicoid_with_a_vanishing_pitch_is_refused():
     text = ('[surface]\nkind = "helicoid"\nradius = 1.0\npitch = 2.2250738585072014e-308\n'
             'turns = 1.0\n[mesh]\nu = 3\nv = 3\n')
     # The design layer refuses such a number before the construction sees it.
-    with pytest.raises(RuledMeshError, match="surface.pitch: expected 0 or a number of magnitude"):
+    with pytest.raises(RuledMeshError, match=r"surface\.pitch: expected 0 or a number of magnitude"):
         build_design(parse_design(text, "helicoid.toml"))

@@ -7,15 +7,14 @@ import pytest
 from scipy.integrate import dblquad
 
 from ruledmesh.curves import Arc, BSpline, Line, Polyline
+from ruledmesh.design.rulings import from_csv, rulings_from_spec
 from ruledmesh.errors import DesignError, GeometryError, ParameterError
 from ruledmesh.rulings import (
     Distribution,
     Rulings,
     between,
     conoid,
-    from_csv,
     from_lines,
-    rulings_from_spec,
     three_directrices,
 )
 
@@ -62,7 +61,7 @@ def test_director_plane_generators_lie_in_the_planes():
     assert _on_curve(C1, r.a, r.info["c1_params"]) < 1e-14
     assert _on_curve(C2, r.b, r.info["c2_params"]) < 1e-14
     # the smooth surface's generators stay parallel to the director plane
-    su, st = r.surface.partials(np.linspace(0, 1, 101), 0.3)
+    _su, st = r.surface.partials(np.linspace(0, 1, 101), 0.3)
     assert np.abs(st @ n).max() < 1e-6
     _surface_matches_generators(r)
 
@@ -122,7 +121,7 @@ def test_three_directrices_area_is_a_quarter_hyperboloid():
 
 
 def test_three_directrices_reports_where_the_family_ends():
-    c1, c2, c3 = _hyperboloid_directrices()
+    c1, _c2, c3 = _hyperboloid_directrices()
     short = Arc.from_center([0, 0, 1], math.sqrt(2), [0, 0, 1], 40, 100, x_axis=[1, 0, 0])
     with pytest.raises(GeometryError, match=r"family of lines ends near u = .* runs off the end "
                                             r"of c2"):
@@ -209,7 +208,7 @@ def test_from_csv_reads_rows_and_names_bad_lines(tmp_path):
     bad.write_text("0,0,0,0,1,0\n1,0,0,1,1\n")
     with pytest.raises(DesignError, match=r"bad.csv: line 2: expected 6 numbers"):
         from_csv(bad)
-    with pytest.raises(DesignError, match="missing.csv: cannot read"):
+    with pytest.raises(DesignError, match=r"missing\.csv: cannot read"):
         from_csv(tmp_path / "missing.csv")
 
 
@@ -230,7 +229,7 @@ def test_director_plane_branch_turning_back_names_the_generator():
 
 def test_curves_without_common_planes_are_refused():
     far = Line([20, 0, 0], [30, 0, 1])
-    with pytest.raises(GeometryError, match="no plane n . x = s meets both curves"):
+    with pytest.raises(GeometryError, match=r"no plane n \. x = s meets both curves"):
         between(C1, far, 9, "director-plane", director_plane=[1, 0, 0])
 
 
@@ -252,7 +251,7 @@ def test_wrong_options_for_a_distribution():
         between(C1, C2, 9, "director-plane")
     with pytest.raises(ParameterError, match='directrix: only used with distribution "linear'):
         between(C1, C2, 9, "arc-length", directrix=D)
-    with pytest.raises(ParameterError, match='distribution: expected one of .*did you mean '
+    with pytest.raises(ParameterError, match=r'distribution: expected one of .*did you mean '
                                              '"arc-length"'):
         between(C1, C2, 9, "arclength")
 

@@ -88,7 +88,7 @@ def test_projective_refuses_vertex_at_or_across_infinity():
     with pytest.raises(GeometryError, match="across infinity"):
         T.projective(mesh, M)
     M[3] = [-1.0 / 4.0, 0, 0, 1.0]  # w = 1 - x / 4: zero at the vertex (4, 0, 0)
-    with pytest.raises(GeometryError, match="vertex 0 .* to infinity"):
+    with pytest.raises(GeometryError, match=r"vertex 0 .* to infinity"):
         T.projective(mesh, M)
 
 

@@ -8,16 +8,21 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-from hypothesis import given, settings, strategies as st
+from hypothesis import given, settings
+from hypothesis import strategies as st
 
 from ruledmesh.analysis.faces import face_normals
 from ruledmesh.analysis.report import analyze
-from ruledmesh.analysis.triangles import (aspect_ratios, compare_tessellations, parameter_grid,
-                                          triangle_quality)
+from ruledmesh.analysis.triangles import aspect_ratios, compare_tessellations, parameter_grid, triangle_quality
 from ruledmesh.errors import ParameterError
 from ruledmesh.mesh import Mesh
-from ruledmesh.triangulate import (MAX_TEMPLATE_VALENCE, polygon_templates, recover_polygons,
-                                   triangle_angles, triangulate)
+from ruledmesh.triangulate import (
+    MAX_TEMPLATE_VALENCE,
+    polygon_templates,
+    recover_polygons,
+    triangle_angles,
+    triangulate,
+)
 
 
 def _helpers():

@@ -4,7 +4,7 @@ Every public function validates its inputs once, here, and the maths below it
 trusts them.  Each helper takes the parameter's ``name`` (a dotted field path
 for design files) and the error class to raise, so the same checks serve the
 Python API (:class:`~ruledmesh.errors.ParameterError`) and the design-file
-reader (:class:`~ruledmesh.errors.DesignError`).
+reader of :mod:`ruledmesh.design` (its own error class).
 """
 
 from __future__ import annotations
@@ -59,7 +59,7 @@ def near_miss(value: Any, choices: Iterable[str]) -> str:
 
 
 def _as_float_array(value: Any, name: str, err: type) -> np.ndarray:
-    if isinstance(value, str) or isinstance(value, Mapping):
+    if isinstance(value, (str, Mapping)):
         raise err(f"expected numbers, got {describe(value)}", name)
     try:
         arr = np.asarray(value, dtype=np.float64)
@@ -152,9 +152,8 @@ def check_int(value: Any, name: str, *, lo: int | None = None, hi: int | None = 
     expected = f"expected an integer{_bound_text(lo, hi)}"
     if isinstance(value, bool) or not isinstance(value, (int, float, np.integer, np.floating)):
         raise err(f"{expected}, got {describe(value)}", name)
-    if isinstance(value, (float, np.floating)):
-        if not math.isfinite(value) or value != int(value):
-            raise err(f"{expected}, got {describe(value)}", name)
+    if isinstance(value, (float, np.floating)) and (not math.isfinite(value) or value != int(value)):
+        raise err(f"{expected}, got {describe(value)}", name)
     ivalue = int(value)
     if (lo is not None and ivalue < lo) or (hi is not None and ivalue > hi):
         raise err(f"{expected}, got {ivalue}", name)

@@ -27,20 +27,12 @@ DesignLike = Union[str, "os.PathLike[str]", Mapping[str, Any]]
 
 def _design(design: Any, base_dir: str | os.PathLike | None):
     """A parsed :class:`~ruledmesh.design.Design` from a path, TOML text or a mapping."""
-    from .design import Design, load_design, parse_design
+    from .design import Design, design_from_tables, load_design, parse_design
 
     if isinstance(design, Design):
         return design
     if isinstance(design, Mapping):
-        from ._validation import check_keys
-        from .design import TOP_LEVEL
-        from .errors import DesignError
-
-        try:
-            check_keys(design, TOP_LEVEL, "", err=DesignError)
-        except DesignError as exc:
-            raise exc.with_source("<dict>") from None
-        return Design(design, "<dict>", Path(base_dir if base_dir is not None else "."))
+        return design_from_tables(design, "<dict>", base_dir if base_dir is not None else ".")
     if isinstance(design, os.PathLike):
         return load_design(design)
     if isinstance(design, str):

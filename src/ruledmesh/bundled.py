@@ -13,11 +13,10 @@ from __future__ import annotations
 import os
 import re
 import shutil
+import tomllib
 from collections.abc import Iterator
 from pathlib import Path
 from typing import Any
-
-import tomllib
 
 from ._validation import near_miss
 from .errors import ParameterError

@@ -37,17 +37,14 @@ its tangent plane).
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import Any, Mapping
+from typing import Any
 
 import numpy as np
 
-from ._validation import check_int, check_keys, check_points, describe
+from ._validation import check_int, check_points, describe
 from .budget import HYBRID_BYTES_PER_NODE, check_budget
-from .budget import HYBRID_BYTES_PER_NODE, check_budget
-from .errors import DesignError, GeometryError, ParameterError
+from .errors import GeometryError, ParameterError
 from .mesh import FaceKind, Mesh
-from .registry import BuildContext, Built, surface_kind
-from .tolerances import DEFAULT, Tolerances
 
 __all__ = ["c1_step", "compound_net", "c1_residual", "compound_mesh", "CompoundSurface",
            "CompoundReference"]
@@ -124,15 +121,15 @@ def compound_net(seed: Any, u_steps: Any = (), v_steps: Any = ()) -> tuple[np.nd
     if seed.shape != (2, 2, 3):
         raise ParameterError(f"expected two generators [[a0, b0], [a1, b1]], got {seed.shape[0]}",
                              "seed")
-    us = _steps(u_steps, "u_steps")
-    vs = _steps(v_steps, "v_steps")
+    us = check_steps(u_steps, "u_steps")
+    vs = check_steps(v_steps, "v_steps")
     I, J = len(us) + 1, len(vs) + 1
     P = np.full((I + 1, J + 1, 3), np.nan)
     P[:2, :2] = seed
-    for i, (lam, sig, tau) in enumerate(us):          # a loop over generators, not faces
-        P[i + 2, 0], P[i + 2, 1] = c1_step(P[i, 0], P[i + 1, 0], P[i, 1], P[i + 1, 1], lam, sig, tau)
-    for j, (lam, sig, tau) in enumerate(vs):
-        P[0, j + 2], P[1, j + 2] = c1_step(P[0, j], P[0, j + 1], P[1, j], P[1, j + 1], lam, sig, tau)
+    for k, (lam, sig, tau) in enumerate(us):          # a loop over generators, not faces
+        P[k + 2, 0], P[k + 2, 1] = c1_step(P[k, 0], P[k + 1, 0], P[k, 1], P[k + 1, 1], lam, sig, tau)
+    for k, (lam, sig, tau) in enumerate(vs):
+        P[0, k + 2], P[1, k + 2] = c1_step(P[0, k], P[0, k + 1], P[1, k], P[1, k + 1], lam, sig, tau)
     gap = 0.0
     # Inner corners, one anti-diagonal at a time (each needs its left and lower neighbours).
     for s in range(2, I + J - 1):
@@ -158,7 +155,7 @@ def compound_net(seed: Any, u_steps: Any = (), v_steps: Any = ()) -> tuple[np.nd
     return P, gap
 
 
-def _steps(value: Any, name: str, err: type = ParameterError) -> np.ndarray:
+def check_steps(value: Any, name: str, err: type = ParameterError) -> np.ndarray:
     """``value`` as an (n, 3) array of ``(lambda, sigma, tau)`` with ``lambda > 0``."""
     expected = f"expected a list of [lambda, sigma, tau] triples, got {describe(value)}"
     try:
@@ -306,9 +303,6 @@ def compound_mesh(P: Any, midpoints: int = 1, divisions: int = 8, border: str = 
     check_budget(float(CX + 1) * (CY + 1), HYBRID_BYTES_PER_NODE,
                  f"{I} x {J} patches x {nu} columns x {nv} divisions",
                  "reduce the midpoints or the divisions", "divisions", ParameterError)
-    check_budget(float(CX + 1) * (CY + 1), HYBRID_BYTES_PER_NODE,
-                 f"{I} x {J} patches x {nu} columns x {nv} divisions",
-                 "reduce the midpoints or the divisions", "divisions", ParameterError)
     x, y = np.meshgrid(np.arange(CX + 1), np.arange(CY + 1), indexing="ij")
     i, j = np.minimum(x // nu, I - 1), np.minimum(y // nv, J - 1)
     X = _bilinear(P, i, j, (x - i * nu) / nu, (y - j * nv) / nv)[0].reshape(-1, 3)
@@ -357,72 +351,6 @@ def compound_mesh(P: Any, midpoints: int = 1, divisions: int = 8, border: str = 
     return mesh.compact()
 
 
-# --------------------------------------------------------------------------- design files
-_SURFACE_KEYS = ("kind", "seed", "u_steps", "v_steps")
-_MESH_KEYS = ("midpoints", "divisions", "border")
-
-
-@surface_kind("compound-hp")
-def build_compound(surface: Mapping[str, Any], mesh_table: Mapping[str, Any],
-                   ctx: BuildContext, tol: Tolerances = DEFAULT) -> Built:
-    """Design-file builder for ``[surface] kind = "compound-hp"``."""
-    check_keys(surface, _SURFACE_KEYS, "surface", err=DesignError)
-    check_keys(mesh_table, _MESH_KEYS, "mesh", err=DesignError)
-    if "seed" not in surface:
-        raise DesignError("missing: the first two generators [[a0, b0], [a1, b1]]", "surface.seed")
-    seed = surface["seed"]
-    try:
-        arr = np.asarray(seed, dtype=np.float64)
-    except (TypeError, ValueError):
-        arr = None
-    if arr is None or arr.shape != (2, 2, 3):
-        raise DesignError(f"expected two generators [[a0, b0], [a1, b1]], got {describe(seed)}",
-                          "surface.seed")
-    check_points(arr.reshape(4, 3), "surface.seed", err=DesignError)
-    steps = {}
-    for key in ("u_steps", "v_steps"):
-        value = surface.get(key, [])
-        if not isinstance(value, list):
-            raise DesignError(f"expected a list of [lambda, sigma, tau], got {describe(value)}",
-                              f"surface.{key}")
-        for k, row in enumerate(value):
-            if not isinstance(row, list) or len(row) != 3:
-                raise DesignError(f"expected [lambda, sigma, tau], got {describe(row)}",
-                                  f"surface.{key}[{k}]")
-        steps[key] = _steps(value, f"surface.{key}", err=DesignError)
-    midpoints = check_int(mesh_table.get("midpoints", 1), "mesh.midpoints", lo=0, hi=10_000,
-                          err=DesignError)
-    divisions = check_int(mesh_table.get("divisions", 8), "mesh.divisions", lo=1, hi=100_000,
-                          err=DesignError)
-    border = mesh_table.get("border", "notched")
-    if border not in ("notched", "triangles"):
-        raise DesignError(f'expected "notched" or "triangles", got {describe(border)}',
-                          "mesh.border")
-    # The steps are ratios and slides along the joints (affine-invariant): the net is
-    # grown in the seed's unit frame and mapped back, so its arithmetic never
-    # overflows; a net that is not finite is refused by compound_net.
-    from .normalise import unit_frame
-
-    centre, unit = unit_frame(arr.reshape(4, 3))
-    with np.errstate(all="ignore"):
-        P, gap = compound_net((arr - centre) / unit, steps["u_steps"], steps["v_steps"])
-    P, gap = P * unit + centre, gap * unit
-    mesh = compound_mesh(P, midpoints, divisions, border)
-    c1 = c1_residual(P)
-    scale = float(np.linalg.norm(np.ptp(P.reshape(-1, 3), axis=0))) or 1.0
-    warnings = []
-    if c1["max"] > tol.planarity * 1e3:
-        warnings.append(f"compound: tangent planes differ along a joint by {c1['max']:.2e} "
-                        "(sine of the angle)")
-    I, J = P.shape[0] - 1, P.shape[1] - 1
-    extras = {"c1": {"max_sine": c1["max"], "joints": c1["joints"],
-                     "corner_gap": gap / scale, "patches": [I, J],
-                     "free_numbers": 12 + 3 * (I - 1) + 3 * (J - 1),
-                     "net_numbers": 3 * (I + 1) * (J + 1)}}
-    mesh = mesh.with_info(source=ctx.source, warnings=warnings)
-    return Built(mesh, CompoundReference(P), None, extras)
-
-
 class CompoundReference:
     """Closeness and area of the compound (the :class:`~ruledmesh.registry.Reference` protocol).
 
@@ -432,7 +360,7 @@ class CompoundReference:
     """
 
     def __init__(self, P: np.ndarray):
-        from .analysis.surface import RuledReference
+        from .surfaces import RuledReference
 
         self._ref = RuledReference(CompoundSurface(np.asarray(P, dtype=np.float64)))
 

@@ -20,8 +20,9 @@ level has at most one root, so ``brentq`` finds it; a touch shows up as a
 piece end within tolerance of the level; a branch *ends* where the sweep
 passes a piece end at which ``g`` turns back, or an end of the curve.
 
-``curve_from_spec`` reads the ``[curves.*]`` tables of a design file and
-``Curve.to_spec`` writes them back (``curve_from_spec(c.to_spec(), p) == c``).
+:func:`ruledmesh.design.curves.curve_from_spec` reads the ``[curves.*]`` tables
+of a design file and ``Curve.to_spec`` writes them back
+(``curve_from_spec(c.to_spec(), p) == c``).
 
 B-splines are evaluated as one polynomial per knot span (Taylor coefficients
 from de Boor's algorithm, once per curve; Horner's rule per call), in numpy, so
@@ -33,7 +34,7 @@ from __future__ import annotations
 
 import functools
 import math
-from collections.abc import Callable, Mapping
+from collections.abc import Callable
 from dataclasses import dataclass, fields
 from enum import Enum
 from functools import cached_property
@@ -42,16 +43,13 @@ from typing import Any
 import numpy as np
 
 from ._validation import (
-    check_bool,
-    check_choice,
     check_float,
     check_int,
-    check_keys,
     check_points,
     check_vector,
     describe,
 )
-from .errors import DesignError, GeometryError, ParameterError
+from .errors import GeometryError, ParameterError
 from .tolerances import DEFAULT, Tolerances
 
 __all__ = [
@@ -63,7 +61,6 @@ __all__ = [
     "BSpline",
     "Helix",
     "CurveType",
-    "curve_from_spec",
 ]
 
 # Gauss-Legendre nodes per arc-length piece; with pieces no longer than half a
@@ -84,7 +81,7 @@ def _unit(v: np.ndarray) -> np.ndarray:
     return v / np.linalg.norm(v)
 
 
-def _perpendicular(axis: np.ndarray) -> np.ndarray:
+def perpendicular(axis: np.ndarray) -> np.ndarray:
     """A deterministic unit vector perpendicular to ``axis``.
 
     Projects the coordinate axis least aligned with ``axis``, so the same axis
@@ -223,7 +220,7 @@ class _LiesInLevel(Exception):
     """The level function equals the target everywhere (curve in the plane)."""
 
 
-class _Level:
+class LevelSet:
     """A continuous scalar function ``g`` on [0, 1] cut into monotone pieces.
 
     Parameters
@@ -251,7 +248,7 @@ class _Level:
         crit = []
         signs = np.nonzero(dl * dr < 0)[0]
         if signs.size:
-            from ._roots import brentq
+            from .roots import brentq
         for i in signs:
             lo, hi = a[i] + delta[i], b[i] - delta[i]
             # Evaluated one by one, a derivative at rounding level (a curve
@@ -442,7 +439,7 @@ class Curve:
     def __eq__(self, other: object) -> bool:
         if type(other) is not type(self):
             return NotImplemented
-        return self._key() == other._key()  # type: ignore[attr-defined]
+        return self._key() == other._key()
 
     def __hash__(self) -> int:
         return hash(self._key())
@@ -461,7 +458,7 @@ class Curve:
         return np.linspace(0.0, 1.0, 65)
 
     def to_spec(self) -> dict:
-        """A design-file table that :func:`curve_from_spec` reads back to an equal curve."""
+        """A design-file table that :func:`~ruledmesh.design.curves.curve_from_spec` reads back."""
         raise NotImplementedError
 
     # --- evaluation --------------------------------------------------------
@@ -679,9 +676,9 @@ class Curve:
         return u
 
     # --- planes ----------------------------------------------------------------
-    def _plane_level(self, unit_normal: np.ndarray, tol: Tolerances) -> _Level:
+    def _plane_level(self, unit_normal: np.ndarray, tol: Tolerances) -> LevelSet:
         n = unit_normal
-        return _Level(lambda u: self._eval(np.asarray(u, dtype=np.float64)) @ n,
+        return LevelSet(lambda u: self._eval(np.asarray(u, dtype=np.float64)) @ n,
                       lambda u: self._deriv(np.asarray(u, dtype=np.float64), 1) @ n,
                       np.concatenate([self._level_grid(), self._breaks()]),
                       tol.degenerate * self._size)
@@ -953,7 +950,7 @@ class Arc(Curve):
         object.__setattr__(self, "end_angle", a1)
 
     @classmethod
-    def through(cls, start: Any, mid: Any, end: Any) -> "Arc":
+    def through(cls, start: Any, mid: Any, end: Any) -> Arc:
         """The arc from ``start`` through ``mid`` to ``end``.
 
         Raises
@@ -983,7 +980,7 @@ class Arc(Curve):
 
     @classmethod
     def from_center(cls, center: Any, radius: float, normal: Any, start_angle: float,
-                    end_angle: float, x_axis: Any = None) -> "Arc":
+                    end_angle: float, x_axis: Any = None) -> Arc:
         """The arc about ``center`` in the plane with ``normal``; angles in degrees.
 
         ``x_axis`` (the direction of angle 0) defaults to a fixed direction
@@ -991,7 +988,7 @@ class Arc(Curve):
         """
         normal = check_vector(normal, "normal", nonzero=True)
         if x_axis is None:
-            x_axis = _perpendicular(normal)
+            x_axis = perpendicular(normal)
         return cls(center, radius, normal, x_axis, start_angle, end_angle)
 
     @cached_property
@@ -1018,7 +1015,7 @@ class Arc(Curve):
         return (self.radius * w ** order) * (np.cos(ak)[..., None] * x + np.sin(ak)[..., None] * y)
 
     def _level_grid(self):
-        return np.linspace(0.0, 1.0, max(9, int(math.ceil(abs(self.end_angle - self.start_angle) / 10.0)) + 1))
+        return np.linspace(0.0, 1.0, max(9, math.ceil(abs(self.end_angle - self.start_angle) / 10.0) + 1))
 
     def length(self) -> float:
         return self.radius * abs(self._sweep_rad)
@@ -1099,7 +1096,7 @@ class BSpline(Curve):
         object.__setattr__(self, "knots", _frozen(knots))
 
     @classmethod
-    def interpolate(cls, points: Any, degree: int = 3) -> "BSpline":
+    def interpolate(cls, points: Any, degree: int = 3) -> BSpline:
         """The B-spline through ``points`` at chord-length parameters.
 
         Parameters
@@ -1123,6 +1120,12 @@ class BSpline(Curve):
         spl = make_interp_spline(x, pts, k=degree)
         return cls(np.asarray(spl.c), degree, np.asarray(spl.t))
 
+    @property
+    def _knot_vector(self) -> np.ndarray:
+        # __post_init__ always sets the knots; the None is only the constructor's default
+        assert self.knots is not None
+        return self.knots
+
     @cached_property
     def _derivative_nets(self) -> list[tuple[np.ndarray, np.ndarray, int]]:
         """(knots, control points, degree) of the curve and its derivatives up to the degree.
@@ -1131,7 +1134,7 @@ class BSpline(Curve):
         the knots without their ends, control points
         ``p (c[i+1] - c[i]) / (t[i+p+1] - t[i+1])`` (zero over empty spans).
         """
-        nets = [(self.knots, self.control_points, self.degree)]
+        nets = [(self._knot_vector, self.control_points, self.degree)]
         for _ in range(self.degree):
             t, c, p = nets[-1]
             denom = (t[p + 1:-1] - t[1:-p - 1])[:, None]
@@ -1194,7 +1197,7 @@ class BSpline(Curve):
     @property
     def _domain(self) -> tuple[float, float]:
         n = len(self.control_points)
-        return float(self.knots[self.degree]), float(self.knots[n])
+        return float(self._knot_vector[self.degree]), float(self._knot_vector[n])
 
     def _eval(self, u):
         return self._poly(np.asarray(u, dtype=np.float64), 0)
@@ -1206,7 +1209,7 @@ class BSpline(Curve):
 
     def _breaks(self):
         t0, t1 = self._domain
-        k = np.unique(self.knots)
+        k = np.unique(self._knot_vector)
         k = k[(k >= t0) & (k <= t1)]
         u = (k - t0) / (t1 - t0)
         u[0], u[-1] = 0.0, 1.0
@@ -1227,8 +1230,8 @@ class BSpline(Curve):
 
     def to_spec(self) -> dict:
         spec = {"type": "bspline", "degree": self.degree, "points": _as_list(self.control_points)}
-        if not np.array_equal(self.knots, _default_knots(len(self.control_points), self.degree)):
-            spec["knots"] = _as_list(self.knots)
+        if not np.array_equal(self._knot_vector, _default_knots(len(self.control_points), self.degree)):
+            spec["knots"] = _as_list(self._knot_vector)
         return spec
 
 
@@ -1270,7 +1273,7 @@ class Helix(Curve):
     @cached_property
     def _frame(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         a = _unit(self.axis)
-        x = _perpendicular(a)
+        x = perpendicular(a)
         return a, x, np.cross(a, x)
 
     def _eval(self, u):
@@ -1289,7 +1292,7 @@ class Helix(Curve):
         return out
 
     def _level_grid(self):
-        return np.linspace(0.0, 1.0, max(17, int(math.ceil(32 * self.turns)) + 1))
+        return np.linspace(0.0, 1.0, max(17, math.ceil(32 * self.turns) + 1))
 
     def length(self) -> float:
         return self.turns * math.hypot(2.0 * math.pi * self.radius, self.pitch)
@@ -1304,140 +1307,3 @@ class Helix(Curve):
         return {"type": "helix", "center": _as_list(self.center), "axis": _as_list(self.axis),
                 "radius": self.radius, "pitch": self.pitch, "turns": self.turns,
                 "start_angle": self.start_angle}
-
-
-# --------------------------------------------------------------------------
-# design-file tables
-# --------------------------------------------------------------------------
-
-_KEYS = {
-    CurveType.LINE: ("type", "points"),
-    CurveType.POLYLINE: ("type", "points"),
-    CurveType.ARC: ("type", "points", "center", "radius", "normal", "start_angle", "end_angle",
-                    "x_axis"),
-    CurveType.BSPLINE: ("type", "points", "degree", "knots", "interpolate"),
-    CurveType.HELIX: ("type", "center", "axis", "radius", "pitch", "turns", "start_angle"),
-}
-
-
-def _require(spec: Mapping, key: str, path: str, what: str) -> Any:
-    if key not in spec:
-        raise DesignError(f"missing; expected {what}", f"{path}.{key}")
-    return spec[key]
-
-
-def curve_from_spec(spec: Mapping, path: str) -> Curve:
-    """Build a curve from a design file's ``[curves.<name>]`` table.
-
-    Parameters
-    ----------
-    spec : Mapping
-        E.g. ``{"type": "bspline", "degree": 3, "points": [[0, 0, 0], ...]}``.
-        Types and keys:
-
-        * ``line``: ``points`` (2 points);
-        * ``polyline``: ``points`` (>= 2);
-        * ``arc``: ``points`` (start, through, end) or ``center``, ``radius``,
-          ``normal``, ``start_angle``, ``end_angle`` (degrees) and optional
-          ``x_axis`` (direction of angle 0);
-        * ``bspline``: ``points`` (control points), ``degree`` (1..5, default
-          3), optional ``knots``; or ``interpolate = true`` to pass through
-          ``points``;
-        * ``helix``: ``center``, ``axis``, ``radius``, ``pitch``, ``turns``,
-          optional ``start_angle`` (degrees, default 0).
-    path : str
-        The table's dotted path, e.g. ``"curves.c1"``, prefixed to errors.
-
-    Returns
-    -------
-    Curve
-
-    Raises
-    ------
-    DesignError
-        With the full dotted field path, e.g.
-        ``curves.c1.degree: expected an integer >= 1 and <= 5, got 7``.
-
-    Examples
-    --------
-    >>> c = curve_from_spec({"type": "line", "points": [[0, 0, 0], [3, 4, 0]]}, "curves.c1")
-    >>> c.length()
-    5.0
-    >>> curve_from_spec(c.to_spec(), "curves.c1") == c
-    True
-    """
-    if not isinstance(spec, Mapping):
-        raise DesignError(f"expected a table, got {describe(spec)}", path)
-    kind = check_choice(_require(spec, "type", path, "one of " + " | ".join(
-        f'"{t.value}"' for t in CurveType)), CurveType, f"{path}.type", err=DesignError)
-    check_keys(spec, _KEYS[kind], path, err=DesignError)
-    E = DesignError
-
-    def pts(key: str, **kw: Any) -> np.ndarray:
-        return check_points(_require(spec, key, path, "a list of points [x, y, z]"),
-                            f"{path}.{key}", err=E, **kw)
-
-    def vec(key: str, nonzero: bool = False) -> np.ndarray:
-        return check_vector(_require(spec, key, path, "[x, y, z]"), f"{path}.{key}",
-                            nonzero=nonzero, err=E)
-
-    def num(key: str, default: Any = None, **kw: Any) -> float:
-        value = spec.get(key, default) if default is not None else _require(spec, key, path, "a number")
-        return check_float(value, f"{path}.{key}", err=E, **kw)
-
-    # constructor parameter -> design key, for re-attributing ParameterErrors
-    rename: dict[str, str] = {}
-    try:
-        if kind is CurveType.LINE:
-            p = pts("points")
-            if len(p) != 2:
-                raise E(f"expected 2 points, got {len(p)}", f"{path}.points")
-            rename = {"p0": "points", "p1": "points"}
-            return Line(p[0], p[1])
-        if kind is CurveType.POLYLINE:
-            return Polyline(pts("points", min_count=2))
-        if kind is CurveType.ARC:
-            center_keys = [k for k in ("center", "radius", "normal", "start_angle", "end_angle",
-                                       "x_axis") if k in spec]
-            if "points" in spec:
-                if center_keys:
-                    raise E(f"give either points (start, through, end) or center/radius/normal/"
-                            f"angles, not both", f"{path}.{center_keys[0]}")
-                p = pts("points")
-                if len(p) != 3:
-                    raise E(f"expected 3 points (start, through, end), got {len(p)}",
-                            f"{path}.points")
-                rename = {"start": "points", "mid": "points", "end": "points"}
-                return Arc.through(p[0], p[1], p[2])
-            if not center_keys:
-                raise E("missing; expected points (start, through, end) or center, radius, "
-                        "normal, start_angle, end_angle", f"{path}.points")
-            x_axis = vec("x_axis", nonzero=True) if "x_axis" in spec else None
-            return Arc.from_center(vec("center"), num("radius", lo=0.0, lo_open=True),
-                                   vec("normal", nonzero=True), num("start_angle"),
-                                   num("end_angle"), x_axis)
-        if kind is CurveType.BSPLINE:
-            degree = check_int(spec.get("degree", 3), f"{path}.degree", lo=1, hi=5, err=E)
-            interp = check_bool(spec.get("interpolate", False), f"{path}.interpolate", err=E)
-            p = pts("points")
-            if len(p) < degree + 1:
-                raise E(f"a degree-{degree} B-spline needs at least {degree + 1} points, "
-                        f"got {len(p)}", f"{path}.points")
-            if interp:
-                if "knots" in spec:
-                    raise E("knots cannot be given with interpolate = true", f"{path}.knots")
-                return BSpline.interpolate(p, degree)
-            knots = None
-            if "knots" in spec:
-                knots = spec["knots"]
-                if isinstance(knots, (str, Mapping)):
-                    raise E(f"expected a list of numbers, got {describe(knots)}", f"{path}.knots")
-            rename = {"control_points": "points"}
-            return BSpline(p, degree, knots)
-        # helix
-        return Helix(vec("center"), vec("axis", nonzero=True), num("radius", lo=0.0, lo_open=True),
-                     num("pitch"), num("turns", lo=0.0, lo_open=True),
-                     num("start_angle", default=0.0))
-    except ParameterError as exc:
-        field = rename.get(exc.field or "", exc.field or "")
-        raise DesignError(exc.detail, f"{path}.{field}" if field else path) from None

@@ -87,11 +87,11 @@ class _FieldError(RuledMeshError, ValueError):
         parts.append(printable(self.detail, MAX_MESSAGE))
         return ": ".join(parts)
 
-    def with_source(self, source: str) -> "_FieldError":
+    def with_source(self, source: str) -> _FieldError:
         """Return the same error attributed to the file ``source``."""
         return type(self)(self.detail, self.field, source)
 
-    def within(self, prefix: str) -> "_FieldError":
+    def within(self, prefix: str) -> _FieldError:
         """Return the same error with ``prefix`` prepended to its field path."""
         path = f"{prefix}.{self.field}" if self.field else prefix
         return type(self)(self.detail, path, self.source)

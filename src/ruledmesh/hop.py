@@ -11,7 +11,7 @@ Because the plane through ``P(t) = a0 + t d0`` and ``g1`` depends linearly on
 ``g1``) is a Moebius function of ``t``: a 2x2 matrix acting on homogeneous
 ``(t, 1)``.  Composing the matrices gives every row of the mesh at once
 (:mod:`ruledmesh.pq`), and their poles say where a row runs to infinity.
-See ``constructions.md`` §1-2.
+See the paper, §4.3.
 """
 
 from __future__ import annotations

@@ -38,16 +38,16 @@ degenerate faces only, which are rare).
 
 from __future__ import annotations
 
-from typing import Any, Mapping
+import itertools
+from typing import Any
 
 import numpy as np
 
-from ._validation import check_bool, check_int, check_keys, check_points
+from ._validation import check_bool, check_int, check_points
 from .budget import HYBRID_BYTES_PER_NODE, MAX_BUILD_BYTES, gib
-from .errors import DesignError, GeometryError, ParameterError
+from .errors import GeometryError, ParameterError
 from .mesh import FaceKind, Mesh
 from .normalise import normalised
-from .registry import BuildContext, Built, mesh_method
 from .tolerances import DEFAULT, Tolerances
 
 __all__ = ["hybrid_mesh", "hybrid_grid", "orient_generators", "checkerboard_faces"]
@@ -243,8 +243,8 @@ def _merge_coincident(V: np.ndarray, faces: list[np.ndarray], radius: float,
         rows.append(comp[fid] + n_groups)
         cols.append(verts)
         n_groups += int(comp.max()) + 1
-    rows, cols = np.concatenate(rows), np.concatenate(cols)
-    inc = csr_matrix((np.ones(len(cols)), (cols, rows)), shape=(n, n_groups))
+    group, vertex = np.concatenate(rows), np.concatenate(cols)
+    inc = csr_matrix((np.ones(len(vertex)), (vertex, group)), shape=(n, n_groups))
     share = np.asarray(inc[pairs[:, 0]].multiply(inc[pairs[:, 1]]).sum(axis=1)).ravel() > 0
     pairs = pairs[share]
     if len(pairs) == 0:
@@ -276,6 +276,7 @@ def _fan(V: np.ndarray, poly: list[int]) -> list[list[int]]:
         score = signed.min() if np.all(signed > 0) else signed.min() - 1e300
         if score > best_score:
             best, best_score = tri, score
+    assert best is not None  # every start vertex gives a fan; the first one always wins over -inf
     return best.tolist()
 
 
@@ -301,7 +302,22 @@ def _repair(V: np.ndarray, faces: list[np.ndarray], members: np.ndarray, member_
     members = rep[members]
     keep_m = members[:, 0] != members[:, 1]
     members, member_id = members[keep_m], member_id[keep_m]
+    quads, tris, dropped = _drop_repeated_corners(quads, tris)
 
+    # Zero-area faces whose corners are distinct but collinear.
+    flat_q, flat_t = _flat(V, quads, tol), _flat(V, tris, tol)
+    if not (flat_q.any() or flat_t.any()):
+        return quads, tris, members, member_id, dropped
+    quads, tris, splits, removed = _remove_flat_faces(V, quads, tris, np.r_[flat_q, flat_t], tol)
+    members, member_id = _split_members(members, member_id, splits)
+    return quads, tris, members, member_id, dropped + removed
+
+
+def _drop_repeated_corners(quads: np.ndarray, tris: np.ndarray) -> tuple[np.ndarray, np.ndarray, int]:
+    """Quads with one repeated corner become triangles; slits and degenerate faces go.
+
+    Returns the (Q', 4) quads, (T', 3) triangles and the number of faces removed.
+    """
     # Quads losing a repeated corner become triangles; slits [A, B, A, D] and
     # faces with fewer than three corners vanish.
     nxt = quads == np.roll(quads, -1, axis=1)
@@ -316,12 +332,18 @@ def _repair(V: np.ndarray, faces: list[np.ndarray], members: np.ndarray, member_
     t_ok = (tris[:, 0] != tris[:, 1]) & (tris[:, 1] != tris[:, 2]) & (tris[:, 2] != tris[:, 0])
     dropped += int((~t_ok).sum())
     tris = tris[t_ok]
+    return quads, tris, dropped
 
-    # Zero-area faces whose corners are distinct but collinear.
-    flat_q, flat_t = _flat(V, quads, tol), _flat(V, tris, tol)
-    if not (flat_q.any() or flat_t.any()):
-        return quads, tris, members, member_id, dropped
 
+def _remove_flat_faces(V: np.ndarray, quads: np.ndarray, tris: np.ndarray, flat: np.ndarray,
+                       tol: Tolerances) -> tuple[np.ndarray, np.ndarray, dict, int]:
+    """Remove the zero-area faces ``flat`` (quads first, then triangles); split their neighbours.
+
+    A neighbour sharing an edge of a flat face gets the flat face's corners that lie on
+    that edge inserted (no T-junctions) and is fanned into triangles.  Returns the quads,
+    the triangles, the splits ``{(p, q): [inserted vertices]}`` and the faces removed.
+    """
+    dropped = 0
     # Rare path: a loop over the collapsed faces and the few neighbours they touch.
     polys: dict[int, list[int]] = {}          # faces edited (ids: quads first, then triangles)
     nq = len(quads)
@@ -346,7 +368,7 @@ def _repair(V: np.ndarray, faces: list[np.ndarray], members: np.ndarray, member_
                     out.append(f)
         return out
 
-    flat_ids = np.nonzero(np.r_[flat_q, flat_t])[0]
+    flat_ids = np.nonzero(flat)[0]
     # Flat faces back to back with the same corners (two triangles across a generator
     # that both neighbours cross at one point) simply vanish together: their other
     # neighbours then share the edges, and splitting by each other would stack faces.
@@ -397,7 +419,12 @@ def _repair(V: np.ndarray, faces: list[np.ndarray], members: np.ndarray, member_
     quads = pad[:nq][keep[:nq]]
     tris = np.concatenate([pad[nq:, :3][keep[nq:]],
                            np.asarray(new_tris, dtype=np.int64).reshape(-1, 3)])
-    # Members along a split edge become chains through the inserted vertices.
+    return quads, tris, splits, dropped
+
+
+def _split_members(members: np.ndarray, member_id: np.ndarray,
+                   splits: dict) -> tuple[np.ndarray, np.ndarray]:
+    """(E', 2) members and (E',) ids with every member along a split edge made a chain."""
     for _ in range(8):
         changed = False
         out_m, out_id = [], []
@@ -407,7 +434,7 @@ def _repair(V: np.ndarray, faces: list[np.ndarray], members: np.ndarray, member_
                 path = [p] + chain + [q]
                 if members[h, 0] == q:
                     path = path[::-1]
-                out_m += list(zip(path[:-1], path[1:]))
+                out_m += list(itertools.pairwise(path))
                 out_id += [member_id[h]] * (len(path) - 1)
                 members[h] = -1
                 changed = True
@@ -416,7 +443,55 @@ def _repair(V: np.ndarray, faces: list[np.ndarray], members: np.ndarray, member_
         ok = members[:, 0] >= 0
         members = np.concatenate([members[ok], np.asarray(out_m, np.int64).reshape(-1, 2)])
         member_id = np.concatenate([member_id[ok], np.asarray(out_id, np.int64)])
-    return quads, tris, members, member_id, dropped
+    return members, member_id
+
+
+def _grid_data(n_vertices: int, n: int, k: int, reversed_: np.ndarray) -> dict[str, np.ndarray]:
+    """Per-vertex ``t`` (along the generator as given), ``generator`` (-1 between) and ``u``."""
+    col = np.arange(n_vertices) // (k + 1)
+    v = (np.arange(n_vertices) % (k + 1)) / k
+    on_gen = col % n == 0
+    gen = np.where(on_gen, col // n, -1)
+    t = np.where(on_gen & reversed_[np.maximum(gen, 0)], 1.0 - v, v)
+    return {"t": t, "generator": gen, "u": col / n}
+
+
+def _warnings(dropped: int, bare_gens: list[int]) -> list[str]:
+    out = []
+    if dropped:
+        out.append(f"hybrid: removed {dropped} collapsed faces where generators meet "
+                   "(shared end points or crossings at division points)")
+    if bare_gens:
+        out.append(f"hybrid: generators {bare_gens}: a segment is not a mesh edge (a "
+                   "neighbouring generator ends inside it or folds onto it); it stays a member")
+    return out
+
+
+def _bare_generators(quads: np.ndarray, tris: np.ndarray, members: np.ndarray,
+                     member_id: np.ndarray, n_vertices: int) -> list[int]:
+    """Generators with a member segment that is no mesh edge.
+
+    Where the end of a neighbour lies inside a generator the strip has zero width along
+    part of it; that part bounds no face and cannot be a chain of mesh edges there.
+    """
+    e = np.concatenate([np.stack([quads, np.roll(quads, -1, axis=1)], axis=2).reshape(-1, 2),
+                        np.stack([tris, np.roll(tris, -1, axis=1)], axis=2).reshape(-1, 2)])
+    e.sort(axis=1)
+    mm = np.sort(members, axis=1)
+    is_edge = np.isin(mm[:, 0] * n_vertices + mm[:, 1], e[:, 0] * n_vertices + e[:, 1])
+    return sorted(set(member_id[~is_edge].tolist()))
+
+
+def _check_grid(m: int, n: int, k: int) -> None:
+    """Refuse a grid of ``(m - 1) n + 1`` columns by ``k + 1`` rows above :data:`MAX_GRID_NODES`."""
+    nodes = ((m - 1) * n + 1) * (k + 1)
+    if nodes > MAX_GRID_NODES:
+        need = gib(nodes * HYBRID_BYTES_PER_NODE)
+        raise ParameterError(f"expected at most {MAX_GRID_NODES:,} grid nodes, got "
+                             f"{nodes:,} ({m} generators x {n} columns x {k + 1} "
+                             f"rows), about {need} of memory (limit {gib(MAX_BUILD_BYTES)}); "
+                             "reduce the divisions, the midpoints or the generator count",
+                             "divisions")
 
 
 # --------------------------------------------------------------------------- public
@@ -494,79 +569,26 @@ def hybrid_mesh(a: Any, b: Any, *, midpoints: int = 1, divisions: int = 8, flip:
                             "distinct end points")
     m, n, k = len(a), midpoints + 1, divisions
     C = (m - 1) * n
-    if (C + 1) * (k + 1) > MAX_GRID_NODES:
-        need = gib((C + 1) * (k + 1) * HYBRID_BYTES_PER_NODE)
-        raise ParameterError(f"expected at most {MAX_GRID_NODES:,} grid nodes, got "
-                             f"{(C + 1) * (k + 1):,} ({m} generators x {n} columns x {k + 1} "
-                             f"rows), about {need} of memory (limit {gib(MAX_BUILD_BYTES)}); "
-                             "reduce the divisions, the midpoints or the generator count",
-                             "divisions")
+    _check_grid(m, n, k)
     reversed_ = orient_generators(a, b) if orient else np.zeros(m, bool)
     A = np.where(reversed_[:, None], b, a)
     B = np.where(reversed_[:, None], a, b)
-
-    K = k + 1
     X = hybrid_grid(A, B, n, k).reshape(-1, 3)
     quads, tris, vertex = checkerboard_faces(C, k, n, flip)
     members, member_id = _generator_members(vertex, n, k + 1)
     quads, tris, members, member_id, dropped = _repair(X, [quads, tris], members, member_id,
                                                        scale, tol)
 
-    col = np.arange(len(X)) // K
-    v = (np.arange(len(X)) % K) / k
-    on_gen = col % n == 0
-    gen = np.where(on_gen, col // n, -1)
-    t = np.where(on_gen & reversed_[np.maximum(gen, 0)], 1.0 - v, v)
-    faces = np.concatenate([quads.ravel(), tris.ravel()])
-    offsets = np.r_[np.arange(len(quads) + 1) * 4, 4 * len(quads) + np.arange(1, len(tris) + 1) * 3]
-    kinds = np.r_[np.full(len(quads), FaceKind.QUAD), np.full(len(tris), FaceKind.TRIANGLE)]
-    warnings: list[str] = []
-    if dropped:
-        warnings.append(f"hybrid: removed {dropped} collapsed faces where generators meet "
-                        "(shared end points or crossings at division points)")
-    # Where the end of a neighbour lies inside a generator the strip has zero width along
-    # part of it; that part bounds no face and cannot be a chain of mesh edges there.
-    e = np.concatenate([np.stack([quads, np.roll(quads, -1, axis=1)], axis=2).reshape(-1, 2),
-                        np.stack([tris, np.roll(tris, -1, axis=1)], axis=2).reshape(-1, 2)])
-    e.sort(axis=1)
-    mm = np.sort(members, axis=1)
-    size = len(X)
-    is_edge = np.isin(mm[:, 0] * size + mm[:, 1], e[:, 0] * size + e[:, 1])
-    bare_gens = sorted(set(member_id[~is_edge].tolist())) if not flip else []
-    if bare_gens:
-        warnings.append(f"hybrid: generators {bare_gens}: a segment is not a mesh edge (a "
-                        "neighbouring generator ends inside it or folds onto it); it stays a member")
+    bare_gens = [] if flip else _bare_generators(quads, tris, members, member_id, len(X))
+    warnings = _warnings(dropped, bare_gens)
     info = {"construction": "hybrid", "midpoints": midpoints, "divisions": divisions,
             "flip": flip, "reversed_generators": np.nonzero(reversed_)[0].tolist(),
             "collapsed_faces": dropped, "bare_generators": bare_gens, "warnings": warnings}
-    mesh = Mesh(X, offsets.astype(np.int64), faces.astype(np.int64), kinds.astype(np.uint8),
-                members.astype(np.int64), member_id.astype(np.int64),
-                {"t": t, "generator": gen, "u": col / n}, info)
+    faces = np.concatenate([quads.ravel(), tris.ravel()]).astype(np.int64)
+    offsets = np.r_[np.arange(len(quads) + 1) * 4,
+                    4 * len(quads) + np.arange(1, len(tris) + 1) * 3].astype(np.int64)
+    kinds = np.r_[np.full(len(quads), FaceKind.QUAD),
+                  np.full(len(tris), FaceKind.TRIANGLE)].astype(np.uint8)
+    mesh = Mesh(X, offsets, faces, kinds, members.astype(np.int64), member_id.astype(np.int64),
+                _grid_data(len(X), n, k, reversed_), info)
     return mesh.compact()
-
-
-# --------------------------------------------------------------------------- design files
-_MESH_KEYS = ("method", "midpoints", "divisions", "flip", "orient")
-
-
-@mesh_method("hybrid")
-def build_hybrid(rulings, table: Mapping[str, Any], ctx: BuildContext) -> Built:
-    """Design-file builder for ``[mesh] method = "hybrid"``."""
-    check_keys(table, _MESH_KEYS, "mesh", err=DesignError)
-    midpoints = check_int(table.get("midpoints", 1), "mesh.midpoints", lo=0, hi=10_000,
-                          err=DesignError)
-    divisions = check_int(table.get("divisions", 8), "mesh.divisions", lo=1, hi=1_000_000,
-                          err=DesignError)
-    flip = check_bool(table.get("flip", False), "mesh.flip", err=DesignError)
-    orient = check_bool(table.get("orient", True), "mesh.orient", err=DesignError)
-    mesh = hybrid_mesh(rulings.a, rulings.b, midpoints=midpoints, divisions=divisions, flip=flip,
-                       orient=orient)
-    reference = None
-    if getattr(rulings, "surface", None) is not None:
-        from .analysis.surface import RuledReference
-
-        reference = RuledReference(rulings.surface)
-    extras = {"hybrid": {"triangles": int(np.count_nonzero(mesh.face_kind == FaceKind.TRIANGLE)),
-                         "quads": int(np.count_nonzero(mesh.face_kind == FaceKind.QUAD)),
-                         "collapsed_faces": mesh.info["collapsed_faces"]}}
-    return Built(mesh.with_info(source=ctx.source), reference, rulings, extras)

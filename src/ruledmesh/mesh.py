@@ -11,9 +11,10 @@ become beams or cables, paper §6).
 
 from __future__ import annotations
 
+from collections.abc import Iterable, Mapping
 from dataclasses import dataclass, field, replace
 from enum import IntEnum
-from typing import Any, Iterable, Mapping
+from typing import Any
 
 import numpy as np
 
@@ -51,7 +52,7 @@ class FaceKind(IntEnum):
         return self.name.lower()
 
     @classmethod
-    def from_label(cls, label: str) -> "FaceKind":
+    def from_label(cls, label: str) -> FaceKind:
         """The kind named ``label`` (as written by :attr:`label`)."""
         try:
             return cls[label.upper()]
@@ -61,7 +62,7 @@ class FaceKind(IntEnum):
             ) from None
 
 
-def _offsets_from_valences(valences: np.ndarray) -> np.ndarray:
+def offsets_from_valences(valences: np.ndarray) -> np.ndarray:
     offsets = np.zeros(len(valences) + 1, dtype=np.int64)
     np.cumsum(valences, out=offsets[1:])
     return offsets
@@ -111,7 +112,7 @@ class Mesh:
     # ------------------------------------------------------------------ build
     @classmethod
     def from_arrays(cls, vertices, face_offsets, face_indices, face_kind=None, *,
-                    members=None, member_id=None, vertex_data=None, info=None) -> "Mesh":
+                    members=None, member_id=None, vertex_data=None, info=None) -> Mesh:
         """Build a mesh from compressed-row face arrays, validating them.
 
         Parameters
@@ -163,7 +164,7 @@ class Mesh:
         return cls(v, off, idx, kind, mem, mid, vdata, dict(info or {}))
 
     @classmethod
-    def from_faces(cls, vertices, faces, face_kind=None, **kwargs) -> "Mesh":
+    def from_faces(cls, vertices, faces, face_kind=None, **kwargs) -> Mesh:
         """Build a mesh from a ``(F, k)`` array or a list of index sequences.
 
         Parameters
@@ -182,13 +183,13 @@ class Mesh:
         else:
             faces = list(faces)
             val = np.fromiter((len(f) for f in faces), dtype=np.int64, count=len(faces))
-            off = _offsets_from_valences(val)
+            off = offsets_from_valences(val)
             idx = (np.concatenate([np.asarray(f, np.int64) for f in faces])
                    if faces else np.zeros(0, np.int64))
         return cls.from_arrays(vertices, off, idx, face_kind, **kwargs)
 
     @classmethod
-    def concatenate(cls, meshes: Iterable["Mesh"], info: Mapping[str, Any] | None = None) -> "Mesh":
+    def concatenate(cls, meshes: Iterable[Mesh], info: Mapping[str, Any] | None = None) -> Mesh:
         """Join meshes into one (vertices are not merged; see :meth:`merge_vertices`)."""
         meshes = list(meshes)
         if not meshes:
@@ -308,16 +309,16 @@ class Mesh:
         return int(used - (len(self.edges()) if n_edges is None else n_edges) + self.n_faces)
 
     # -------------------------------------------------------------- modify
-    def with_vertices(self, vertices: np.ndarray, **info: Any) -> "Mesh":
+    def with_vertices(self, vertices: np.ndarray, **info: Any) -> Mesh:
         """The same connectivity with new vertex positions (and updated info)."""
         new_info = {**self.info, **info}
         return replace(self, vertices=np.ascontiguousarray(vertices, dtype=np.float64), info=new_info)
 
-    def with_info(self, **info: Any) -> "Mesh":
+    def with_info(self, **info: Any) -> Mesh:
         """The same mesh with ``info`` updated."""
         return replace(self, info={**self.info, **info})
 
-    def with_units(self, units: str, *, convert: bool = True) -> "Mesh":
+    def with_units(self, units: str, *, convert: bool = True) -> Mesh:
         """The mesh in ``units``: coordinates scaled from :attr:`units` (or only relabelled).
 
         Parameters
@@ -335,15 +336,15 @@ class Mesh:
             return self.with_info(units=target)
         return self.with_vertices(self.vertices * factor, units=target)
 
-    def select_faces(self, mask: np.ndarray) -> "Mesh":
+    def select_faces(self, mask: np.ndarray) -> Mesh:
         """The mesh made of the faces where ``mask`` is true (vertices kept)."""
         mask = np.asarray(mask, dtype=bool)
         val = self.valences[mask]
         keep = np.repeat(mask, self.valences)
-        return replace(self, face_offsets=_offsets_from_valences(val),
+        return replace(self, face_offsets=offsets_from_valences(val),
                        face_indices=self.face_indices[keep], face_kind=self.face_kind[mask])
 
-    def compact(self) -> "Mesh":
+    def compact(self) -> Mesh:
         """Drop vertices used by no face and no member, renumbering the rest."""
         used = np.zeros(self.n_vertices, dtype=bool)
         used[self.face_indices] = True
@@ -355,7 +356,7 @@ class Mesh:
         return replace(self, vertices=self.vertices[used], face_indices=new[self.face_indices],
                        members=new[self.members], vertex_data=vdata)
 
-    def merge_vertices(self, tol: float = 1e-12) -> "Mesh":
+    def merge_vertices(self, tol: float = 1e-12) -> Mesh:
         """Merge vertices closer than ``tol`` times the diagonal (exact grid snap).
 
         Vertices are snapped to a grid of spacing ``tol * diagonal`` and merged
@@ -378,7 +379,7 @@ class Mesh:
         return replace(self, vertices=self.vertices[keep], face_indices=remap[self.face_indices],
                        members=remap[self.members], vertex_data=vdata)
 
-    def drop_repeated_corners(self) -> "Mesh":
+    def drop_repeated_corners(self) -> Mesh:
         """Remove corners equal to the next corner of their face; drop faces left with < 3.
 
         After :meth:`merge_vertices` a face whose corners collapsed loses them
@@ -396,7 +397,7 @@ class Mesh:
         ok_face = val >= 3
         keep &= ok_face[face_of]
         mem_ok = self.members[:, 0] != self.members[:, 1]
-        return replace(self, face_offsets=_offsets_from_valences(val[ok_face]),
+        return replace(self, face_offsets=offsets_from_valences(val[ok_face]),
                        face_indices=idx[keep], face_kind=self.face_kind[ok_face],
                        members=self.members[mem_ok], member_id=self.member_id[mem_ok])
 

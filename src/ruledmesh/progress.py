@@ -41,7 +41,7 @@ class Task:
     def close(self) -> None:
         """The work is over (called by ``with`` on exit)."""
 
-    def __enter__(self) -> "Task":
+    def __enter__(self) -> Task:
         return self
 
     def __exit__(self, *exc: object) -> None:
@@ -84,7 +84,7 @@ def stages(progress: Progress | None, label: str, names: list[str]):
 
 
 class _BarTask(Task):
-    def __init__(self, owner: "TerminalProgress", bar: Any, label: str):
+    def __init__(self, owner: TerminalProgress, bar: Any, label: str):
         self._owner, self._bar, self._label = owner, bar, label
 
     def advance(self, n: int = 1, note: str | None = None) -> None:

@@ -10,9 +10,10 @@ decorator, so adding a construction touches only its own module and the
 from __future__ import annotations
 
 import importlib
+from collections.abc import Callable, Mapping
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any, Callable, Mapping, Protocol
+from typing import Any, Protocol
 
 import numpy as np
 
@@ -93,11 +94,10 @@ TRANSFORMS: dict[str, Callable[[Built, Mapping, str], Built]] = {}
 
 # Modules that register builders when imported; a module not yet written is skipped.
 PLUGINS = [
-    "ruledmesh.pq",
-    "ruledmesh.hybrid",
-    "ruledmesh.compound",
-    "ruledmesh.constructions",
-    "ruledmesh.transforms",
+    "ruledmesh.design.pq",
+    "ruledmesh.design.meshers",
+    "ruledmesh.design.catalogue",
+    "ruledmesh.design.transforms",
 ]
 
 _loaded = False

@@ -14,6 +14,7 @@ import io
 import os
 from enum import Enum
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 
@@ -333,7 +334,7 @@ def render(mesh: Mesh, *, color: ColorBy | str = ColorBy.PLANARITY, reference=No
     # The 3-D axes reserve wide empty margins; most of the canvas goes to the mesh.
     # A title gets its own band at the top, inside the canvas.
     top = 1.1 if not title else 1.0
-    ax = fig.add_axes((-0.02, -0.05, 0.88, top), projection="3d", computed_zorder=False)
+    ax: Any = fig.add_axes((-0.02, -0.05, 0.88, top), projection="3d", computed_zorder=False)  # an untyped Axes3D
     # Without outlines, antialiased neighbours leave light seams between sub-pixel faces.
     polys = Poly3DCollection(_face_polygons(mesh), cmap=cmap, norm=norm,
                              edgecolors="#20202080" if draw_edges else "none",

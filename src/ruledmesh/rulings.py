@@ -13,8 +13,9 @@ Constructors, one per way the paper gives a ruled surface:
   directrix ``d`` (the planes through ``d`` cut both curves);
 * :func:`three_directrices`: the lines meeting three curves (§5, general case);
 * :func:`conoid`: one curve, a line directrix and a director plane (§5.1);
-* :func:`from_lines` / :func:`from_csv`: explicit generators;
-* :func:`rulings_from_spec`: the ``[rulings]`` table of a design file.
+* :func:`from_lines`: explicit generators (a CSV file of them is read by
+  :func:`ruledmesh.design.rulings.from_csv`, the ``[rulings]`` table of a design
+  file by :func:`ruledmesh.design.rulings.rulings_from_spec`).
 
 The smooth reference surface.  For curve-based rulings ``A(u) = c1(sigma1(u))``
 lies exactly on c1 (likewise B on c2); only the correspondence ``sigma`` is
@@ -35,8 +36,6 @@ given lines is then followed rather than smoothed over.
 from __future__ import annotations
 
 import math
-import os
-from collections.abc import Mapping
 from dataclasses import dataclass, field
 from enum import Enum
 from typing import Any
@@ -46,7 +45,6 @@ import numpy as np
 from ._validation import (
     check_choice,
     check_int,
-    check_keys,
     check_points,
     check_vector,
     describe,
@@ -54,8 +52,8 @@ from ._validation import (
 
 # scipy is imported where it is used (lines through points, PCHIP at tangencies, root
 # brackets), so building from director curves starts without it.
-from .curves import BSpline, CubicHermite, Curve, _Level, _perpendicular
-from .errors import DesignError, GeometryError, ParameterError
+from .curves import BSpline, CubicHermite, Curve, LevelSet, perpendicular
+from .errors import GeometryError, ParameterError
 from .tolerances import DEFAULT, Tolerances
 
 __all__ = [
@@ -66,8 +64,8 @@ __all__ = [
     "three_directrices",
     "conoid",
     "from_lines",
-    "from_csv",
-    "rulings_from_spec",
+    "check_line",
+    "MAX_GENERATORS",
 ]
 
 # dense samples of a numerically found correspondence (PCHIP nodes)
@@ -119,7 +117,7 @@ def _arc_sigma(curve: Curve, count: int) -> Any:
     exact = _ArcLength(curve)
     if not isinstance(curve, BSpline):
         return exact
-    grid, _ = _dense_grid(count)
+    grid, _ = dense_grid(count)
     values = exact.value(grid)
     speed = curve._speed(values)
     if np.all(speed > 1e-12 * curve.length()):
@@ -136,7 +134,7 @@ class _Pchip:
     interp: Any
 
     @classmethod
-    def of(cls, u: np.ndarray, sigma: np.ndarray, dsigma: np.ndarray | None = None) -> "_Pchip":
+    def of(cls, u: np.ndarray, sigma: np.ndarray, dsigma: np.ndarray | None = None) -> _Pchip:
         """PCHIP of the samples, or, given exact slopes ``dsigma`` (implicit
         differentiation of the correspondence), the cubic Hermite interpolant:
         fourth order, so the surface hardly depends on the sampling."""
@@ -326,7 +324,7 @@ def _check_generators(a: np.ndarray, b: np.ndarray, what: str, tol: Tolerances) 
             f"{np.array2string(a[i], precision=6, separator=', ')}")
 
 
-def _dense_grid(count: int) -> tuple[np.ndarray, int]:
+def dense_grid(count: int) -> tuple[np.ndarray, int]:
     """A dense u grid holding the ``count`` generator parameters at every k-th node."""
     k = max(1, math.ceil(_DENSE / (count - 1)))
     return np.linspace(0.0, 1.0, k * (count - 1) + 1), k
@@ -403,7 +401,7 @@ def between(c1: Curve, c2: Curve, count: int, distribution: Distribution | str =
         raise ParameterError('only used with distribution "director-plane"', "director_plane")
     if directrix is not None and dist is not Distribution.LINEAR_DIRECTRIX:
         raise ParameterError('only used with distribution "linear-directrix"', "directrix")
-    info = {"distribution": dist.value, "warnings": []}
+    info: dict[str, Any] = {"distribution": dist.value, "warnings": []}
     if dist is Distribution.PARAMETER:
         return _curve_rulings(c1, _Identity(), c2, _Identity(), count, info, tol)
     if dist is Distribution.ARC_LENGTH:
@@ -415,11 +413,12 @@ def between(c1: Curve, c2: Curve, count: int, distribution: Distribution | str =
                                                            nonzero=True), info, tol)
     if directrix is None:
         raise ParameterError('required with distribution "linear-directrix"', "directrix")
-    d = _check_line(directrix, "directrix")
+    d = check_line(directrix, "directrix")
     return _linear_directrix(c1, c2, count, d, info, tol)
 
 
-def _check_line(value: Any, name: str, err: type = ParameterError) -> np.ndarray:
+def check_line(value: Any, name: str, err: type = ParameterError) -> np.ndarray:
+    """(2, 3) float64: two distinct points of a line, checked, errors naming ``name``."""
     d = check_points(value, name, err=err)
     if len(d) != 2:
         raise err(f"expected 2 points of the line, got {len(d)}", name)
@@ -457,14 +456,14 @@ def _director_plane(c1: Curve, c2: Curve, count: int, normal: np.ndarray, info: 
             f"[{lo1:g}, {hi1:g}] on c1 and [{lo2:g}, {hi2:g}] on c2")
     # sweep in the direction that runs along c1 from its start
     forward = levels[0].values[-1] >= levels[0].values[0]
-    grid, k = _dense_grid(count)
+    grid, k = dense_grid(count)
     s = lo + grid * (hi - lo) if forward else hi - grid * (hi - lo)
     sig = []
-    for name, c, lev in zip(("c1", "c2"), (c1, c2), levels):
+    for name, lev in zip(("c1", "c2"), levels):
         roots = lev.roots(float(s[0]))
         if len(roots) == 0:  # only by rounding at a range end
             raise GeometryError(f"director-plane: the first plane n . x = {s[0]:g} misses {name}")
-        u, ok, end = lev.follow(s, float(roots[0]))
+        u, _ok, end = lev.follow(s, float(roots[0]))
         if end is not None:
             raise _ended("director-plane", name, end, k, count,
                          ": the planes n . x = s meet it more than once (or not at all) over "
@@ -491,7 +490,7 @@ class _PencilAngle:
     def __init__(self, d: np.ndarray):
         self.d0 = d[0]
         self.e = (d[1] - d[0]) / np.linalg.norm(d[1] - d[0])
-        self.p = _perpendicular(self.e)
+        self.p = perpendicular(self.e)
         self.q = np.cross(self.e, self.p)
 
     def xy(self, pts: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -506,7 +505,7 @@ class _PencilAngle:
         x, y = self.xy(pts)
         return np.hypot(x, y)
 
-    def level(self, curve: Curve, name: str, tol: Tolerances) -> _Level:
+    def level(self, curve: Curve, name: str, tol: Tolerances) -> LevelSet:
         grid = np.unique(np.concatenate([curve._level_grid(), curve._breaks()]))
         # the closest approach to d, polished between the neighbours of the
         # nearest sample (there the pencil angle jumps by pi)
@@ -520,10 +519,10 @@ class _PencilAngle:
 
         xm = grid[i]
         if approach(lo) < 0 < approach(hi):
-            from ._roots import brentq
+            from .roots import brentq
 
             xm = brentq(approach, lo, hi, xtol=1e-16, rtol=8.9e-16)
-        rmin = float(self.radius(curve._eval(np.float64(xm))))
+        rmin = float(self.radius(curve._eval(np.asarray(xm, dtype=np.float64))))
         if rmin <= tol.degenerate * curve._size:
             raise GeometryError(
                 f"linear-directrix: {name} meets the directrix d at u = {xm:.6g}: "
@@ -549,13 +548,13 @@ class _PencilAngle:
             dx, dy = self.xy(curve._deriv(u, 1) + self.d0)
             return (x * dy - y * dx) / (x * x + y * y)
 
-        return _Level(g, dg, grid, tol.degenerate)
+        return LevelSet(g, dg, grid, tol.degenerate)
 
 
 def _linear_directrix(c1: Curve, c2: Curve, count: int, d: np.ndarray, info: dict,
                       tol: Tolerances) -> Rulings:
     pencil = _PencilAngle(d)
-    grid, k = _dense_grid(count)
+    grid, k = dense_grid(count)
     arc1 = _arc_sigma(c1, count)
     sig1 = arc1.value(grid)
     pts1 = c1._eval(sig1)
@@ -589,7 +588,7 @@ def _linear_directrix(c1: Curve, c2: Curve, count: int, d: np.ndarray, info: dic
             "linear-directrix: the plane through the directrix d and a_0 (generator 0) does not "
             "meet c2")
     v0, j0 = min(starts)
-    sig2, ok, end = lev2.follow(theta1 + j0 * np.pi, v0)
+    sig2, _ok, end = lev2.follow(theta1 + j0 * np.pi, v0)
     if end is not None:
         raise _ended("linear-directrix", "c2", end, k, count,
                      ": the planes through d and the points of c1 stop meeting c2 along one "
@@ -692,7 +691,7 @@ def three_directrices(c1: Curve, c2: Curve, c3: Curve, count: int, *,
     c3 = _check_curve(c3, "c3")
     count = check_int(count, "count", lo=2)
     size = max(c1._size, c2._size, c3._size)
-    grid, k = _dense_grid(count)
+    grid, k = dense_grid(count)
     arc1 = _arc_sigma(c1, count)
     sig1 = arc1.value(grid)
     pts1 = c1._eval(sig1)
@@ -706,7 +705,7 @@ def three_directrices(c1: Curve, c2: Curve, c3: Curve, count: int, *,
         x = candidates[0]
     sol = np.empty((len(grid), 3))
     sol[0] = x
-    a_param = lambda g: float(arc1.value(np.array(g)))  # noqa: E731
+    a_param = lambda g: float(arc1.value(np.array(g)))
     for i in range(1, len(grid)):
         # continue from grid[i-1] to grid[i] with step halving; a secant predictor
         g0, g1 = grid[i - 1], grid[i]
@@ -788,7 +787,7 @@ def conoid(curve: Curve, directrix: Any, director_plane: Any, count: int, *,
         d is parallel to the director plane, or the curve meets d.
     """
     curve = _check_curve(curve, "curve")
-    d = _check_line(directrix, "directrix")
+    d = check_line(directrix, "directrix")
     n = check_vector(director_plane, "director_plane", nonzero=True)
     count = check_int(count, "count", lo=2)
     n = n / np.linalg.norm(n)
@@ -864,71 +863,9 @@ def from_lines(lines: Any, *, tol: Tolerances = DEFAULT) -> Rulings:
     return Rulings(a, b, u, surface, {"distribution": "lines", "warnings": []})
 
 
-def _is_number(text: str) -> bool:
-    try:
-        float(text)
-    except ValueError:
-        return False
-    return True
-
-
-def from_csv(path: str | os.PathLike, *, tol: Tolerances = DEFAULT) -> Rulings:
-    """Rulings from a CSV file with rows ``x0,y0,z0,x1,y1,z1``.
-
-    A first line that is not numeric is a header; blank lines and lines
-    starting with ``#`` are skipped.
-
-    Raises
-    ------
-    DesignError
-        The file cannot be read or a row is malformed; the message names the
-        file and the line number, e.g. ``lines.csv: line 4: expected 6 numbers, got 5``.
-    """
-    from ._files import MAX_CSV_BYTES, read_capped
-
-    name = os.fspath(path)
-    try:
-        text = read_capped(name, MAX_CSV_BYTES, "a CSV table of lines").decode("utf-8")
-    except (OSError, UnicodeDecodeError) as exc:
-        raise DesignError(f"cannot read the file: {exc.strerror or exc}", None, name) from None
-    rows = []
-    first = True
-    for number, line in enumerate(text.splitlines(), start=1):
-        stripped = line.strip()
-        if not stripped or stripped.startswith("#"):
-            continue
-        cells = [c.strip() for c in stripped.split(",")]
-        try:
-            values = [float(c) for c in cells]
-        except ValueError:
-            if first:
-                first = False
-                continue  # header
-            # The cell's position, not its text: the message must not echo a file's content.
-            bad = next(k for k, c in enumerate(cells, start=1) if not _is_number(c))
-            raise DesignError(f"expected 6 numbers separated by commas; cell {bad} is not a "
-                              "number", f"line {number}", name) from None
-        first = False
-        if len(values) != 6:
-            raise DesignError(f"expected 6 numbers (x0,y0,z0,x1,y1,z1), got {len(values)}",
-                              f"line {number}", name)
-        if not all(math.isfinite(v) for v in values):
-            raise DesignError("expected finite numbers, got NaN or infinity", f"line {number}",
-                              name)
-        rows.append(values)
-    if len(rows) < 2:
-        raise DesignError(f"expected at least 2 lines (rows), got {len(rows)}", None, name)
-    try:
-        return from_lines(np.asarray(rows).reshape(-1, 2, 3), tol=tol)
-    except GeometryError as exc:
-        raise GeometryError(f"{name}: {exc}") from None
-
-
 # --------------------------------------------------------------------------
-# design files
+# limits
 # --------------------------------------------------------------------------
-
-_SOURCES = ("between", "lines", "file", "conoid")
 
 # Most generators a design may ask for.  Measured peak memory of ``ruledmesh
 # build`` (mesh, analysis against the smooth surface, export) is about 1 KiB per
@@ -937,160 +874,3 @@ _SOURCES = ("between", "lines", "file", "conoid")
 # out-of-memory kill halfway through.
 MAX_GENERATORS = 100_000
 BUILD_BYTES_PER_GRID_POINT = 1024
-
-
-def _too_many(n: int, what: str, where: str, err: type = DesignError) -> None:
-    """Refuse ``n`` generators above :data:`MAX_GENERATORS`, saying what they would need."""
-    if n > MAX_GENERATORS:
-        need = n * 21 * BUILD_BYTES_PER_GRID_POINT / 2**30
-        raise err(f"expected at most {MAX_GENERATORS} {what}, got {n}: meshing them would need "
-                  f"about {need:.1f} GiB of memory at the default 20 rows "
-                  f"(~{BUILD_BYTES_PER_GRID_POINT} bytes per generator and row)", where)
-_RULINGS_KEYS = ("between", "distribution", "director_plane", "directrix", "count", "lines",
-                 "file", "conoid")
-
-
-def rulings_from_spec(spec: Mapping, curves: Mapping[str, Curve], *, path: str = "rulings",
-                      base_dir: str | os.PathLike = ".") -> Rulings:
-    """Build rulings from the ``[rulings]`` table of a design file.
-
-    Parameters
-    ----------
-    spec : Mapping
-        Exactly one of ``between`` (two or three curve names), ``lines``
-        (list of ``[[x, y, z], [x, y, z]]``), ``file`` (CSV, relative to
-        ``base_dir``) or ``conoid`` (table ``curve``, ``directrix``,
-        ``director_plane``); with ``between`` of two curves ``distribution``
-        (default ``"arc-length"``) and its ``director_plane`` or
-        ``directrix``; ``count`` (>= 3) with ``between`` and ``conoid``.
-    curves : Mapping[str, Curve]
-        The design's ``[curves.*]``, by name.
-    path : str
-        Dotted path of the table for error messages.
-    base_dir : path
-        Directory that ``file`` is relative to.
-
-    Raises
-    ------
-    DesignError
-        With the dotted field path, e.g. ``rulings.count: expected an integer
-        >= 3, got "forty"`` or ``rulings.between: no curve named "c3"
-        (defined: c1, c2)``.
-    GeometryError
-        The table is well formed but the generators cannot be built.
-    """
-    E = DesignError
-    if not isinstance(spec, Mapping):
-        raise E(f"expected a table, got {describe(spec)}", path)
-    check_keys(spec, _RULINGS_KEYS, path, err=E)
-    given = [k for k in _SOURCES if k in spec]
-    if not given:
-        raise E("expected one of between, lines, file or conoid", path)
-    if len(given) > 1:
-        raise E(f"give only one of between, lines, file or conoid; also got {given[0]}",
-                f"{path}.{given[1]}")
-    source = given[0]
-
-    def refuse(*keys: str, why: str) -> None:
-        for key in keys:
-            if key in spec:
-                raise E(f"not used {why}", f"{path}.{key}")
-
-    def curve(name: Any, where: str) -> Curve:
-        if not isinstance(name, str):
-            raise E(f"expected the name of a [curves.*] table, got {describe(name)}", where)
-        if name not in curves:
-            defined = ", ".join(curves) if curves else "none"
-            raise E(f'no curve named "{name}" (defined: {defined})', where)
-        return curves[name]
-
-    def count() -> int:
-        if "count" not in spec:
-            raise E("missing; expected an integer >= 3 (the number of generators)",
-                    f"{path}.count")
-        n = check_int(spec["count"], f"{path}.count", lo=3, err=E)
-        _too_many(n, "generators", f"{path}.count", E)
-        return n
-
-    try:
-        if source in ("lines", "file"):
-            refuse("count", "distribution", "director_plane", "directrix",
-                   why=f"with {source} (the generators are given)")
-            if source == "lines":
-                raw = spec["lines"]
-                try:
-                    arr = np.asarray(raw, dtype=np.float64)
-                except (TypeError, ValueError):
-                    arr = None
-                if arr is None or arr.ndim != 3 or arr.shape[1:] != (2, 3) or len(arr) < 2:
-                    raise E("expected at least 2 lines [[x, y, z], [x, y, z]], got "
-                            f"{describe(raw)}", f"{path}.lines")
-                if not np.all(np.isfinite(arr)):
-                    raise E("expected finite coordinates, got NaN or infinity", f"{path}.lines")
-                _too_many(len(arr), "lines", f"{path}.lines", E)
-                return from_lines(arr)
-            fname = spec["file"]
-            if not isinstance(fname, str) or not fname:
-                raise E(f"expected a file name, got {describe(fname)}", f"{path}.file")
-            full = os.path.join(os.fspath(base_dir), fname)
-            from ._files import not_a_regular_file
-
-            if not os.path.exists(full):
-                raise E(f'no such file "{fname}" (looked in {os.fspath(base_dir)})',
-                        f"{path}.file")
-            kind = not_a_regular_file(full)
-            if kind is not None:
-                raise E(f'"{fname}" is {kind}, not a CSV table of lines; give a regular file',
-                        f"{path}.file")
-            rulings = from_csv(full)
-            _too_many(len(rulings), "lines (rows)", f"{path}.file", E)
-            return rulings
-
-        if source == "conoid":
-            refuse("distribution", "director_plane", "directrix",
-                   why="with conoid (give directrix and director_plane inside the conoid table)")
-            table = spec["conoid"]
-            cpath = f"{path}.conoid"
-            if not isinstance(table, Mapping):
-                raise E(f"expected a table {{ curve, directrix, director_plane }}, got "
-                        f"{describe(table)}", cpath)
-            check_keys(table, ("curve", "directrix", "director_plane"), cpath, err=E)
-            for key in ("curve", "directrix", "director_plane"):
-                if key not in table:
-                    raise E("missing", f"{cpath}.{key}")
-            c = curve(table["curve"], f"{cpath}.curve")
-            d = _check_line(table["directrix"], f"{cpath}.directrix", err=E)
-            n = check_vector(table["director_plane"], f"{cpath}.director_plane", nonzero=True,
-                             err=E)
-            return conoid(c, d, n, count())
-
-        names = spec["between"]
-        bpath = f"{path}.between"
-        if isinstance(names, str) or not isinstance(names, (list, tuple)) or len(names) not in (2, 3):
-            raise E(f"expected two or three curve names, got {describe(names)}", bpath)
-        cs = [curve(nm, bpath) for nm in names]
-        if len(cs) == 3:
-            refuse("distribution", "director_plane", "directrix",
-                   why="with three directrices (the lines meeting all three are the generators)")
-            return three_directrices(cs[0], cs[1], cs[2], count())
-        dist = check_choice(spec.get("distribution", "arc-length"), Distribution,
-                            f"{path}.distribution", err=E)
-        plane = directrix = None
-        if dist is Distribution.DIRECTOR_PLANE:
-            refuse("directrix", why='with distribution "director-plane"')
-            if "director_plane" not in spec:
-                raise E('missing; expected the normal [x, y, z] of the director plane for '
-                        'distribution "director-plane"', f"{path}.director_plane")
-            plane = check_vector(spec["director_plane"], f"{path}.director_plane", nonzero=True,
-                                 err=E)
-        elif dist is Distribution.LINEAR_DIRECTRIX:
-            refuse("director_plane", why='with distribution "linear-directrix"')
-            if "directrix" not in spec:
-                raise E('missing; expected two points [[x, y, z], [x, y, z]] of the line d for '
-                        'distribution "linear-directrix"', f"{path}.directrix")
-            directrix = _check_line(spec["directrix"], f"{path}.directrix", err=E)
-        else:
-            refuse("director_plane", "directrix", why=f'with distribution "{dist.value}"')
-        return between(cs[0], cs[1], count(), dist, director_plane=plane, directrix=directrix)
-    except ParameterError as exc:  # pragma: no cover - inputs are checked above
-        raise E(exc.detail, f"{path}.{exc.field}" if exc.field else path) from None

@@ -17,7 +17,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
-__all__ = ["Tolerances", "DEFAULT"]
+__all__ = ["Tolerances", "DEFAULT", "TINY"]
 
 
 @dataclass(frozen=True)
@@ -57,3 +57,7 @@ class Tolerances:
 
 
 DEFAULT = Tolerances()
+
+#: The positive floor a division by a length, area or norm is guarded with (``x / max(n, TINY)``).
+#: Not a tolerance: far below any rounding level, it only keeps 0 / 0 out of the arrays.
+TINY = 1e-300

@@ -26,17 +26,18 @@ dropped after a non-similar map, and the report says so.
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from dataclasses import dataclass, replace
-from typing import Any, Callable, Mapping
+from typing import Any
 
 import numpy as np
 
 from ._validation import check_float, check_vector, describe
 from .analysis.circularity import circularity
-from .constructions.reference import ImplicitSurface
-from .errors import DesignError, GeometryError, ParameterError
+from .errors import GeometryError, ParameterError
 from .mesh import Mesh
-from .registry import Built, transform_type
+from .registry import Built
+from .surfaces import ImplicitSurface
 from .tolerances import DEFAULT, Tolerances
 
 __all__ = [
@@ -97,7 +98,7 @@ def affine_matrix(matrix, offset=None, *, name: str = "matrix") -> tuple[np.ndar
         raise ParameterError("expected last row 0 0 0 1 for an affine map (use a projective "
                              "map for anything else)", name)
     A = m[:3, :3].copy()
-    t = m[:3, 3].copy() if m.shape[1] == 4 else np.zeros(3)
+    t = np.zeros(3) if m.shape == (3, 3) else m[:3, 3].copy()
     if offset is not None:
         t = t + check_vector(offset, "offset")
     return A, t
@@ -146,12 +147,13 @@ def _moved_reference(ref, inverse: Callable, pullback: Callable, similarity: flo
         return None, None
     if isinstance(ref, ImplicitSurface):
         value = gradient = None
-        if ref.value is not None:
-            value = lambda q: ref.value(inverse(q))  # noqa: E731
-            gradient = lambda q: pullback(q, ref.gradient(inverse(q)))  # noqa: E731
+        f_value, f_gradient, f_exact = ref.value, ref.gradient, ref.exact
+        if f_value is not None and f_gradient is not None:
+            value = lambda q: f_value(inverse(q))
+            gradient = lambda q: pullback(q, f_gradient(inverse(q)))
         if similarity is not None:
-            exact = (None if ref.exact is None
-                     else (lambda q: similarity * ref.exact(inverse(q))))
+            exact = (None if f_exact is None
+                     else (lambda q: similarity * f_exact(inverse(q))))
             if exact is None and value is None:
                 return None, "reference dropped (no distance after the transform)"
             area = None if ref.patch_area is None else ref.patch_area * similarity ** 2
@@ -334,14 +336,15 @@ def transform_built(built: Built, kind: str, **params) -> Built:
     """
     mesh = built.mesh
     if kind in ("affine", "translate", "rotate", "scale", "shear"):
-        fn = {"affine": affine, "translate": translate, "rotate": rotate, "scale": scale,
-              "shear": shear}[kind]
+        maps: dict[str, Callable[..., Mesh]] = {"affine": affine, "translate": translate, "rotate": rotate,
+                                                "scale": scale, "shear": shear}
+        fn = maps[kind]
         new = fn(mesh, **params)
         # Recover (A, t) from the vertex map itself: one code path for all five.
         A, t = _fit_affine(mesh.vertices, new.vertices, fn, params)
         Ainv = np.linalg.inv(A)
-        inverse = lambda q: (q - t) @ Ainv.T  # noqa: E731
-        pullback = lambda q, g: g @ Ainv  # noqa: E731
+        inverse = lambda q: (q - t) @ Ainv.T
+        pullback = lambda q, g: g @ Ainv
         similarity = _similarity_scale(A)
     elif kind == "projective":
         new = projective(mesh, **params)
@@ -432,84 +435,3 @@ def _fit_affine(before: np.ndarray, after: np.ndarray, fn, params) -> tuple[np.n
     else:
         A, t = shear_matrix(**params), np.zeros(3)
     return A, t
-
-
-# ------------------------------------------------------------- design files
-def _fields(table: Mapping, path: str, allowed):
-    from .constructions._spec import Fields
-
-    return Fields(table, path, allowed, selector="type")
-
-
-def _matrix(table: Mapping, key: str, path: str, shapes):
-    value = table.get(key)
-    if value is None:
-        raise DesignError("missing value", f"{path}.{key}")
-    try:
-        m = np.asarray(value, dtype=np.float64)
-    except (TypeError, ValueError):
-        m = None
-    if m is None or m.shape not in shapes or not np.all(np.isfinite(m)):
-        listed = " or ".join(f"{r}x{c}" for r, c in shapes)
-        raise DesignError(f"expected a {listed} matrix (a list of rows), got {describe(value)}",
-                          f"{path}.{key}")
-    return m
-
-
-def _run(built: Built, path: str, kind: str, **params) -> Built:
-    try:
-        return transform_built(built, kind, **params)
-    except (ParameterError, GeometryError) as exc:
-        field = getattr(exc, "field", None)
-        detail = getattr(exc, "detail", str(exc))
-        raise DesignError(detail, f"{path}.{field}" if field else path) from None
-
-
-@transform_type("affine")
-def _design_affine(built: Built, table: Mapping, path: str) -> Built:
-    f = _fields(table, path, ["matrix", "offset"])
-    m = _matrix(table, "matrix", path, [(3, 3), (3, 4), (4, 4)])
-    return _run(built, path, "affine", matrix=m, offset=f.vector("offset", None))
-
-
-@transform_type("translate")
-def _design_translate(built: Built, table: Mapping, path: str) -> Built:
-    f = _fields(table, path, ["vector"])
-    return _run(built, path, "translate", vector=f.vector("vector", f.REQUIRED))
-
-
-@transform_type("rotate")
-def _design_rotate(built: Built, table: Mapping, path: str) -> Built:
-    f = _fields(table, path, ["axis", "angle", "center"])
-    return _run(built, path, "rotate", axis=f.vector("axis", [0.0, 0.0, 1.0], nonzero=True),
-                angle=f.float("angle", f.REQUIRED), center=f.vector("center", [0.0, 0.0, 0.0]))
-
-
-@transform_type("scale")
-def _design_scale(built: Built, table: Mapping, path: str) -> Built:
-    f = _fields(table, path, ["factor", "center"])
-    raw = f.raw("factor", f.REQUIRED)
-    factors = (f.floats("factor", count=3) if isinstance(raw, list) else f.float("factor"))
-    if np.any(np.asarray(factors) == 0):
-        raise DesignError("expected non-zero factors", f"{path}.factor")
-    return _run(built, path, "scale", factors=factors, center=f.vector("center", [0.0, 0.0, 0.0]))
-
-
-@transform_type("shear")
-def _design_shear(built: Built, table: Mapping, path: str) -> Built:
-    keys = ["xy", "xz", "yx", "yz", "zx", "zy"]
-    f = _fields(table, path, keys)
-    return _run(built, path, "shear", **{k: f.float(k, 0.0) for k in keys})
-
-
-@transform_type("projective")
-def _design_projective(built: Built, table: Mapping, path: str) -> Built:
-    _fields(table, path, ["matrix"])
-    return _run(built, path, "projective", matrix=_matrix(table, "matrix", path, [(4, 4)]))
-
-
-@transform_type("inversion")
-def _design_inversion(built: Built, table: Mapping, path: str) -> Built:
-    f = _fields(table, path, ["center", "radius"])
-    return _run(built, path, "inversion", center=f.vector("center", f.REQUIRED),
-                radius=f.float("radius", f.REQUIRED, lo=0.0, lo_open=True))

@@ -30,12 +30,13 @@ from __future__ import annotations
 
 from dataclasses import dataclass, replace
 from enum import Enum
-from functools import lru_cache
+from functools import cache
 
 import numpy as np
 
 from ._validation import check_choice
-from .mesh import FaceKind, Mesh
+from .mesh import Mesh
+from .tolerances import TINY as _TINY
 
 __all__ = [
     "QuadSplit",
@@ -50,8 +51,6 @@ __all__ = [
 # Above this valence the Catalan number of templates (1430 for 10) outgrows
 # greedy ear clipping; polygons that large are rare caps, not panels.
 MAX_TEMPLATE_VALENCE = 9
-
-_TINY = 1e-300
 
 
 class QuadSplit(str, Enum):
@@ -133,7 +132,7 @@ def triangle_angles(points: np.ndarray) -> np.ndarray:
     return np.degrees(np.arctan2(sin, cos))
 
 
-@lru_cache(maxsize=None)
+@cache
 def polygon_templates(k: int) -> np.ndarray:
     """All triangulations of a convex ``k``-gon by diagonals.
 
@@ -247,10 +246,10 @@ def _ear_clip(points: np.ndarray) -> np.ndarray:
                 inside &= np.cross(q - p, others - p) @ normal >= 0
             ear[e] = not inside.any()
         score = np.where(ear, triangle_angles(tri).min(axis=1), -1.0)
-        e = int(np.argmax(score))
-        out.append((prv[e], idx[e], nxt[e]))
-        del left[e]
-    out.append(tuple(left))
+        best = int(np.argmax(score))
+        out.append((prv[best], idx[best], nxt[best]))
+        del left[best]
+    out.append((left[0], left[1], left[2]))
     return np.array(out, dtype=np.int64)
 
 

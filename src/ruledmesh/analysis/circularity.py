@@ -11,8 +11,10 @@ through three well-spread vertices; triangles are circular by definition.
 A *parallelogram* quad has ``p0 - p1 + p2 - p3 = 0`` (its diagonals bisect each
 other); the measure is that vector's length over the mean diagonal length.
 
-Both register with :data:`ruledmesh.analysis.report.METRIC_HOOKS` and appear
-in ``ruledmesh analyze`` for meshes with quads.
+Both appear in ``ruledmesh analyze`` for meshes with quads (the report
+registers :func:`circularity_report` and :func:`parallelogram_report`); the
+measures themselves depend on the mesh only, so the meshers and transforms
+may use them.
 """
 
 from __future__ import annotations
@@ -21,12 +23,10 @@ import numpy as np
 
 from ..mesh import Mesh
 from ..tolerances import DEFAULT, Tolerances
-from .report import METRIC_HOOKS
+from ..tolerances import TINY as _TINY
 
 __all__ = ["circle_through", "quad_circularity", "circularity", "quad_parallelogram",
            "parallelogram", "circularity_report", "parallelogram_report"]
-
-_TINY = 1e-300
 
 
 def circle_through(a: np.ndarray, b: np.ndarray, c: np.ndarray):
@@ -168,6 +168,3 @@ def parallelogram_report(mesh: Mesh, tol: Tolerances = DEFAULT) -> dict | None:
             "above_tolerance": int(np.count_nonzero(m > tol.planarity)),
             "all_quads": bool(np.all(m <= tol.planarity))}
 
-
-METRIC_HOOKS["circularity"] = circularity_report
-METRIC_HOOKS["parallelogram"] = parallelogram_report

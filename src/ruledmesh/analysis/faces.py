@@ -12,6 +12,7 @@ from __future__ import annotations
 import numpy as np
 
 from ..mesh import Mesh
+from ..tolerances import TINY as _TINY
 
 __all__ = [
     "quad_planarity",
@@ -28,8 +29,6 @@ __all__ = [
     "face_min_angles",
     "area_shares",
 ]
-
-_TINY = 1e-300
 
 
 def quad_diagonal_crossing(corners: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
@@ -48,6 +47,11 @@ def quad_diagonal_crossing(corners: np.ndarray) -> tuple[np.ndarray, np.ndarray,
     gap : (F,) float64
         Distance between the diagonal lines (0 for a planar quad).
     """
+    # Each quad moved to its first corner and scaled to unit size: the products of squared
+    # lengths below would overflow for coordinates beyond about 1e77.
+    origin = corners[:, :1]
+    scale = np.maximum(np.abs(corners - origin).max(axis=(1, 2), initial=0.0), _TINY)
+    corners = (corners - origin) / scale[:, None, None]
     p, q = corners[:, 0], corners[:, 1]
     d1 = corners[:, 2] - p
     d2 = corners[:, 3] - q
@@ -68,7 +72,7 @@ def quad_diagonal_crossing(corners: np.ndarray) -> tuple[np.ndarray, np.ndarray,
     # Parallel diagonals: distance from q to the line of d1.
     gap_par = np.linalg.norm(np.cross(w, d1), axis=1) / np.sqrt(np.maximum(a, _TINY))
     gap = np.where(parallel, gap_par, gap_skew)
-    return s, t, gap
+    return s, t, gap * scale
 
 
 def quad_planarity(corners: np.ndarray) -> np.ndarray:

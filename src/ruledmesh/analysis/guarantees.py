@@ -30,11 +30,10 @@ import numpy as np
 
 from ..mesh import FaceKind, Mesh
 from ..tolerances import DEFAULT, Tolerances
+from ..tolerances import TINY as _TINY
 from .circularity import quad_circularity, quad_parallelogram
 
 __all__ = ["check_guarantee", "format_guarantee", "quad_trapezoid"]
-
-_TINY = 1e-300
 
 
 def quad_trapezoid(corners: np.ndarray) -> tuple[np.ndarray, np.ndarray]:

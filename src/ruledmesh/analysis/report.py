@@ -24,7 +24,8 @@ there is nothing to measure, and a table of zeros would read as a result.
 from __future__ import annotations
 
 import inspect
-from typing import Any, Mapping
+from collections.abc import Mapping
+from typing import Any
 
 import numpy as np
 
@@ -62,12 +63,17 @@ COVERAGE_WARN = 0.9
 # Extra figures from other modules: name -> fn(mesh) -> dict or None (None: not applicable).
 # Modules in _HOOK_MODULES register themselves here when imported.
 METRIC_HOOKS: dict[str, Any] = {}
-_HOOK_MODULES = ["ruledmesh.analysis.circularity", "ruledmesh.analysis.triangles"]
+_HOOK_MODULES = ["ruledmesh.analysis.triangles"]
 
 
 def _load_hooks() -> None:
     import importlib
 
+    # circularity is a measure the transforms use too: it does not import the report
+    from .circularity import circularity_report, parallelogram_report
+
+    METRIC_HOOKS.setdefault("circularity", circularity_report)
+    METRIC_HOOKS.setdefault("parallelogram", parallelogram_report)
     for name in _HOOK_MODULES:
         try:
             importlib.import_module(name)
@@ -249,7 +255,7 @@ def _figures(mesh: Mesh, tol: Tolerances) -> dict[str, Any]:
 
     plan = face_planarity(mesh)
     convex = F.convexity(mesh, tol.convexity)
-    normals, areas = F.face_normals(mesh)
+    _normals, areas = F.face_normals(mesh)
     angles = F.corner_angles(mesh)
     edges = mesh.edges()
     lengths = np.linalg.norm(mesh.vertices[edges[:, 1]] - mesh.vertices[edges[:, 0]], axis=1)
@@ -257,7 +263,7 @@ def _figures(mesh: Mesh, tol: Tolerances) -> dict[str, Any]:
     report: dict[str, Any] = {
         "vertices": mesh.n_vertices,
         "faces": mesh.n_faces,
-        "members": int(len(mesh.members)),
+        "members": len(mesh.members),
         "kinds": mesh.count_kinds(),
         "valences": {str(int(k)): int(c) for k, c in zip(*np.unique(mesh.valences, return_counts=True))},
         "finite": finite,
@@ -279,7 +285,7 @@ def _t_junctions(mesh: Mesh) -> dict[str, Any]:
     from .conformity import t_junctions
 
     found = t_junctions(mesh)
-    return {"count": int(len(found)), "first": found[:5].tolist()}
+    return {"count": len(found), "first": found[:5].tolist()}
 
 
 def _closeness(mesh: Mesh, reference, mesh_area: float) -> dict[str, Any]:

@@ -10,6 +10,7 @@ seeds a few vectorised Gauss-Newton steps on ``|S(u, t) - p|^2`` with
 from __future__ import annotations
 
 from dataclasses import dataclass, field
+from typing import Protocol
 
 import numpy as np
 
@@ -31,7 +32,7 @@ class RuledReference:
         Grid resolution of the seeding samples per direction.
     """
 
-    surface: object
+    surface: RuledPatch
     samples: int = 64
     _cache: dict = field(default_factory=dict, repr=False)
 
@@ -124,3 +125,13 @@ class RuledReference:
         if "area" not in self._cache:
             self._cache["area"] = float(self.surface.area())
         return self._cache["area"]
+
+
+class RuledPatch(Protocol):
+    """What :class:`RuledReference` needs of a smooth surface patch ``0 <= u, t <= 1``."""
+
+    def point(self, u: np.ndarray, t: np.ndarray) -> np.ndarray: ...
+
+    def partials(self, u: np.ndarray, t: np.ndarray) -> tuple[np.ndarray, np.ndarray]: ...
+
+    def area(self) -> float: ...

@@ -17,10 +17,13 @@ below :data:`SPLINTER_ANGLE` degrees.
 
 from __future__ import annotations
 
-from typing import Any, Callable
+import itertools
+from collections.abc import Callable
+from typing import Any
 
 import numpy as np
 
+from ..errors import ParameterError
 from ..mesh import Mesh
 from ..triangulate import triangle_angles, triangulate
 from .report import METRIC_HOOKS
@@ -98,9 +101,9 @@ def triangle_quality(vertices: np.ndarray, triangles: np.ndarray) -> dict[str, A
     mins = triangle_angles(pts).min(axis=1)
     ar = aspect_ratios(pts)
     counts, _ = np.histogram(np.minimum(ar, 1e300), bins=np.array(ASPECT_BINS[:-1] + (1e301,)))
-    labels = [f"{lo:g}-{hi:g}" for lo, hi in zip(ASPECT_BINS[:-1], ASPECT_BINS[1:])]
+    labels = [f"{lo:g}-{hi:g}" for lo, hi in itertools.pairwise(ASPECT_BINS)]
     return {
-        "triangles": int(len(pts)),
+        "triangles": len(pts),
         "min_angle_deg": float(mins.min()),
         "min_angle_percentiles": {f"p{q}": float(np.percentile(mins, q)) for q in (1, 5, 50)},
         "splinters": int(np.count_nonzero(mins < SPLINTER_ANGLE)),
@@ -171,8 +174,8 @@ def _grid_counts(point, n_triangles: int) -> tuple[int, int]:
     len_u = np.linalg.norm(np.diff(p, axis=0), axis=2).sum(axis=0).mean()
     len_t = np.linalg.norm(np.diff(p, axis=1), axis=2).sum(axis=1).mean()
     cells = max(n_triangles / 2.0, 1.0)
-    nu = max(int(round(np.sqrt(cells * len_u / max(len_t, 1e-300)))), 1)
-    nt = max(int(round(cells / nu)), 1)
+    nu = max(int(round(np.sqrt(cells * len_u / max(len_t, 1e-300)))), 1)  # noqa: RUF046 - numpy scalar
+    nt = max(round(cells / nu), 1)
     return nu, nt
 
 
@@ -247,6 +250,8 @@ def compare_tessellations(mesh: Mesh, point: Callable[[np.ndarray, np.ndarray], 
         the exported mesh, with cells as long as wide on average.
     """
     ours = mesh_triangle_quality(mesh)
+    if ours is None:
+        raise ParameterError("a mesh without faces has no triangles to compare", "mesh")
     rows = [{"tessellation": "ruledmesh (PQ faces split)", **ours}]
     nu, nt = _grid_counts(point, ours["triangles"])
     for diag, label in (("fixed", "parameter grid"), ("shorter", "parameter grid, shorter diagonal")):

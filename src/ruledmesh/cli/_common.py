@@ -110,7 +110,7 @@ def file_kind(path: Path) -> str | None:
     for name, test in _BINARY_KINDS:
         if test(head):
             return name
-    if len(head) >= 84 and b"\0" in head[:84] and not head[:5].lower() == b"solid":
+    if len(head) >= 84 and b"\0" in head[:84] and head[:5].lower() != b"solid":
         return "a binary STL mesh" if path.suffix.lower() == ".stl" else None
     try:
         text = head.decode("utf-8")
@@ -219,13 +219,13 @@ def read_source(typed: str, progress: Progress | None = None) -> Source:
                          f"meshes ({readable}) and design files (.toml)")
     from .._files import MAX_MESH_BYTES, FileRefused, read_capped
     from ..errors import ParameterError
-    from ..io import _module
+    from ..io import format_module
 
     with (progress or SILENT).task(f"read {typed}"):
         try:
             # Content decides the reader: an OBJ saved as .txt is still read as OBJ.
             data = read_capped(path, MAX_MESH_BYTES, "a mesh file")
-            mesh = _module(ext, READERS, "read").loadb(data)
+            mesh = format_module(ext, READERS, "read").loadb(data)
         except FileRefused as exc:
             raise InputError(f"{typed}: {exc.strerror}") from None
         except ParameterError as exc:

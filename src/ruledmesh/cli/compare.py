@@ -26,7 +26,8 @@ def add_parser(sub) -> None:
         help="mesh one design with the PQ and the hybrid method and compare",
         description="Build the rulings of a design file once and mesh them with the §4.3 PQ "
                     "method and the §4.1 hybrid HP-patch method; print faces, the share of "
-                    "the area in triangles and of the faces that are triangles, max planarity, closeness to the smooth surface, coverage and "
+                    "the area in triangles and of the faces that are triangles, max planarity, closeness to "
+                    "the smooth surface, coverage and "
                     "min angle for both. Options of the design's [mesh] table that belong to "
                     "one method are passed to it.",
         epilog="examples:\n"
@@ -69,9 +70,9 @@ def compare(design, rows=None, divisions=None, midpoints=None) -> dict:
     """
     from ..analysis.report import analyze
     from ..design import Design, build_design
+    from ..design.meshers import HYBRID_MESH_KEYS as HYBRID_KEYS
+    from ..design.pq import MESH_KEYS as PQ_KEYS
     from ..errors import DesignError
-    from ..hybrid import _MESH_KEYS as HYBRID_KEYS
-    from ..pq import MESH_KEYS as PQ_KEYS
 
     if "rulings" not in design.data:
         raise DesignError("compare needs a design with a [rulings] table (generators), not a "
@@ -116,7 +117,7 @@ def run(args) -> int:
 
     reports = compare(load_design(check_design_file(args.design)), args.rows, args.divisions, args.midpoints)
     if args.json:
-        json.dump({m: {k: v for k, v in r.items()} for m, r in reports.items()}, sys.stdout,
+        json.dump({m: dict(r.items()) for m, r in reports.items()}, sys.stdout,
                   indent=2, default=str)
         sys.stdout.write("\n")
     else:

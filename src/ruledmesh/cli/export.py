@@ -65,7 +65,7 @@ def run(args) -> int:
 
     from ..analysis.report import kind_counts
     from ..errors import RuledMeshWarning
-    from ..io import WRITERS, _module, save
+    from ..io import WRITERS, format_module, save
     from ._common import check_output_file, progress_for, read_source
 
     output = check_output_file(args.output, WRITERS)
@@ -77,7 +77,7 @@ def run(args) -> int:
         mesh = mesh.with_units(args.input_units, convert=False)
     if args.units:
         mesh = mesh.with_units(args.units)
-    module = _module(output.suffix.lower(), WRITERS, "write")
+    module = format_module(output.suffix.lower(), WRITERS, "write")
     accepted = inspect.signature(module.dumpb).parameters
     options = {"shading": args.shading, "quads": args.quads, "design": design,
                "origin": _origin(args.origin), "panels": args.panels, "extras": args.extras}

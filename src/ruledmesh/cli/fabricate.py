@@ -11,7 +11,7 @@ def _size(text: str) -> tuple[float, float]:
     try:
         w, h = (float(p) for p in text.lower().split("x"))
     except ValueError:
-        raise argparse.ArgumentTypeError(f'expected WIDTHxHEIGHT, e.g. 2500x1250, got "{text}"')
+        raise argparse.ArgumentTypeError(f'expected WIDTHxHEIGHT, e.g. 2500x1250, got "{text}"') from None
     return w, h
 
 

@@ -11,7 +11,7 @@ def _pair(text: str, kind=float) -> tuple:
         a, b = (kind(p) for p in parts)
     except ValueError:
         raise argparse.ArgumentTypeError(f"expected two numbers separated by "
-                                         f"{'x' if kind is int else 'a comma'}, got \"{text}\"")
+                                         f"{'x' if kind is int else 'a comma'}, got \"{text}\"") from None
     return a, b
 
 
@@ -61,7 +61,7 @@ def run(args) -> int:
     from ._common import check_output_file, progress_for, read_design, read_source
 
     check_output_file(args.output, FORMATS,
-                      optional={ext: ("matplotlib", "plot") for ext in FORMATS})
+                      optional=dict.fromkeys(FORMATS, ("matplotlib", "plot")))
     progress = progress_for(args)
     source = read_source(args.mesh, progress)
     reference = source.built.reference if source.built is not None else None

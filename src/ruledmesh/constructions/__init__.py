@@ -1,7 +1,8 @@
 """Surfaces with exact PQ analogues (paper §2-§3), one module per family.
 
-Importing this package registers every design-file kind with
-:mod:`ruledmesh.registry` (see ``docs/design-reference.md``):
+The maths only: arrays and numbers in, a :class:`~ruledmesh.mesh.Mesh` out.
+The design-file kinds (see ``docs/design-reference.md``) are read by
+:mod:`ruledmesh.design.catalogue`, which calls these functions:
 
 ==========================  ===============================  =========================
 kind                        function                         every face
@@ -33,7 +34,7 @@ from .helicoid import helicoid_mesh
 from .hyperbolic_paraboloid import hyperbolic_paraboloid_mesh
 from .hyperboloid import hyperboloid_mesh
 from .moulding import moulding_mesh, pipe_mesh
-from .quadrics import elliptic_paraboloid_mesh, ellipsoid_mesh, two_sheet_hyperboloid_mesh
+from .quadrics import ellipsoid_mesh, elliptic_paraboloid_mesh, two_sheet_hyperboloid_mesh
 from .rotational import rotational_mesh
 from .strips import parallel_edge_strips, similar_strips
 from .translational import translational_mesh

@@ -9,7 +9,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..mesh import FaceKind, Mesh, _offsets_from_valences
+from ..mesh import FaceKind, Mesh, offsets_from_valences
 
 __all__ = ["grid_quads", "grid_mesh", "polyline_members"]
 
@@ -32,8 +32,8 @@ def grid_quads(nu: int, nv: int, wrap_u: bool = False, wrap_v: bool = False) -> 
     """
     iu = np.arange(nu if wrap_u else nu - 1)
     jv = np.arange(nv if wrap_v else nv - 1)
-    i, j = np.meshgrid(iu, jv, indexing="ij")
-    i, j = i.ravel(), j.ravel()
+    gi, gj = np.meshgrid(iu, jv, indexing="ij")
+    i, j = gi.ravel(), gj.ravel()
     i1 = (i + 1) % nu
     j1 = (j + 1) % nv
     return np.stack([i * nv + j, i1 * nv + j, i1 * nv + j1, i * nv + j1], axis=1).astype(np.int64)
@@ -99,7 +99,7 @@ def grid_mesh(points: np.ndarray, *, wrap_u: bool = False, wrap_v: bool = False,
            else np.asarray(member_id, np.int64))
     real = mem[:, 0] != mem[:, 1]
     mem, mid = mem[real], mid[real]
-    mesh = Mesh(verts.copy(), _offsets_from_valences(valence), q[keep], kinds, mem, mid, {},
+    mesh = Mesh(verts.copy(), offsets_from_valences(valence), q[keep], kinds, mem, mid, {},
                 dict(info or {}))
     return mesh.compact()
 

@@ -15,18 +15,12 @@ inversion of a torus mesh in a sphere, circular again (§2.3).
 
 from __future__ import annotations
 
-from typing import Mapping
-
 import numpy as np
 
 from .._validation import check_float, check_int, check_points
-from ..errors import DesignError, GeometryError, ParameterError
-from ..registry import BuildContext, Built, surface_kind
-from ._frames import perpendicular
+from ..errors import GeometryError, ParameterError
 from ._grid import grid_mesh
-from ._spec import Fields, mesh_counts
-from .profiles import profile_from_spec
-from .reference import torus
+from .frames import perpendicular
 
 __all__ = ["canal_mesh", "sphere_circles", "torus_mesh", "dupin_cyclide"]
 
@@ -170,64 +164,3 @@ def dupin_cyclide(R: float, r: float, u: int, v: int, center, radius: float):
     from ..transforms import inversion
 
     return inversion(torus_mesh(R, r, u, v), center, radius)
-
-
-@surface_kind("torus")
-def _build_torus(table: Mapping, mesh_table: Mapping, ctx: BuildContext) -> Built:
-    f = Fields(table, "surface", ["R", "r"])
-    u, v = mesh_counts(mesh_table, 32, 16, min_u=3, min_v=3)
-    R = f.float("R", Fields.REQUIRED, lo=0.0, lo_open=True)
-    r = f.float("r", Fields.REQUIRED, lo=0.0, lo_open=True)
-    if r >= R:
-        raise DesignError(f"expected r < R (a ring torus), got r = {r:g}, R = {R:g}", "surface.r")
-    return Built(torus_mesh(R, r, u, v), torus(R, r), None,
-                 {"guarantee": "isosceles trapezoids, circular"})
-
-
-@surface_kind("dupin-cyclide")
-def _build_cyclide(table: Mapping, mesh_table: Mapping, ctx: BuildContext) -> Built:
-    from ..transforms import _design_inversion
-
-    f = Fields(table, "surface", ["R", "r", "center", "radius"])
-    built = _build_torus({k: table[k] for k in ("R", "r") if k in table}, mesh_table, ctx)
-    inv = {"center": f.raw("center", Fields.REQUIRED), "radius": f.raw("radius", Fields.REQUIRED)}
-    out = _design_inversion(built, inv, "surface")
-    return Built(out.mesh.with_info(construction="dupin cyclide"), out.reference, None,
-                 {**dict(out.extras), "guarantee": "circular (inversion of a torus)"})
-
-
-@surface_kind("canal")
-def _build_canal(table: Mapping, mesh_table: Mapping, ctx: BuildContext) -> Built:
-    f = Fields(table, "surface", ["spine", "radii", "radius"])
-    u, v = mesh_counts(mesh_table, 24, 16, min_u=2, min_v=3)
-    spine = profile_from_spec(f.raw("spine", Fields.REQUIRED), "surface.spine",
-                              min_points=3).sample(u)
-    if len(spine) < 3:
-        raise DesignError("expected at least 3 spine points", "surface.spine")
-    if f.has("radius") == f.has("radii"):
-        raise DesignError("give either radius (a number) or radii (a list)", "surface.radii")
-    if f.has("radius"):
-        radii = np.full(len(spine), f.float("radius", lo=0.0, lo_open=True))
-    else:
-        given = f.floats("radii", positive=True)
-        if given.size == 2 and len(spine) != 2:
-            # From the first to the last sphere, linear in arc length along the spine.
-            arc = np.concatenate([[0.0], np.cumsum(np.linalg.norm(np.diff(spine, axis=0), axis=1))])
-            radii = given[0] + (given[1] - given[0]) * arc / arc[-1]
-        elif given.size == len(spine):
-            radii = given
-        else:
-            raise DesignError(f"expected 2 numbers (start, end) or one per spine point "
-                              f"({len(spine)}), got {given.size}", "surface.radii")
-    try:
-        mesh = canal_mesh(spine, radii, v)
-    except GeometryError as exc:
-        raise DesignError(str(exc), "surface.spine") from None
-    # Ring k lies on spheres k and k + 1: report the worst relative deviation.
-    ring = mesh.vertices.reshape(len(spine) - 1, v, 3)
-    dev = max(np.abs(np.linalg.norm(ring - spine[:-1, None], axis=2) - radii[:-1, None]).max(),
-              np.abs(np.linalg.norm(ring - spine[1:, None], axis=2) - radii[1:, None]).max())
-    return Built(mesh, None, None, {
-        "guarantee": "circular (consecutive circles on one sphere)",
-        "on_spheres_max": float(dev / (mesh.diagonal() or 1.0)),
-    })

@@ -7,15 +7,11 @@ mesh's members.  These polyhedra *are* the surfaces (no smooth reference).
 
 from __future__ import annotations
 
-from typing import Mapping
-
 import numpy as np
 
 from .._validation import check_points, check_vector
-from ..errors import DesignError, GeometryError, ParameterError
-from ..registry import BuildContext, Built, surface_kind
+from ..errors import GeometryError, ParameterError
 from ._grid import grid_mesh, polyline_members
-from ._spec import Fields, mesh_counts
 
 __all__ = ["prism", "pyramid", "torsal_polyhedron"]
 
@@ -124,35 +120,3 @@ def torsal_polyhedron(polygon: np.ndarray, lengths=(0.2, 1.0), rows: int = 4):
     mid = np.repeat(np.arange(grid.shape[0]), rows)
     return grid_mesh(grid, members=members, member_id=mid, collapse=False,
                      info={"construction": "torsal polyhedron"})
-
-
-@surface_kind("prism")
-def _build_prism(table: Mapping, mesh_table: Mapping, ctx: BuildContext) -> Built:
-    f = Fields(table, "surface", ["polygon", "direction", "closed"])
-    u, _ = mesh_counts(mesh_table, 4, None)
-    mesh = prism(f.points("polygon", Fields.REQUIRED, min_count=2),
-                 f.vector("direction", [0.0, 0.0, 1.0], nonzero=True), u,
-                 closed=f.bool("closed", False))
-    return Built(mesh, None, None, {"guarantee": "parallelograms (prism)"})
-
-
-@surface_kind("pyramid")
-def _build_pyramid(table: Mapping, mesh_table: Mapping, ctx: BuildContext) -> Built:
-    f = Fields(table, "surface", ["polygon", "apex", "closed", "to_apex"])
-    u, _ = mesh_counts(mesh_table, 4, None)
-    mesh = pyramid(f.points("polygon", Fields.REQUIRED, min_count=2),
-                   f.vector("apex", Fields.REQUIRED), u, closed=f.bool("closed", False),
-                   to_apex=f.bool("to_apex", False))
-    return Built(mesh, None, None, {"guarantee": "trapezoids (pyramid)"})
-
-
-@surface_kind("torsal-polyhedron")
-def _build_torsal(table: Mapping, mesh_table: Mapping, ctx: BuildContext) -> Built:
-    f = Fields(table, "surface", ["polygon", "lengths"])
-    u, _ = mesh_counts(mesh_table, 4, None)
-    lengths = f.floats("lengths", [0.2, 1.0], count=2)
-    if not (0 < lengths[0] < lengths[1]):
-        raise DesignError(f"expected 0 < first < second, got {lengths.tolist()}",
-                          "surface.lengths")
-    mesh = torsal_polyhedron(f.points("polygon", Fields.REQUIRED, min_count=3), lengths, u)
-    return Built(mesh, None, None, {"guarantee": "planar strips (torsal polyhedron)"})

@@ -17,18 +17,14 @@ family as the two profiles).
 
 from __future__ import annotations
 
-from typing import Mapping
-
 import numpy as np
 
 from .._validation import check_float, check_int
-from ..errors import DesignError, GeometryError
+from ..errors import GeometryError
 from ..mesh import Mesh
-from ..registry import BuildContext, Built, surface_kind
+from ..surfaces import ImplicitSurface
 from ..tolerances import DEFAULT
 from ._grid import grid_mesh
-from ._spec import Fields, mesh_counts
-from .reference import ImplicitSurface
 
 __all__ = ["helicoid_mesh", "helicoid"]
 
@@ -104,19 +100,3 @@ def helicoid_mesh(radius: float, pitch: float, turns: float = 1.0, u: int = 48,
         raise GeometryError(f"u = {u}, v = {v} leave no cell inside the patch: raise u and v")
     return grid_mesh(grid, cell_mask=cell.ravel(), collapse=False,
                      info={"construction": "helicoid (translational)"})
-
-
-@surface_kind("helicoid")
-def _build(table: Mapping, mesh_table: Mapping, ctx: BuildContext) -> Built:
-    f = Fields(table, "surface", ["radius", "pitch", "turns"])
-    u, v = mesh_counts(mesh_table, 48, 48, min_u=2, min_v=2)
-    radius = f.float("radius", 1.0, lo=0.0, lo_open=True)
-    pitch = f.float("pitch", 1.0)
-    if pitch == 0:
-        raise DesignError("expected a non-zero number (0 is a plane), got 0", "surface.pitch")
-    turns = f.float("turns", 1.0, lo=0.0, lo_open=True)
-    try:
-        mesh = helicoid_mesh(radius, pitch, turns, u, v)
-    except GeometryError as exc:
-        raise DesignError(str(exc), "mesh") from None
-    return Built(mesh, helicoid(pitch, radius, turns), None, {"guarantee": "parallelograms"})

@@ -20,17 +20,14 @@ paper that turns the orthogonal grid of a right HP into any other.
 from __future__ import annotations
 
 from enum import Enum
-from typing import Mapping
 
 import numpy as np
 
 from .._validation import check_bool, check_choice, check_float, check_int
-from ..errors import DesignError, GeometryError
-from ..mesh import FaceKind, Mesh, _offsets_from_valences
-from ..registry import BuildContext, Built, surface_kind
+from ..errors import GeometryError
+from ..mesh import FaceKind, Mesh, offsets_from_valences
+from ..surfaces import ImplicitSurface, parametric_area
 from ._grid import grid_mesh
-from ._spec import Fields, mesh_counts
-from .reference import ImplicitSurface, parametric_area
 
 __all__ = ["HPStyle", "hyperbolic_paraboloid_mesh", "hyperbolic_paraboloid"]
 
@@ -138,51 +135,8 @@ def hyperbolic_paraboloid_mesh(a: float, b: float, size: float, u: int, v: int,
     if sum(len(f) for f in faces) == 0:
         raise GeometryError(f"u = {u}, v = {v} without fill leave no face: raise u or v")
     val = np.concatenate([np.full(len(f), f.shape[1]) for f in faces])
-    mesh = Mesh(X, _offsets_from_valences(val), np.concatenate([f.ravel() for f in faces]),
+    mesh = Mesh(X, offsets_from_valences(val), np.concatenate([f.ravel() for f in faces]),
                 np.concatenate(kinds), np.concatenate(members).astype(np.int64),
                 np.concatenate(mid).astype(np.int64), {},
                 {"construction": "hyperbolic paraboloid (generators)"})
     return mesh.compact()
-
-
-@surface_kind("hyperbolic-paraboloid")
-def _build(table: Mapping, mesh_table: Mapping, ctx: BuildContext) -> Built:
-    f = Fields(table, "surface", ["a", "b", "angle", "size", "style", "fill"])
-    u, v = mesh_counts(mesh_table, 16, 16)
-    a = f.float("a", 1.0, lo=0.0, lo_open=True)
-    if f.has("angle"):
-        if f.has("b"):
-            raise DesignError("give either b or angle (b = a tan(angle / 2)), not both",
-                              "surface.angle")
-        angle = f.float("angle", lo=0.0, lo_open=True, hi=179.0)
-        b = a * np.tan(np.radians(angle) / 2)
-    else:
-        b = f.float("b", 1.0, lo=0.0, lo_open=True)
-    size = f.float("size", 1.0, lo=0.0, lo_open=True)
-    style = f.choice("style", HPStyle, "parabolas")
-    fill = f.bool("fill", True)
-    if style is HPStyle.GENERATORS and min(u, v) < 2:
-        raise DesignError(f"expected u, v >= 2 for style \"generators\", got {u}, {v}", "mesh")
-    try:
-        mesh = hyperbolic_paraboloid_mesh(a, b, size, u, v, style, fill=fill)
-    except GeometryError as exc:
-        raise DesignError(str(exc), "mesh") from None
-    if style is HPStyle.PARABOLAS:
-        def partials(x, y):
-            return (np.stack([np.ones_like(x), 0 * x, 2 * x / a ** 2], axis=1),
-                    np.stack([0 * y, np.ones_like(y), -2 * y / b ** 2], axis=1))
-
-        ref = hyperbolic_paraboloid(a, b, partials, (-size, size), (-size, size))
-        guarantee = "parallelograms"
-    else:
-        L = size / max(a, b)
-
-        def partials(lam, mu):
-            return (np.stack([0.5 * a + 0 * lam, 0.5 * b + 0 * lam, mu], axis=1),
-                    np.stack([0.5 * a + 0 * mu, -0.5 * b + 0 * mu, lam], axis=1))
-
-        ref = hyperbolic_paraboloid(a, b, partials, (-L, L), (-L, L))
-        guarantee = "parallelograms; diagonals are generators of both reguli"
-    return Built(mesh, ref, None, {"guarantee": guarantee,
-                                   "plan_angle_between_reguli_deg":
-                                       float(np.degrees(2 * np.arctan(b / a)))})

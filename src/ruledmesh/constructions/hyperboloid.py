@@ -17,16 +17,13 @@ an isosceles trapezoid (circular).  The generators are the mesh's members.
 from __future__ import annotations
 
 from enum import Enum
-from typing import Mapping
 
 import numpy as np
 
 from .._validation import check_choice, check_float, check_int
-from ..errors import DesignError, GeometryError
-from ..registry import BuildContext, Built, surface_kind
+from ..errors import GeometryError
+from ..surfaces import ImplicitSurface, parametric_area
 from ._grid import grid_mesh
-from ._spec import Fields, mesh_counts
-from .reference import ImplicitSurface, parametric_area
 
 __all__ = ["HyperboloidStyle", "hyperboloid_mesh", "one_sheet_hyperboloid"]
 
@@ -101,8 +98,8 @@ def hyperboloid_mesh(a: float, c: float, height: float, u: int, v: int | None = 
         rho = 1.0 / np.cos(ang)
         # Cell diagonals: (m, p)-(m+1, p+1) on the first regulus, (m+1, p)-(m, p+1) on the second.
         nv = len(p)
-        m, q = np.meshgrid(np.arange(u), np.arange(nv - 1), indexing="ij")
-        m, q = m.ravel(), q.ravel()
+        gm, gq = np.meshgrid(np.arange(u), np.arange(nv - 1), indexing="ij")
+        m, q = gm.ravel(), gq.ravel()
         m1 = (m + 1) % u
         members = np.concatenate([np.stack([m * nv + q, m1 * nv + q + 1], axis=1),
                                   np.stack([m1 * nv + q, m * nv + q + 1], axis=1)])
@@ -112,40 +109,3 @@ def hyperboloid_mesh(a: float, c: float, height: float, u: int, v: int | None = 
                      np.broadcast_to(z, (u, len(z)))], axis=-1)
     return grid_mesh(grid, wrap_u=True, members=members, member_id=mid, collapse=False,
                      info={"construction": f"hyperboloid ({style.value})"})
-
-
-@surface_kind("hyperboloid")
-def _build(table: Mapping, mesh_table: Mapping, ctx: BuildContext) -> Built:
-    f = Fields(table, "surface", ["a", "b", "c", "height", "style"])
-    u, v = mesh_counts(mesh_table, 32, 16, min_u=3)
-    a = f.float("a", 1.0, lo=0.0, lo_open=True)
-    b = f.float("b", a, lo=0.0, lo_open=True)
-    c = f.float("c", 1.0, lo=0.0, lo_open=True)
-    height = f.float("height", 2.0, lo=0.0, lo_open=True)
-    style = f.choice("style", HyperboloidStyle, "circular")
-    if style is HyperboloidStyle.GENERATORS and u < 4:
-        raise DesignError(f"expected an integer >= 4 (generators per regulus), got {u}", "mesh.u")
-    try:
-        mesh = hyperboloid_mesh(a, c, height, u, v, b=b, style=style)
-    except GeometryError as exc:
-        raise DesignError(str(exc), "surface.height") from None
-    z = mesh.vertices[:, 2]
-    warnings = []
-    if style is HyperboloidStyle.GENERATORS and "v" in mesh_table:
-        warnings.append("mesh.v is not used with style = \"generators\": the crossings of the "
-                        "generators fix the parallels (z = c tan(2 pi k / u))")
-        mesh = mesh.with_info(warnings=warnings)
-    guarantee = ("isosceles trapezoids, circular" if a == b else "trapezoids")
-    if style is HyperboloidStyle.GENERATORS:
-        guarantee += "; diagonals are generators of both reguli"
-    reach = float(np.abs(z).max())
-    if reach < height * (1 - 1e-9):
-        # The crossings of the generators fix the parallels: the last one below
-        # `height` ends the mesh.  The reference stays the designed patch, so the
-        # coverage says how much is missing, and this warning says why.
-        warnings.append(f"the generator crossings reach |z| = {reach:.6g}, not the height "
-                        f"{height:g}: z = c tan(2 pi k / u) for whole k; set height = {reach:.6g} "
-                        "or change u or c to cover the patch")
-        mesh = mesh.with_info(warnings=warnings)
-    return Built(mesh, one_sheet_hyperboloid(a, b, c, -height, height), None,
-                 {"guarantee": guarantee})

@@ -21,18 +21,12 @@ an exact torus.
 
 from __future__ import annotations
 
-from typing import Mapping
-
 import numpy as np
 
-from .._validation import check_float, check_int, check_points, check_vector, describe
-from ..errors import DesignError, GeometryError, ParameterError
-from ..registry import BuildContext, Built, surface_kind
-from ._frames import perpendicular, rotation_matrix
+from .._validation import check_float, check_int, check_points, check_vector
+from ..errors import GeometryError, ParameterError
 from ._grid import grid_mesh
-from ._spec import Fields, mesh_counts
-from .profiles import profile_from_spec
-from .reference import pipe_of_polyline
+from .frames import perpendicular, rotation_matrix
 
 __all__ = ["moulding_mesh", "pipe_mesh"]
 
@@ -178,46 +172,3 @@ def pipe_mesh(spine: np.ndarray, radius: float, segments: int, *, normal=None):
         n = -r / np.linalg.norm(r)
         rows.append(pts)
     return grid_mesh(np.stack(rows), wrap_v=True, info={"construction": "pipe"})
-
-
-def _axes(value, path: str):
-    if not isinstance(value, list) or not value:
-        raise DesignError(f"expected a list of tables {{point, direction, angle}}, got "
-                          f"{describe(value)}", path)
-    o, d, a = [], [], []
-    for k, item in enumerate(value):
-        if not isinstance(item, Mapping):
-            raise DesignError(f"expected a table, got {describe(item)}", f"{path}[{k}]")
-        f = Fields(item, f"{path}[{k}]", ["point", "direction", "angle"])
-        o.append(f.vector("point", Fields.REQUIRED))
-        d.append(f.vector("direction", Fields.REQUIRED, nonzero=True))
-        a.append(f.float("angle", Fields.REQUIRED))
-    return np.array(o), np.array(d), np.array(a)
-
-
-@surface_kind("moulding")
-def _build_moulding(table: Mapping, mesh_table: Mapping, ctx: BuildContext) -> Built:
-    f = Fields(table, "surface", ["profile", "axes", "closed"])
-    _, v = mesh_counts(mesh_table, None, 12)
-    prof = profile_from_spec(f.raw("profile", Fields.REQUIRED), "surface.profile")
-    o, d, a = _axes(f.raw("axes", Fields.REQUIRED), "surface.axes")
-    try:
-        mesh = moulding_mesh(prof.sample(v), o, d, a, closed=f.bool("closed", False))
-    except GeometryError as exc:
-        raise DesignError(str(exc), "surface.axes") from None
-    return Built(mesh, None, None, {"guarantee": "isosceles trapezoids, circular"})
-
-
-@surface_kind("pipe")
-def _build_pipe(table: Mapping, mesh_table: Mapping, ctx: BuildContext) -> Built:
-    f = Fields(table, "surface", ["spine", "radius", "normal"])
-    u, v = mesh_counts(mesh_table, 24, 16, min_v=3)
-    spine = profile_from_spec(f.raw("spine", Fields.REQUIRED), "surface.spine").sample(u)
-    radius = f.float("radius", Fields.REQUIRED, lo=0.0, lo_open=True)
-    try:
-        mesh = pipe_mesh(spine, radius, v, normal=f.vector("normal", None, nonzero=True))
-    except GeometryError as exc:
-        raise DesignError(str(exc), "surface.spine") from None
-    return Built(mesh, pipe_of_polyline(spine, radius), None,
-                 {"guarantee": "isosceles trapezoids, circular; on the pipe within the "
-                               "sampling error"})

@@ -11,15 +11,11 @@ meshes circular.  Poles become triangles.
 
 from __future__ import annotations
 
-from typing import Mapping
-
 import numpy as np
 
 from .._validation import check_float, check_int
-from ..registry import BuildContext, Built, surface_kind
+from ..surfaces import ImplicitSurface, parametric_area
 from ._grid import grid_mesh
-from ._spec import Fields, mesh_counts
-from .reference import ImplicitSurface, parametric_area
 
 __all__ = ["ellipsoid_mesh", "two_sheet_hyperboloid_mesh", "elliptic_paraboloid_mesh",
            "ellipsoid", "two_sheet_hyperboloid", "elliptic_paraboloid"]
@@ -130,45 +126,7 @@ def elliptic_paraboloid_mesh(a: float, b: float, height: float, u: int, v: int):
                      info={"construction": "elliptic paraboloid"})
 
 
-def _guarantee(a: float, b: float) -> str:
+def quadric_guarantee(a: float, b: float) -> str:
+    """What every face of a quadric mesh with semi-axes ``a``, ``b`` is (for the report)."""
     return ("isosceles trapezoids, circular (rotational)" if a == b
             else "trapezoids (similar sections)")
-
-
-@surface_kind("ellipsoid")
-def _build_ellipsoid(table: Mapping, mesh_table: Mapping, ctx: BuildContext) -> Built:
-    f = Fields(table, "surface", ["axes"])
-    u, v = mesh_counts(mesh_table, 32, 16, min_u=3, min_v=2)
-    axes = f.floats("axes", Fields.REQUIRED, count=3, positive=True)
-    a, b, c = (float(x) for x in axes)
-    return Built(ellipsoid_mesh(a, b, c, u, v), ellipsoid(a, b, c), None,
-                 {"guarantee": _guarantee(a, b)})
-
-
-def _abc(f: Fields):
-    a = f.float("a", 1.0, lo=0.0, lo_open=True)
-    b = f.float("b", a, lo=0.0, lo_open=True)
-    c = f.float("c", 1.0, lo=0.0, lo_open=True)
-    return a, b, c
-
-
-@surface_kind("hyperboloid-two-sheets")
-def _build_two_sheets(table: Mapping, mesh_table: Mapping, ctx: BuildContext) -> Built:
-    f = Fields(table, "surface", ["a", "b", "c", "height"])
-    u, v = mesh_counts(mesh_table, 32, 12, min_u=3)
-    a, b, c = _abc(f)
-    height = f.float("height", 3.0 * c, lo=c, lo_open=True)
-    return Built(two_sheet_hyperboloid_mesh(a, b, c, height, u, v),
-                 two_sheet_hyperboloid(a, b, c, height), None, {"guarantee": _guarantee(a, b)})
-
-
-@surface_kind("elliptic-paraboloid")
-def _build_elliptic_paraboloid(table: Mapping, mesh_table: Mapping, ctx: BuildContext) -> Built:
-    f = Fields(table, "surface", ["a", "b", "height"])
-    u, v = mesh_counts(mesh_table, 32, 12, min_u=3)
-    a = f.float("a", 1.0, lo=0.0, lo_open=True)
-    b = f.float("b", a, lo=0.0, lo_open=True)
-    height = f.float("height", 1.0, lo=0.0, lo_open=True)
-    return Built(elliptic_paraboloid_mesh(a, b, height, u, v),
-                 elliptic_paraboloid(a, b, height), None, {"guarantee": _guarantee(a, b)})
-

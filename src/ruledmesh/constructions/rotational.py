@@ -8,18 +8,11 @@ become poles where the quads turn into triangles.
 
 from __future__ import annotations
 
-from typing import Mapping
-
 import numpy as np
 
 from .._validation import check_float, check_int, check_points, check_vector
-from ..errors import DesignError
-from ..registry import BuildContext, Built, surface_kind
-from ._frames import axis_frame
 from ._grid import grid_mesh
-from ._spec import Fields, mesh_counts
-from .profiles import profile_from_spec
-from .reference import revolution_of_polyline
+from .frames import axis_frame
 
 __all__ = ["rotational_mesh", "meridian_coordinates"]
 
@@ -90,31 +83,3 @@ def rotational_mesh(meridian: np.ndarray, steps: int, *, origin=(0.0, 0.0, 0.0),
     grid = (o + h[None, :, None] * a
             + rho[None, :, None] * (np.cos(ang)[..., None] * e1 + np.sin(ang)[..., None] * e2))
     return grid_mesh(grid, wrap_u=full, info={"construction": "rotational"})
-
-
-@surface_kind("rotational")
-def _build(table: Mapping, mesh_table: Mapping, ctx: BuildContext) -> Built:
-    f = Fields(table, "surface", ["meridian", "axis", "angle"])
-    u, v = mesh_counts(mesh_table, 24, 12)
-    prof = profile_from_spec(f.raw("meridian", Fields.REQUIRED), "surface.meridian")
-    axis_table = f.raw("axis", {})
-    if not isinstance(axis_table, Mapping):
-        raise DesignError("expected a table {point = [..], direction = [..]}", "surface.axis")
-    af = Fields(axis_table, "surface.axis", ["point", "direction"])
-    origin = af.vector("point", [0.0, 0.0, 0.0])
-    direction = af.vector("direction", [0.0, 0.0, 1.0], nonzero=True)
-    angle = f.float("angle", 360.0, lo=0.0, lo_open=True, hi=360.0)
-    if angle == 360.0 and u < 3:
-        raise DesignError(f"expected an integer >= 3 for a full turn, got {u}", "mesh.u")
-    merid = prof.sample(v)
-    mesh = rotational_mesh(merid, u, origin=origin, axis=direction, angle=angle)
-    # The reference meridian: the profile's own points (polyline), or a fine
-    # sampling that contains the mesh's samples (analytic profile).
-    dense = merid if not prof.analytic else prof.sample(v * max(1, -(-2000 // v)))
-    _, _, a = axis_frame(direction)
-    rho, h, phi = meridian_coordinates(dense, origin, a)
-    e1, e2, _ = axis_frame(a)
-    phi0 = phi[np.argmax(rho > 0)]
-    start = np.cos(phi0) * e1 + np.sin(phi0) * e2
-    ref = revolution_of_polyline(np.stack([rho, h], axis=1), origin, a, np.radians(angle), start)
-    return Built(mesh, ref, None, {"guarantee": "isosceles trapezoids, circular"})

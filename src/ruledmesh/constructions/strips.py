@@ -10,15 +10,11 @@ have parallel edges without being similar).
 
 from __future__ import annotations
 
-from typing import Mapping
-
 import numpy as np
 
 from .._validation import check_points
-from ..errors import DesignError, ParameterError
-from ..registry import BuildContext, Built, surface_kind
+from ..errors import ParameterError
 from ._grid import grid_mesh
-from ._spec import Fields, mesh_counts
 
 __all__ = ["similar_strips", "parallel_edge_strips"]
 
@@ -92,35 +88,3 @@ def parallel_edge_strips(polygon: np.ndarray, starts: np.ndarray, edge_factors: 
         [np.zeros((len(starts), 1, 3)), np.cumsum(scale[..., None] * edges[None], axis=1)], axis=1)
     grid = np.concatenate([c0[None], rows], axis=0)
     return grid_mesh(grid, collapse=False, info={"construction": "parallel-edge strips"})
-
-
-@surface_kind("strips")
-def _build_strips(table: Mapping, mesh_table: Mapping, ctx: BuildContext) -> Built:
-    f = Fields(table, "surface", ["polygon", "closed", "scales", "translations", "starts",
-                                  "edge_factors"])
-    mesh_counts(mesh_table, 1, None)
-    closed = f.bool("closed", False)
-    poly = f.points("polygon", Fields.REQUIRED, min_count=2)
-    if f.has("edge_factors") or f.has("starts"):
-        if closed:
-            raise DesignError("edge_factors work on open polylines only", "surface.closed")
-        starts = f.points("starts", Fields.REQUIRED)
-        factors = f.raw("edge_factors", Fields.REQUIRED)
-        try:
-            mesh = parallel_edge_strips(poly, starts, factors)
-        except (ParameterError, ValueError) as exc:
-            raise DesignError(str(exc), "surface.edge_factors") from None
-        return Built(mesh, None, None, {"guarantee": "trapezoids (pairwise parallel edges)"})
-    scales = f.floats("scales", [1.0])
-    trans = f.points("translations", np.zeros((len(scales), 3)), min_count=1)
-    if len(trans) != len(scales):
-        raise DesignError(f"expected {len(scales)} translations (one per scale), got {len(trans)}",
-                          "surface.translations")
-    if np.any(scales == 0):
-        raise DesignError("expected non-zero scales", "surface.scales")
-    mesh = similar_strips(poly, scales, trans, closed=closed)
-    # Scale 1 throughout: translated copies of one polygon (Fig. 3 middle), so
-    # every face is a parallelogram, which the analysis then measures.
-    claim = ("parallelograms (congruent polygons)" if np.all(np.asarray(scales) == 1.0)
-             else "trapezoids (similar polygons)")
-    return Built(mesh, None, None, {"guarantee": claim})

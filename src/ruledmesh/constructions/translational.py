@@ -8,16 +8,13 @@ is translated along it.
 
 from __future__ import annotations
 
-from typing import Mapping
-
 import numpy as np
 
 from .._validation import check_points
-from ..registry import BuildContext, Built, surface_kind
+from ..errors import ParameterError
+from ..surfaces import parametric_area
 from ._grid import grid_mesh
-from ._spec import Fields, mesh_counts
-from .profiles import Profile, profile_from_spec
-from .reference import parametric_area
+from .profiles import Profile
 
 __all__ = ["translational_mesh", "TranslationalPatch"]
 
@@ -47,33 +44,21 @@ class TranslationalPatch:
     """``S(u, t) = p(u) + q(t) - q(0)`` on ``[0, 1]^2`` for analytic profiles.
 
     Has ``point``, ``partials`` and ``area`` as
-    :class:`~ruledmesh.analysis.surface.RuledReference` expects.
+    :class:`~ruledmesh.surfaces.RuledReference` expects.
     """
 
     def __init__(self, p: Profile, q: Profile):
+        if p.derivative is None or q.derivative is None:
+            raise ParameterError("expected analytic profiles (a polyline has no derivative)", "p")
         self.p, self.q = p, q
+        self._dp, self._dq = p.derivative, q.derivative
         self._q0 = q.point(np.zeros(1))[0]
 
     def point(self, u, t):
         return self.p.point(np.asarray(u)) + self.q.point(np.asarray(t)) - self._q0
 
     def partials(self, u, t):
-        return self.p.derivative(np.asarray(u)), self.q.derivative(np.asarray(t))
+        return self._dp(np.asarray(u)), self._dq(np.asarray(t))
 
     def area(self) -> float:
         return parametric_area(self.partials, (0.0, 1.0), (0.0, 1.0))
-
-
-@surface_kind("translational")
-def _build(table: Mapping, mesh_table: Mapping, ctx: BuildContext) -> Built:
-    f = Fields(table, "surface", ["p", "q"])
-    u, v = mesh_counts(mesh_table, 16, 16)
-    p = profile_from_spec(f.raw("p", Fields.REQUIRED), "surface.p")
-    q = profile_from_spec(f.raw("q", Fields.REQUIRED), "surface.q")
-    mesh = translational_mesh(p.sample(u), q.sample(v))
-    reference = None
-    if p.analytic and q.analytic:
-        from ..analysis.surface import RuledReference
-
-        reference = RuledReference(TranslationalPatch(p, q))
-    return Built(mesh, reference, None, {"guarantee": "parallelograms"})

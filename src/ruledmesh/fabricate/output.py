@@ -86,6 +86,54 @@ def _hotwire(mesh: Mesh, unit: str, machine: hm.Machine, **options: Any):
     return path, hw.gcode(path, units=unit, machine=machine)
 
 
+def _checked_hotwire(mesh: Mesh, unit: str, hotwire: bool | None, machine: hm.Machine | None,
+                     notes: list[str], *, feed: float, **options: Any) -> tuple[Any, str | None]:
+    """Hot-wire path and G-code, computed before any file is written (or a note why not).
+
+    ``hotwire=True`` or a given ``machine`` make a refusal an error; by default it is a note.
+    """
+    if hotwire is not False and len(mesh.members):
+        try:
+            return _hotwire(mesh, unit, machine or hm.Machine(feed=feed), **options)
+        except GeometryError as exc:
+            if hotwire or machine is not None:
+                raise
+            notes.append(f"hot-wire paths skipped: {exc}")
+    elif hotwire and not len(mesh.members):
+        raise GeometryError("the mesh has no generators (members) to cut along")
+    return None, None
+
+
+def _sheet_summary(lay: Any, unit: str) -> dict[str, Any]:
+    return {"count": lay.n_sheets, "size": lay.sheet_size.tolist(), "gap": lay.gap,
+            "unit": unit, "nesting": lay.method, "panel_area": lay.panel_area(),
+            "utilisation": lay.utilisation(), "utilisation_trimmed": lay.utilisation_trimmed()}
+
+
+def _layout(unrolled: Any, sheet: Any, gap: float | None, unit: str, nesting: str,
+            seconds: int, notes: list[str]) -> Any:
+    if nesting == "auto" and not _spyrrow_available():
+        notes.append("sheets packed by shelves: true-shape nesting needs spyrrow "
+                     "(pip install 'ruledmesh[nesting]')")
+    return layout(unrolled, sheet, gap=gap, units=unit, method=nesting, seconds=seconds)
+
+
+def _panel_table(mesh: Mesh, unrolled: Any, lay: Any, tolerances: dict[str, Any]) -> dict[str, Any]:
+    """The ``panels.csv`` columns: congruence classes and the place of each panel on its sheet."""
+    classes = congruence_classes(mesh, unrolled=unrolled, **tolerances)
+    table = panel_table(mesh, unrolled=unrolled, classes=classes)
+    table.update({"sheet": lay.sheet + 1, "sheet_x": lay.offset[:, 0], "sheet_y": lay.offset[:, 1],
+                  "rotation_deg": np.degrees(lay.rotation)})
+    return table
+
+
+def _write_hotwire(put: Any, path: Any, program_text: str, unit: str,
+                   machine: hm.Machine) -> dict[str, Any]:
+    put("hotwire.csv", csv_bytes(hw.path_table(path)))
+    put("hotwire.gcode", program_text.encode("ascii"))
+    return _wire_summary(path, unit, machine)
+
+
 def fabricate(mesh: Mesh, folder: str | os.PathLike, *, sheet: tuple[float, float] | None = None,
               gap: float | None = None, unit: str | None = None, decimals: int = 3,
               length_tol: float | None = None, angle_tol: float = 1e-4, dxf: bool | None = None,
@@ -150,66 +198,37 @@ def fabricate(mesh: Mesh, folder: str | os.PathLike, *, sheet: tuple[float, floa
         write_atomic(folder / name, data)
         written.append(name)
 
-    unit = mesh.units if not unit else unit
-    progress = progress or SILENT
+    unit, progress = unit or mesh.units, progress or SILENT
     # Not a ``with``: the caller closes what an error leaves open (TerminalProgress.close).
     task = stages(progress, "fabricate", ["unroll", "hot wire", "layout", "labels", "classes"])
     unrolled = unroll(mesh, require_planar=require_planar, tol=tol)
     task.advance(note="hot wire")
     # Everything that can refuse runs before the first file is written, the quick
     # checks before the nesting search.
-    path = program_text = None
-    if hotwire is not False and len(mesh.members):
-        try:
-            path, program_text = _hotwire(mesh, unit, machine or hm.Machine(feed=feed), span=span,
+    path, program_text = _checked_hotwire(mesh, unit, hotwire, machine, notes, feed=feed, span=span,
                                           up=up, kerf=kerf, kerf_side=kerf_side, tol=tol)
-        except GeometryError as exc:
-            if hotwire or machine is not None:
-                raise
-            notes.append(f"hot-wire paths skipped: {exc}")
-    elif hotwire and not len(mesh.members):
-        raise GeometryError("the mesh has no generators (members) to cut along")
-
     task.advance(note="layout")
-    if gap is None and tool is not None:
-        gap = tool
-    if nesting == "auto" and not _spyrrow_available():
-        notes.append("sheets packed by shelves: true-shape nesting needs spyrrow "
-                     "(pip install 'ruledmesh[nesting]')")
-    lay = layout(unrolled, sheet, gap=gap, units=unit, method=nesting, seconds=nest_seconds)
+    lay = _layout(unrolled, sheet, tool if gap is None else gap, unit, nesting, nest_seconds, notes)
     task.advance(note="labels")
     labels = panel_labels(lay, decimals=decimals)
     task.advance(note="classes")
     tolerances = {"length_tol": length_tol if length_tol is not None
                   else 1e-9 * (mesh.diagonal() or 1.0), "angle_tol": angle_tol}
-    classes = congruence_classes(mesh, unrolled=unrolled, **tolerances)
-    table = panel_table(mesh, unrolled=unrolled, classes=classes)
-    table.update({"sheet": lay.sheet + 1, "sheet_x": lay.offset[:, 0], "sheet_y": lay.offset[:, 1],
-                  "rotation_deg": np.degrees(lay.rotation)})
+    table = _panel_table(mesh, unrolled, lay, tolerances)
     task.advance()
     task.close()
     (folder / "sheets").mkdir(parents=True, exist_ok=True)
-    dxf = _want_dxf(dxf, notes)
-    _write_sheets(put, lay, labels, unit=unit, decimals=decimals, dxf=bool(dxf),
+    _write_sheets(put, lay, labels, unit=unit, decimals=decimals, dxf=bool(_want_dxf(dxf, notes)),
                   progress=progress)
     _write_schedules(put, mesh, table, progress)
-
     wire: dict[str, Any] | None = None
     if path is not None and program_text is not None:
-        put("hotwire.csv", csv_bytes(hw.path_table(path)))
-        put("hotwire.gcode", program_text.encode("ascii"))
-        wire = _wire_summary(path, unit, machine or hm.Machine(feed=feed))
-
+        wire = _write_hotwire(put, path, program_text, unit, machine or hm.Machine(feed=feed))
     summary = {
         "panels": panel_statistics(mesh, table=table, **tolerances),
-        "sheets": {"count": lay.n_sheets, "size": lay.sheet_size.tolist(), "gap": lay.gap,
-                   "unit": unit, "nesting": lay.method, "panel_area": lay.panel_area(),
-                   "utilisation": lay.utilisation(),
-                   "utilisation_trimmed": lay.utilisation_trimmed()},
+        "sheets": _sheet_summary(lay, unit),
         "max_out_of_plane": float(unrolled.out_of_plane.max()) if mesh.n_faces else 0.0,
-        "hotwire": wire,
-        "notes": notes,
-        "files": written + ["summary.json"],
+        "hotwire": wire, "notes": notes, "files": written + ["summary.json"],
     }
     put("summary.json", (json.dumps(summary, indent=2) + "\n").encode("utf-8"))
     return summary

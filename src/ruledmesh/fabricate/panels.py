@@ -32,7 +32,7 @@ def _signatures(lengths: np.ndarray, angles: np.ndarray) -> np.ndarray:
     Row ``r`` of face ``i`` is ``[lengths..., angles...]`` read from corner
     ``r`` forwards (``r < k``) or backwards (``r >= k``).
     """
-    n, k = lengths.shape
+    _n, k = lengths.shape
     shift = (np.arange(k)[:, None] + np.arange(k)[None, :]) % k          # (k, k)
     fwd_l = lengths[:, shift]
     fwd_a = angles[:, shift]

@@ -17,7 +17,7 @@ from __future__ import annotations
 
 import csv
 import io
-from typing import Mapping
+from collections.abc import Mapping
 
 import numpy as np
 
@@ -39,7 +39,7 @@ def _undirected(mesh: Mesh) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     member_edge : (M,) int64
         The edge of each member.
     """
-    face, nxt, _ = corner_structure(mesh.face_offsets)
+    _face, nxt, _ = corner_structure(mesh.face_offsets)
     a = mesh.face_indices
     b = a[nxt]
     pairs = np.concatenate([np.stack([a, b], 1), mesh.members])
@@ -148,7 +148,7 @@ def member_schedule(mesh: Mesh) -> dict[str, np.ndarray]:
         empty_i = np.zeros(0, dtype=np.int64)
         empty_f = np.zeros(0)
         return {"generator": empty_i, "node0": empty_i, "node1": empty_i,
-                **{k: empty_f for k in ("x0", "y0", "z0", "x1", "y1", "z1", "length")},
+                **dict.fromkeys(("x0", "y0", "z0", "x1", "y1", "z1", "length"), empty_f),
                 "segments": empty_i}
     gens, g = np.unique(mid, return_inverse=True)
     g = g.reshape(-1)

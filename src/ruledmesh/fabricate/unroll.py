@@ -17,11 +17,10 @@ import numpy as np
 from ..errors import GeometryError, ParameterError
 from ..mesh import Mesh
 from ..tolerances import DEFAULT, Tolerances
+from ..tolerances import TINY as _TINY
 
 __all__ = ["Unrolled", "unroll", "corner_structure", "polygon_edges", "interior_angles",
            "min_area_rotation"]
-
-_TINY = 1e-300
 
 
 def corner_structure(offsets: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:

@@ -10,14 +10,14 @@ Hops input it comes from.  All components share the outputs of
 from __future__ import annotations
 
 import json
+import tomllib
 from collections.abc import Callable, Mapping
 from dataclasses import replace
 from typing import Any
 
 import numpy as np
-import tomllib
 
-from ..errors import DesignError, ParameterError
+from ..errors import ParameterError, RuledMeshError
 from .geometry import (
     curve_table,
     decode_curve,
@@ -50,17 +50,16 @@ _FIELDS = {
 }
 
 
-def _input_name(exc: DesignError) -> DesignError:
-    """``exc`` with its design path replaced by the Hops input it came from."""
-    path = exc.field
+def _input_name(detail: str, path: str | None) -> ParameterError:
+    """The error of design field ``path``, named by the Hops input it came from."""
     if not path:
-        return DesignError(exc.detail)
+        return ParameterError(detail)
     for prefix, name in _FIELDS.items():
         if path == prefix or path.startswith(prefix + "."):
-            return DesignError(exc.detail, name)
+            return ParameterError(detail, name)
     if path.startswith("surface."):
-        return DesignError(exc.detail, path.split(".", 1)[1])
-    return DesignError(exc.detail, path)
+        return ParameterError(detail, path.split(".", 1)[1])
+    return ParameterError(detail, path)
 
 
 def _quad_share(mesh) -> float:
@@ -90,8 +89,10 @@ def solve_design(design: Mapping[str, Any], notes: list[str], tolerance: float |
     tol = DEFAULT if tolerance is None else replace(DEFAULT, planarity=tolerance)
     try:
         built = api.build_full(dict(design))
-    except DesignError as exc:
-        raise _input_name(exc) from None
+    except RuledMeshError as exc:
+        if not hasattr(exc, "detail"):  # geometry errors name no field
+            raise
+        raise _input_name(exc.detail, getattr(exc, "field", None)) from None
     mesh = built.mesh
     report = analyze(mesh, reference=built.reference, extras=built.extras, tol=tol)
     encoded, face_of = encode_mesh(mesh)

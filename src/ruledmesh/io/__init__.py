@@ -63,7 +63,12 @@ def formats() -> list[str]:
     return sorted(WRITERS)
 
 
-def _module(ext: str, table: dict[str, str], what: str):
+def format_module(ext: str, table: dict[str, str], what: str):
+    """The module of ``ruledmesh.io`` that handles extension ``ext`` in ``table`` (READERS/WRITERS).
+
+    Raises ``ParameterError`` naming ``path`` and the known extensions for any other ``ext``;
+    ``what`` is the verb of that message ("read", "write").
+    """
     try:
         name = table[ext]
     except KeyError:
@@ -194,7 +199,7 @@ def save(path: str | os.PathLike, mesh: Mesh, **options) -> Path:
     Path
     """
     path = Path(path)
-    module = _module(path.suffix.lower(), WRITERS, "write")
+    module = format_module(path.suffix.lower(), WRITERS, "write")
     check_finite(mesh)
     data = module.dumpb(mesh, **options)
     # Formats that keep part of the mesh in companion files (PLY generators).
@@ -207,7 +212,7 @@ def save(path: str | os.PathLike, mesh: Mesh, **options) -> Path:
 def load(path: str | os.PathLike) -> Mesh:
     """Read a mesh file written by ruledmesh (or any plain OBJ/PLY polygon mesh)."""
     path = Path(path)
-    module = _module(path.suffix.lower(), READERS, "read")
+    module = format_module(path.suffix.lower(), READERS, "read")
     try:
         data = path.read_bytes()
     except OSError as exc:

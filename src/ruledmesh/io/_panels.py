@@ -9,7 +9,7 @@ import numpy as np
 from ..analysis.faces import face_normals
 from ..analysis.planar import face_planarity
 from ..errors import ParameterError
-from ..fabricate.labels import panel_labels
+from ..labels import panel_labels
 from ..mesh import FaceKind, Mesh
 
 __all__ = ["PANEL_MODES", "PanelData", "panel_data"]
@@ -25,7 +25,7 @@ class PanelData:
     Attributes
     ----------
     label : (F,) str
-        :func:`ruledmesh.fabricate.labels.panel_labels`, as on the sheets.
+        :func:`ruledmesh.labels.panel_labels`, as on the sheets.
     kind : (F,) str
         :class:`~ruledmesh.mesh.FaceKind` labels.
     area : (F,) float64

@@ -112,6 +112,35 @@ def _unit(v: np.ndarray) -> np.ndarray:
     return out.astype(np.float32)
 
 
+def _add_generators(b: _Builder, mesh: Mesh, centre: np.ndarray, materials: list, meshes: list,
+                    nodes: list) -> None:
+    """The generators as a second mesh of line segments (``_MEMBER_ID`` per end point)."""
+    pos = (mesh.vertices[mesh.members.reshape(-1)] - centre).astype(np.float32)
+    attrs = {"POSITION": b.add(pos, "VEC3", _ARRAY_BUFFER, minmax=True),
+             "_MEMBER_ID": b.add(np.repeat(mesh.member_id, 2).astype(np.float32),
+                                 "SCALAR", _ARRAY_BUFFER)}
+    materials.append({"name": "generators",
+                      "pbrMetallicRoughness": {"baseColorFactor": [0.1, 0.1, 0.12, 1.0],
+                                               "metallicFactor": 0.0, "roughnessFactor": 1.0}})
+    meshes.append({"name": "generators",
+                   "primitives": [{"attributes": attrs, "mode": _LINES,
+                                   "material": len(materials) - 1}]})
+    nodes.append({"name": "generators", "mesh": 1, "translation": centre.tolist()})
+
+
+def _glb(doc: dict, b: _Builder) -> bytes:
+    """The binary container: header, the JSON chunk (space-padded) and the BIN chunk."""
+    js = json.dumps(doc, separators=(",", ":")).encode("utf-8")
+    js += b" " * ((-len(js)) % 4)
+    binary = b"".join(b.chunks)
+    total = 12 + 8 + len(js) + 8 + len(binary)
+    return b"".join([
+        struct.pack("<4sII", b"glTF", 2, total),
+        struct.pack("<I4s", len(js), b"JSON"), js,
+        struct.pack("<I4s", len(binary), b"BIN\0"), binary,
+    ])
+
+
 def dumpb(mesh: Mesh, shading: str = "flat", quads: str = "shorter") -> bytes:
     """The .glb bytes of ``mesh`` (see the module docstring for the layout).
 
@@ -188,18 +217,7 @@ def dumpb(mesh: Mesh, shading: str = "flat", quads: str = "shorter") -> bytes:
                    "axes": "glTF (x, y, z) in metres = design (x, z, -y) times the unit"}}}]
     nodes = [{"name": "panels", "mesh": 0, "translation": centre.tolist()}]
     if len(mesh.members):
-        seg = mesh.vertices[mesh.members.reshape(-1)] - centre
-        pos = seg.astype(np.float32)
-        attrs = {"POSITION": b.add(pos, "VEC3", _ARRAY_BUFFER, minmax=True),
-                 "_MEMBER_ID": b.add(np.repeat(mesh.member_id, 2).astype(np.float32),
-                                     "SCALAR", _ARRAY_BUFFER)}
-        materials.append({"name": "generators",
-                          "pbrMetallicRoughness": {"baseColorFactor": [0.1, 0.1, 0.12, 1.0],
-                                                   "metallicFactor": 0.0, "roughnessFactor": 1.0}})
-        meshes.append({"name": "generators",
-                       "primitives": [{"attributes": attrs, "mode": _LINES,
-                                       "material": len(materials) - 1}]})
-        nodes.append({"name": "generators", "mesh": 1, "translation": centre.tolist()})
+        _add_generators(b, mesh, centre, materials, meshes, nodes)
     doc = {
         "asset": {"version": "2.0", "generator": "ruledmesh"},
         "scene": 0,
@@ -212,12 +230,4 @@ def dumpb(mesh: Mesh, shading: str = "flat", quads: str = "shorter") -> bytes:
         "bufferViews": b.views,
         "buffers": [{"byteLength": b.size}],
     }
-    js = json.dumps(doc, separators=(",", ":")).encode("utf-8")
-    js += b" " * ((-len(js)) % 4)
-    binary = b"".join(b.chunks)
-    total = 12 + 8 + len(js) + 8 + len(binary)
-    return b"".join([
-        struct.pack("<4sII", b"glTF", 2, total),
-        struct.pack("<I4s", len(js), b"JSON"), js,
-        struct.pack("<I4s", len(binary), b"BIN\0"), binary,
-    ])
+    return _glb(doc, b)

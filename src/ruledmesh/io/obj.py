@@ -16,6 +16,7 @@ Blender's importer turns Y-up files to its Z-up by default, so import with
 from __future__ import annotations
 
 import io
+import itertools
 
 import numpy as np
 
@@ -136,7 +137,7 @@ def loads(text: str) -> Mesh:
             kinds.append(int(kind))
         elif tag == "l":
             ids = [index(t, lineno) for t in parts]
-            members.extend(zip(ids[:-1], ids[1:]))
+            members.extend(itertools.pairwise(ids))
         elif tag == "g":
             group_kind = labels.get(parts[0] if parts else "", FaceKind.POLYGON)
     if member_ids is not None and len(member_ids) != len(members):

@@ -24,9 +24,8 @@ construction, up to rounding that does not accumulate.
 
 from __future__ import annotations
 
-from .design import MESH_KEYS, build_pq
 from .maps import row_maps
 from .mesher import pq_mesh
 from .runs import MAX_GRID_POINTS
 
-__all__ = ["MAX_GRID_POINTS", "MESH_KEYS", "build_pq", "pq_mesh", "row_maps"]
+__all__ = ["MAX_GRID_POINTS", "pq_mesh", "row_maps"]

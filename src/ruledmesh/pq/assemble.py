@@ -195,7 +195,7 @@ def assemble(parts: list[Run], a, d, trim: bool, tol: Tolerances, ptol: float,
     # A vertex within rounding of the border counts as on it, so the decisions do
     # not flip when the design is scaled or moved (t is scale-free up to rounding).
     lo_t, hi_t = (-ON_BORDER, 1.0 + ON_BORDER) if trim else (-np.inf, np.inf)
-    good_v = ~FAR & (T >= lo_t) & (T <= hi_t)
+    good_v = ~FAR & (lo_t <= T) & (hi_t >= T)
     strip_quads = np.zeros((0, 4), np.int64)
     substituted = np.zeros(len(L), bool)
     if trim:
@@ -260,12 +260,12 @@ def to_mesh(V, T, G, faces, kinds, warnings, chain, gstart, scale, meet=None) ->
     ``meet`` (m,) bool marks generators that meet a neighbour (a coplanar pair):
     their vertices may coincide with the neighbour's and are merged with them.
     """
-    off = [np.zeros(1, np.int64)]
+    starts = [np.zeros(1, np.int64)]
     total = 0
     for f in faces:
-        off.append(np.arange(1, len(f) + 1, dtype=np.int64) * f.shape[1] + total)
+        starts.append(np.arange(1, len(f) + 1, dtype=np.int64) * f.shape[1] + total)
         total += f.size
-    off = np.concatenate(off)
+    off = np.concatenate(starts)
     idx = np.concatenate([f.reshape(-1) for f in faces]).astype(np.int64)
     kind = np.concatenate(kinds).astype(np.uint8)
     # Generators that share an end point (a torsal pair meeting on a director

@@ -83,7 +83,7 @@ def _cut_at(run: Run, primary: int, m: int) -> tuple[int | None, int | None]:
     bad = (run.failing >= 2) & (run.failing >= _RESTART_SHARE * np.maximum(run.on_patch, 1))
     right = [k for k in np.flatnonzero(bad) if k >= primary + 3 and m - k >= 3]
     left = [k for k in np.flatnonzero(bad) if k <= primary - 3 and k >= 2]
-    return (right[0] if right else None), (left[-1] if left else None)
+    return (int(right[0]) if right else None), (int(left[-1]) if left else None)
 
 
 def _uniform_t(rows: int) -> np.ndarray:
@@ -276,21 +276,14 @@ def pq_mesh(a, b, rows: int = 20, primary: int | str = "middle", option: int = 0
     plan = _Plan(a, d, tol, scale, warnings, frozenset(cg.tolist()))
     parts = _build_all(plan, segs, args.primary, args.middle,
                        Division(rows, args.option, args.extend, args.max_extend), m)
-    restarts = len([r for r in parts if len(r.left)]) - len([s for s in segs if s.hi - s.lo >= 2])
+    restarts = max(len([r for r in parts if len(r.left)]) - len([s for s in segs if s.hi - s.lo >= 2]), 0)
     even = _even_ranges(parts, segs, warnings)
-    meet = np.zeros(m, bool)
-    meet[:-1] |= flat
-    meet[1:] |= flat
+    meet = np.r_[flat, False] | np.r_[False, flat]      # generators of a coplanar pair
     mesh = assemble(parts, a, d, args.trim, tol, ptol, warnings, scale, meet, rows=rows)
-    paired = 0
-    if ptol > tol.planarity:
-        # A margin below the stated tolerance, so that rounding in another
-        # reader's measure cannot push a paired quad over it.
-        mesh, paired = pair_triangles(mesh, _PAIRING_MARGIN * ptol)
-    _warn_share(mesh, warnings, torsal.size, even, max(restarts, 0), m, rows)
+    mesh, paired = _paired(mesh, ptol, tol)
+    _warn_share(mesh, warnings, torsal.size, even, restarts, m, rows)
     _warn_splinters(mesh, warnings, torsal)
-    return mesh.with_info(runs=len(parts), restarts=max(restarts, 0), planarity_tolerance=ptol,
-                          paired=paired)
+    return mesh.with_info(runs=len(parts), restarts=restarts, planarity_tolerance=ptol, paired=paired)
 
 
 @dataclass(frozen=True)
@@ -428,6 +421,15 @@ def _warn_share(mesh: Mesh, warnings: list[str], torsal: int, even: list[str], r
     warnings.append(f"{share:.0%} of the area is not in quads ({'; '.join(causes) or 'border'}): "
                     "more generators (rulings.count), fewer rows, [mesh] planarity_tolerance = 1e-3 "
                     "for nearly developable parts, or method = \"hybrid\"")
+
+
+def _paired(mesh: Mesh, ptol: float, tol: Tolerances) -> tuple[Mesh, int]:
+    """Tolerance mode: triangle pairs planar within the tolerance become quads."""
+    if ptol <= tol.planarity:
+        return mesh, 0
+    # A margin below the stated tolerance, so that rounding in another reader's
+    # measure cannot push a paired quad over it.
+    return pair_triangles(mesh, _PAIRING_MARGIN * ptol)
 
 
 def _warn_splinters(mesh: Mesh, warnings: list[str], torsal: np.ndarray) -> None:

@@ -10,7 +10,7 @@ splinters, and the rows carry on across it.
 
 Chain *b*'s rows are free to start anywhere between chain *a*'s: each row is
 rooted in the middle of the interval of root parameters that keeps every face
-of the row convex on every generator it reaches (constructions.md §7).
+of the row convex on every generator it reaches.
 """
 
 from __future__ import annotations
@@ -152,7 +152,7 @@ def _root_b_rows(M: np.ndarray, N: np.ndarray, tau: np.ndarray, primary: int,
     """Chain *b*'s roots, each in the middle of the interval that keeps its faces convex.
 
     For b-row ``h`` between a-rows ``tau[2h]`` and ``tau[2h+2]`` every face it
-    takes part in gives an interval of admissible roots (constructions.md §7):
+    takes part in gives an interval of admissible roots:
     ``N_i^-1`` of the a-rows on a-generators, ``N_i`` of them on b-generators.
     The intervals are intersected from the primary outwards, as far as the
     intersection stays non-empty; the root is its middle.

@@ -5,7 +5,7 @@ vertex such that the axes at the two ends of every edge are coplanar with it
 (a *torsion-free support structure*).  Then every beam is a planar slab
 through its edge and both axes, and moving the vertices along their axes
 gives an *offset layer* whose faces are planar and parallel to the mesh's
-(constructions.md §8; Pottmann et al. 2007).
+(Pottmann et al. 2007, see docs/structure.md).
 
 =============================  ===============================================
 :mod:`.parallel`               the linear space of parallel meshes (sparse)

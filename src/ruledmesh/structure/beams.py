@@ -34,12 +34,12 @@ from .._validation import check_float
 from ..errors import GeometryError, ParameterError
 from ..fabricate.schedules import edge_schedule, member_schedule
 from ..mesh import FaceKind, Mesh
+from ..tolerances import TINY as _TINY
 from .normals import face_edges
 from .support import SupportStructure
 
 __all__ = ["Solids", "edge_beams", "edge_setbacks", "edge_table", "generator_beams", "thick_panels"]
 
-_TINY = 1e-300
 # Corner (in the cross-section of the box) order of the six faces of a slab whose
 # eight corners are [P0, P1, Q1, Q0] + w/2 m and the same - w/2 m.
 _BOX_FACES = np.array([[0, 1, 2, 3], [7, 6, 5, 4], [0, 4, 5, 1],

@@ -21,9 +21,9 @@ import numpy as np
 import scipy.sparse as sp
 from scipy.sparse.csgraph import breadth_first_order, connected_components
 
-__all__ = ["circular_axes"]
+from ..tolerances import TINY as _TINY
 
-_TINY = 1e-300
+__all__ = ["circular_axes"]
 
 
 def _tree(n: int, edges: np.ndarray) -> tuple[np.ndarray, np.ndarray]:

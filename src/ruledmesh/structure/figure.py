@@ -11,6 +11,7 @@ when given, are grey solids.  Headless matplotlib (Agg, no pyplot), as
 from __future__ import annotations
 
 import io
+from typing import Any
 
 import numpy as np
 
@@ -65,7 +66,7 @@ def render_structure(structure: SupportStructure, *, beams: Solids | None = None
     v, w = mesh.vertices, structure.offset
     fig = Figure(figsize=(size[0] / dpi, size[1] / dpi), dpi=dpi)
     FigureCanvasAgg(fig)
-    ax = fig.add_axes((-0.02, -0.05, 0.88, 1.1), projection="3d", computed_zorder=False)
+    ax: Any = fig.add_axes((-0.02, -0.05, 0.88, 1.1), projection="3d", computed_zorder=False)  # an untyped Axes3D
     shown = mesh if panels is None else panels.mesh
     ax.add_collection3d(Poly3DCollection(_polygons(shown), facecolors="#9ecae1", alpha=0.55,
                                          edgecolors="none" if panels is None else "#3182bd40",

@@ -30,6 +30,7 @@ import numpy as np
 from ..analysis.faces import face_normals, planarity, quad_planarity
 from ..mesh import Mesh
 from ..tolerances import DEFAULT, Tolerances
+from ..tolerances import TINY as _TINY
 
 __all__ = [
     "axis_deviation",
@@ -39,8 +40,6 @@ __all__ = [
     "face_parallelism",
     "offset_planarity",
 ]
-
-_TINY = 1e-300
 
 
 def _unit(v: np.ndarray) -> np.ndarray:

@@ -6,10 +6,9 @@ import numpy as np
 
 from ..analysis.faces import face_normals
 from ..mesh import Mesh
+from ..tolerances import TINY as _TINY
 
 __all__ = ["face_edges", "vertex_normals"]
-
-_TINY = 1e-300
 
 
 def vertex_normals(mesh: Mesh) -> np.ndarray:

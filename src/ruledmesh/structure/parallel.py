@@ -15,7 +15,7 @@ planar and parallel to those of ``V``, whatever their number of sides.
 target offset (``d`` times the vertex normals): a quadratic objective under
 the linear constraints, solved with one sparse factorisation of the
 regularised KKT matrix and iterative refinement towards the exact
-constraints (constructions.md §8).
+constraints.
 """
 
 from __future__ import annotations
@@ -26,9 +26,10 @@ import numpy as np
 import scipy.sparse as sp
 from scipy.sparse.linalg import splu
 
+from ..tolerances import TINY as _TINY
+
 __all__ = ["ParallelFit", "closest_parallel_offset", "edge_bases", "parallel_constraints"]
 
-_TINY = 1e-300
 # Regularisation of the KKT matrix, relative to its unit-size rows: small enough
 # that refinement converges in a few steps, large enough for a stable sparse LU.
 _DELTA = 1e-10
@@ -159,7 +160,7 @@ def closest_parallel_offset(vertices: np.ndarray, edges: np.ndarray, normals: np
     scale = abs(distance)
     residual = np.inf
     steps = 0
-    for steps in range(1, max_steps + 1):
+    for steps in range(1, max_steps + 1):  # noqa: B007 - the count is returned
         r1 = q - Q @ x - C.T @ lam
         r2 = -(C @ x)
         dx = lu.solve(np.concatenate([r1, r2]))

@@ -38,14 +38,13 @@ from ..analysis.faces import planarity
 from ..errors import GeometryError, ParameterError
 from ..mesh import Mesh
 from ..tolerances import DEFAULT, Tolerances
+from ..tolerances import TINY as _TINY
 from . import measures as M
 from .circular import circular_axes
 from .normals import face_edges, vertex_normals
 from .parallel import closest_parallel_offset
 
 __all__ = ["AxisMethod", "SupportStructure", "measure_structure", "support_structure"]
-
-_TINY = 1e-300
 
 
 class AxisMethod(str, Enum):

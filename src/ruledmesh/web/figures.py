@@ -40,7 +40,7 @@ def _worker_main(conn) -> None:  # pragma: no cover - runs in the child process
         try:
             built = build_design(Design(data, source, Path(base_dir)))
             figures, per_face = slow_figures(built)
-            reply = (version, figures, per_face, None)
+            reply: tuple = (version, figures, per_face, None)
         except RuledMeshError as exc:
             reply = (version, {}, None, str(exc))
         except Exception as exc:  # noqa: BLE001 - reported to the page, never a dead worker
@@ -62,11 +62,11 @@ class FigureWorker:
     def __init__(self) -> None:
         self._ctx = mp.get_context("spawn")  # never fork a threaded server
         self._cond = threading.Condition()
-        self._wanted: tuple | None = None  # (version, data, source, base_dir)
+        self._wanted: Any = None  # None or (version, data, source, base_dir)
         self._result: tuple | None = None  # (version, figures, per_face, error)
         self._closed = False
-        self._proc = None
-        self._conn = None
+        self._proc: Any = None
+        self._conn: Any = None
         self._thread = threading.Thread(target=self._run, name="figures", daemon=True)
         self._thread.start()
 

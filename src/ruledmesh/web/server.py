@@ -176,7 +176,7 @@ class _DeadlineH11(H11Protocol):
 
     deadline = REQUEST_TIMEOUT
 
-    def connection_made(self, transport) -> None:  # type: ignore[no-untyped-def]
+    def connection_made(self, transport) -> None:
         self._timer: Any = None
         self._timed_cycle: Any = None
         super().connection_made(transport)

@@ -20,9 +20,10 @@ import importlib
 import json
 import math
 import threading
+from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Any, Mapping, Sequence
+from typing import Any
 
 import numpy as np
 
@@ -245,7 +246,7 @@ def fast_figures(mesh: Mesh) -> tuple[dict[str, Any], np.ndarray]:
         "planarity_max": float(plan.max()) if plan.size else 0.0,
         "planarity_tolerance": DEFAULT.planarity,
         "non_convex": int(np.count_nonzero(~convex)),
-        "members": int(len(mesh.members)),
+        "members": len(mesh.members),
         "warnings": [str(w) for w in mesh.info.get("warnings", [])],
     }, plan
 
@@ -717,7 +718,7 @@ def _curve_polylines(design: Mapping) -> tuple[list[str], list[int], np.ndarray]
 
     Curves that do not build are left out (the build reports their errors).
     """
-    from ..curves import curve_from_spec
+    from ..design.curves import curve_from_spec
 
     names: list[str] = []
     counts: list[int] = []
@@ -786,8 +787,6 @@ def _handles(design: Mapping, mesh: Mesh) -> list[dict[str, Any]]:
     surface = design.get("surface", {})
     if isinstance(surface, Mapping):
         for key, value in surface.items():
-            if _is_points(value) and len(value) >= 2:
-                points(["surface", key], value, key)
-            elif key in _POSITION_KEYS:
+            if (_is_points(value) and len(value) >= 2) or key in _POSITION_KEYS:
                 points(["surface", key], value, key)
     return handles

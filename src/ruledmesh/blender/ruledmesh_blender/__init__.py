@@ -21,10 +21,10 @@ from __future__ import annotations
 import json
 import os
 import sys
+import tomllib
 
 import bpy
 import numpy as np
-import tomllib
 from bpy.props import EnumProperty, IntProperty, PointerProperty, StringProperty
 from bpy_extras.io_utils import ImportHelper
 

@@ -34,7 +34,7 @@ def axis_frame(direction: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarra
     """Right-handed orthonormal ``(e1, e2, a)`` with ``a`` along ``direction``.
 
     For the z direction this is the standard basis (so angles are measured
-    from the x axis, as in the formulas of the issue).
+    from the x axis, as in the formulas of the paper).
     """
     a = np.asarray(direction, dtype=np.float64)
     a = a / np.linalg.norm(a)

@@ -12,20 +12,20 @@ from __future__ import annotations
 import math
 import os
 import tomllib
+from collections.abc import Mapping
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Any, Mapping
+from typing import Any
 
 import numpy as np
 
-from . import budget as _budget
-from ._validation import check_keys, describe, near_miss
-from .errors import DesignError, GeometryError, RuledMeshError
-from .progress import SILENT, Progress, Task, stages
-from .registry import (MESH_METHODS, SURFACE_KINDS, TRANSFORMS, BuildContext, Built,
-                       load_plugins)
+from .. import budget as _budget
+from .._validation import check_keys, describe, near_miss
+from ..errors import DesignError, GeometryError, RuledMeshError
+from ..progress import SILENT, Progress, Task, stages
+from ..registry import MESH_METHODS, SURFACE_KINDS, TRANSFORMS, BuildContext, Built, load_plugins
 
-__all__ = ["Design", "load_design", "parse_design", "build_design", "build_file"]
+__all__ = ["Design", "load_design", "parse_design", "design_from_tables", "build_design", "build_file"]
 
 TOP_LEVEL = ("curves", "rulings", "mesh", "surface", "transform", "name", "description", "units")
 
@@ -70,6 +70,19 @@ def parse_design(text: str, source: str = "<design>", base_dir: str | os.PathLik
         raise DesignError(f"invalid design: tables or arrays nested deeper than the TOML "
                           f"reader can follow (a design needs at most {MAX_NESTING} levels)",
                           None, source) from None
+    return design_from_tables(data, source, base_dir)
+
+
+def design_from_tables(data: Mapping[str, Any], source: str = "<dict>",
+                       base_dir: str | os.PathLike = ".") -> Design:
+    """A :class:`Design` from tables already parsed (a dict shaped like the TOML file).
+
+    Raises
+    ------
+    DesignError
+        For unknown top-level tables, nesting deeper than :data:`MAX_NESTING`
+        and numbers no design needs, naming ``source``.
+    """
     _check_tree(data, source)
     try:
         check_keys(data, TOP_LEVEL, "", err=DesignError)
@@ -112,7 +125,7 @@ def _check_tree(data: Any, source: str) -> None:
 
 def _check_number(value: float, path: str, source: str) -> None:
     """Refuse a number no design field needs (see :func:`_check_tree`)."""
-    from .normalise import MAX_COORDINATE, MIN_EXTENT
+    from ..normalise import MAX_COORDINATE, MIN_EXTENT
 
     size = abs(value)
     if math.isinf(size) or math.isnan(size):
@@ -138,8 +151,8 @@ def load_design(path: str | os.PathLike) -> Design:
     A relative ``examples/NAME.toml`` that does not exist here is the bundled
     example of that name (:func:`ruledmesh.bundled.resolve`).
     """
-    from ._files import MAX_DESIGN_BYTES, FileRefused, read_capped
-    from .bundled import resolve
+    from .._files import MAX_DESIGN_BYTES, FileRefused, read_capped
+    from ..bundled import resolve
 
     path = resolve(path)
     try:
@@ -164,7 +177,7 @@ def _table(data: Mapping, key: str, required: bool = False) -> Mapping:
 
 def _build(design: Design, progress: Progress) -> Built:
     data = design.data
-    from .units import unit_of
+    from ..units import unit_of
 
     units = unit_of(data.get("units"), "units", err=DesignError)
     load_plugins()
@@ -233,8 +246,8 @@ def _in_range(mesh: Any, what: str, hint: str = "") -> None:
     hold faithfully (:func:`ruledmesh.normalise.check_range`).  The message
     passes on what the mesher said about the parts it could not mesh.
     """
-    from .analysis.faces import degenerate_faces, face_normals
-    from .normalise import check_range, unit_frame
+    from ..analysis.faces import degenerate_faces, face_normals
+    from ..normalise import check_range, unit_frame
 
     v = np.asarray(mesh.vertices, dtype=np.float64)
     said = "; ".join(str(w) for w in mesh.info.get("warnings", [])[:2])
@@ -318,7 +331,7 @@ def curve_kinks(curve) -> np.ndarray:
     Polyline corners, and knots of a B-spline repeated ``degree`` times (every
     interior knot of a degree-1 spline).
     """
-    from .curves import BSpline, Polyline
+    from ..curves import BSpline, Polyline
 
     if isinstance(curve, Polyline):
         return np.asarray(curve._knots[1:-1], dtype=float)
@@ -402,7 +415,7 @@ def _kink_parameter(rail: Any, u0: float, u1: float, kink: float) -> float | Non
     f1 = float(sigma.value(np.float64(u1))) - kink
     if f0 == 0.0 or f1 == 0.0 or f0 * f1 > 0:
         return None
-    from ._roots import brentq
+    from ..roots import brentq
 
     u = brentq(lambda x: float(sigma.value(np.float64(x))) - kink, u0, u1, xtol=1e-15)
     if u - u0 < 1e-6 * (u1 - u0) or u1 - u < 1e-6 * (u1 - u0):

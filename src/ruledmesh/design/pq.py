@@ -1,4 +1,4 @@
-"""Design-file builder for ``[mesh] method = "pq"``."""
+"""Design-file builder for ``[mesh] method = "pq"`` (the §4.3 mesher of :mod:`ruledmesh.pq`)."""
 
 from __future__ import annotations
 
@@ -9,9 +9,8 @@ import numpy as np
 
 from .._validation import check_bool, check_float, check_int, check_keys, describe
 from ..errors import DesignError, GeometryError
+from ..pq import MAX_GRID_POINTS, pq_mesh
 from ..registry import BuildContext, Built, mesh_method
-from .mesher import pq_mesh
-from .runs import MAX_GRID_POINTS
 
 __all__ = ["MESH_KEYS", "build_pq"]
 
@@ -51,7 +50,7 @@ def build_pq(rulings, table: Mapping[str, Any], ctx: BuildContext) -> Built:
         rulings, mesh = _refined(rulings, mesh, options)
     reference = None
     if getattr(rulings, "surface", None) is not None:
-        from ..analysis.surface import RuledReference
+        from ..surfaces import RuledReference
 
         reference = RuledReference(rulings.surface)
     return Built(mesh.with_info(source=ctx.source), reference, rulings)
@@ -80,12 +79,12 @@ def _refined(rulings, mesh, options: dict):
     from dataclasses import replace
 
     from ..analysis.faces import area_shares
-    from ..rulings import _dense_grid
+    from ..rulings import dense_grid
 
     surface = getattr(rulings, "surface", None)
     if surface is None or rulings.info.get("distribution") == "lines":
         return rulings, mesh
-    grid, _ = _dense_grid(len(rulings.u))
+    grid, _ = dense_grid(len(rulings.u))
     best = (area_shares(mesh)["quads"], rulings, mesh)
     user = len(rulings.u) - int(rulings.info.get("inserted", 0))
     start = len(rulings.u)

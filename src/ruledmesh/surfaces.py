@@ -1,4 +1,14 @@
-"""Smooth reference surfaces of the catalogue kinds: distance and area.
+"""Smooth reference surfaces: the design surface a mesh is measured against.
+
+Two kinds, both answering ``distance(points)`` and ``area()`` (the
+:class:`~ruledmesh.registry.Reference` protocol): :class:`ImplicitSurface` for
+the catalogue kinds, and :class:`RuledReference` for a parametric ruled patch
+(director curves, generators).
+
+:class:`RuledReference` wraps a patch with ``point(u, t)``, ``partials(u, t)``
+and ``area()`` and measures how far points are from ``0 <= u, t <= 1``: a
+nearest sample on a fine grid seeds a few vectorised Gauss-Newton steps on
+``|S(u, t) - p|^2`` with ``(u, t)`` clamped to the patch.
 
 A reference answers ``distance(points)`` and ``area()`` (the
 :class:`~ruledmesh.registry.Reference` protocol).  Catalogue references are
@@ -18,12 +28,18 @@ whole surface, not only the meshed patch.
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from dataclasses import dataclass
-from typing import Callable
 
 import numpy as np
 
+from .analysis.surface import RuledPatch, RuledReference
+from .errors import GeometryError
+from .tolerances import TINY as _TINY
+
 __all__ = [
+    "RuledPatch",
+    "RuledReference",
     "ImplicitSurface",
     "newton_distance",
     "parametric_area",
@@ -32,8 +48,6 @@ __all__ = [
     "revolution_of_polyline",
     "pipe_of_polyline",
 ]
-
-_TINY = 1e-300
 
 
 def newton_distance(value: Callable, gradient: Callable, points: np.ndarray,
@@ -92,6 +106,8 @@ class ImplicitSurface:
         points = np.asarray(points, dtype=np.float64).reshape(-1, 3)
         if self.exact is not None:
             return self.exact(points)
+        if self.value is None or self.gradient is None:
+            raise GeometryError("the implicit surface has neither a distance nor a value and gradient")
         return newton_distance(self.value, self.gradient, points)
 
     def area(self) -> float | None:
