@@ -141,6 +141,52 @@ def test_session_drag_gesture_is_one_undo_step():
     assert not s.can_undo
 
 
+def test_history_lists_every_step_and_follows_undo_and_redo():
+    s = Session(SMALL)
+    seen = []
+    s.add_listener(seen.append)
+    s.edit([(["mesh", "rows"], 8)])
+    pts = s.design["curves"]["c1"]["points"]
+    s.edit([(["curves", "c1", "points"], [*pts[:2], [4.5, 0, 0], *pts[2:]])])  # inserted
+    for k in range(3):  # a drag: one step
+        s.edit([(["curves", "c2", "points", 1], [3, 4 + 0.1 * k, 5])], coalesce="drag:c2")
+    assert s.history() == {"undo": ["opened", "mesh.rows = 8", "curves.c1.points: 5 points"],
+                           "current": "curves.c2.points[1] moved", "redo": []}
+    s.undo()
+    s.undo()
+    assert s.history() == {"undo": ["opened"], "current": "mesh.rows = 8",
+                           "redo": ["curves.c1.points: 5 points", "curves.c2.points[1] moved"]}
+    assert len(s.design["curves"]["c1"]["points"]) == 4
+    s.redo()
+    assert s.history()["current"] == "curves.c1.points: 5 points"
+    assert len(s.design["curves"]["c1"]["points"]) == 5
+    # every change was announced, once, with its version
+    assert seen == list(range(1, 9))
+    with pytest.raises(DesignError):
+        s.edit([(["mesh", "rows"], -1)])
+    assert seen == list(range(1, 9))  # a refused edit announces nothing
+
+
+def test_panel_read_out_is_the_schedule_row_and_the_unrolled_outline():
+    from ruledmesh.fabricate import panel_table
+
+    s = Session(SMALL)
+    mesh = s.built.mesh
+    table = panel_table(mesh)
+    f = mesh.n_faces // 2
+    info = s.panel(f)
+    assert info["row"]["label"] == f"P{f}" == table["label"][f]
+    assert info["row"]["area"] == pytest.approx(table["area"][f])
+    outline = np.array(info["outline"])
+    assert outline.shape == (mesh.valences[f], 2)
+    # the outline is the face laid flat: the same edge lengths as in space
+    corners = mesh.vertices[mesh.face(f)]
+    assert np.allclose(np.linalg.norm(np.roll(outline, -1, 0) - outline, axis=1),
+                       np.linalg.norm(np.roll(corners, -1, 0) - corners, axis=1))
+    with pytest.raises(ParameterError, match="face"):
+        s.panel(mesh.n_faces)
+
+
 def test_bad_edit_is_refused_with_the_field_and_state_kept():
     s = Session(SMALL)
     before, v = s.design, s.version

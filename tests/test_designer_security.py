@@ -129,11 +129,89 @@ def designer(tmp_path):
 
 
 API = [("GET", "/api/state", None), ("GET", "/api/figures?version=0", None),
-       ("GET", "/api/download?format=.obj", None),
+       ("GET", "/api/download?format=.obj", None), ("GET", "/api/panel?face=0", None),
        ("POST", "/api/edit", {"changes": [[["mesh", "rows"], 13]]}),
        ("POST", "/api/design", {"toml": SMALL.replace("rows = 6", "rows = 13")}),
        ("POST", "/api/undo", {}), ("POST", "/api/save", {"path": "evil.toml"}),
        ("POST", "/api/export", {"format": ".obj", "path": "evil.obj"})]
+
+
+# ---------------------------------------------------------------- live updates (WebSocket)
+def ws_handshake(d: Designer, query: str, origin: str | None = "own", host: str | None = None,
+                 wait: float = 5.0) -> tuple[socket.socket, bytes]:
+    """Open ``/api/live`` with a raw WebSocket handshake; the socket and the first bytes read."""
+    s = socket.create_connection((d.host, d.port), timeout=wait)
+    lines = [f"GET /api/live{query} HTTP/1.1", f"Host: {host or f'127.0.0.1:{d.port}'}",
+             "Upgrade: websocket", "Connection: Upgrade",
+             "Sec-WebSocket-Key: dGhlIHNhbXBsZSBub25jZQ==", "Sec-WebSocket-Version: 13"]
+    if origin is not None:
+        lines.append(f"Origin: {f'http://127.0.0.1:{d.port}' if origin == 'own' else origin}")
+    s.sendall(("\r\n".join(lines) + "\r\n\r\n").encode())
+    data = b""
+    try:
+        while b"\r\n\r\n" not in data:
+            chunk = s.recv(4096)
+            if not chunk:
+                break
+            data += chunk
+    except TimeoutError:
+        pass
+    return s, data
+
+
+@pytest.mark.parametrize(("query", "origin", "host"), [
+    ("", "own", None),                                   # no token
+    ("?token=wrong", "own", None),                       # a wrong token
+    ("?token={token}", None, None),                      # no Origin (not a browser page)
+    ("?token={token}", "http://127.0.0.1:1", None),       # another local origin
+    ("?token={token}", "https://evil.example", None),     # a foreign page
+    ("?token={token}", "http://evil.example", "evil.example"),  # DNS rebinding
+])
+def test_live_socket_needs_token_origin_and_host(designer, query, origin, host):
+    s, answer = ws_handshake(designer, query.format(token=designer.token), origin, host)
+    s.close()
+    assert answer.startswith(b"HTTP/1.1 403"), answer[:80]
+    # a refused socket learns nothing and changes nothing
+    assert b"version" not in answer
+    designer.untouched()
+
+
+def test_live_socket_with_token_tells_every_change(designer):
+    s, answer = ws_handshake(designer, f"?token={designer.token}")
+    assert answer.startswith(b"HTTP/1.1 101"), answer[:80]
+    rest = answer.split(b"\r\n\r\n", 1)[1]
+    status, _ = designer.request("POST", "/api/edit", {"changes": [[["mesh", "rows"], 7]]})
+    assert status == 200
+    status, _ = designer.request("POST", "/api/undo", {})
+    assert status == 200
+    s.settimeout(10)
+    buf = rest
+    frames = []
+    while len(frames) < 3:
+        while len(buf) >= 2 and buf[1] & 0x7F <= len(buf) - 2 and len(frames) < 3:
+            n = buf[1] & 0x7F
+            frames.append(json.loads(buf[2:2 + n]))
+            buf = buf[2 + n:]
+        if len(frames) < 3:
+            buf += s.recv(4096)
+    s.close()
+    # the version on connecting, after the edit, after the undo (never fewer, never stale)
+    assert [f["version"] for f in frames] == [0, 1, 2]
+
+
+def test_live_sockets_are_bounded(designer):
+    from ruledmesh.web.server import MAX_LIVE
+
+    socks = [ws_handshake(designer, f"?token={designer.token}") for _ in range(MAX_LIVE)]
+    assert all(a.startswith(b"HTTP/1.1 101") for _, a in socks)
+    extra, answer = ws_handshake(designer, f"?token={designer.token}")
+    # over the limit: accepted by none (closed with "try again later" or refused)
+    assert not answer.startswith(b"HTTP/1.1 101"), answer[:80]
+    for s, _ in [*socks, (extra, b"")]:
+        s.close()
+    # the server still answers at once
+    status, _ = designer.request("GET", "/api/state")
+    assert status == 200
 
 
 # ---------------------------------------------------------------- token, Host, Origin
