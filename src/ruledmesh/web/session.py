@@ -764,7 +764,7 @@ class Session:
         else:
             gens = np.zeros((0, 2, 3))
         arrays.append(("generators", gens.astype(np.float32)))
-        arrays.append(("torsal", _torsal(gens, mesh)))
+        arrays.append(("torsal", _torsal(np.asarray(gens, dtype=np.float64), mesh)))
         header["figures"] = figures
         header["construction"] = _construction(snap.design, len(gens))
         names, counts, points = _curve_polylines(snap.design)
@@ -813,22 +813,31 @@ class Session:
 
 
 def _torsal(gens: np.ndarray, mesh: Mesh) -> np.ndarray:
-    """(k,) uint32: generators where the twist of the rulings changes sign (torsal ones).
+    """(k,) uint32: the torsal generators, where the mesher restarts its rows.
 
-    The twist of consecutive generators (:func:`ruledmesh.hop.coplanarity`)
-    changes sign across a torsal generator; the one of each pair with the
-    smaller twist is marked.
+    As the PQ mesher finds them: a pair of consecutive generators that is
+    coplanar (twist :func:`ruledmesh.hop.coplanarity` within the tolerance
+    ``degenerate``) marks both, a change of the twist's sign marks the
+    generator where it changes.
+
+    Parameters
+    ----------
+    gens : (m, 2, 3) float64
+        End points of the generators.
     """
     from ..hop import coplanarity
+    from ..tolerances import DEFAULT
 
     if len(gens) < 3:
         return np.zeros(0, np.uint32)
-    a, d = gens[:, 0].astype(float), (gens[:, 1] - gens[:, 0]).astype(float)
+    a, d = gens[:, 0], gens[:, 1] - gens[:, 0]
     twist = coplanarity(a, d, mesh.diagonal() or 1.0)
-    sign = np.sign(twist)
-    flips = np.flatnonzero(sign[:-1] * sign[1:] < 0)
-    # twist[k] is between generators k and k + 1: the flip sits at generator k + 1.
-    return (flips + 1).astype(np.uint32)
+    flat = np.abs(twist) <= DEFAULT.degenerate
+    sign = np.sign(np.where(flat, 0.0, twist))
+    flips = np.flatnonzero(sign[:-1] * sign[1:] < 0) + 1
+    pairs = np.flatnonzero(flat)
+    marked = np.unique(np.concatenate([flips, pairs, pairs + 1]))
+    return marked.astype(np.uint32)
 
 
 def _construction(design: Mapping, generators: int) -> dict[str, Any]:
