@@ -187,6 +187,23 @@ def test_panel_read_out_is_the_schedule_row_and_the_unrolled_outline():
         s.panel(mesh.n_faces)
 
 
+def test_catalogue_surfaces_build_in_the_worker_process():
+    """Regression: a catalogue surface's reference (a closure) made every edit a 500."""
+    from ruledmesh.web.builder import BuildWorker
+
+    worker = BuildWorker()
+    try:
+        for name in ("fig5b-torus", "fig8-helicoid", "sec2-rotational"):
+            path = ROOT / "examples" / f"{name}.toml"
+            s = Session(path.read_text(), path, builder=worker)
+            key = "R" if name.endswith("torus") else "radius" if "helicoid" in name else "angle"
+            value = s.design["surface"][key]
+            s.edit([(["surface", key], value * 1.25)])
+            assert s.design["surface"][key] == value * 1.25 and s.built.mesh.n_faces > 0
+    finally:
+        worker.close()
+
+
 def test_bad_edit_is_refused_with_the_field_and_state_kept():
     s = Session(SMALL)
     before, v = s.design, s.version

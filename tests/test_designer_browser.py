@@ -767,3 +767,40 @@ def test_every_numeric_field_of_the_method_has_a_widenable_slider(page, designer
     set_field(page, "mesh.divisions", 5)
     assert designer.session.design["mesh"] == {"method": "hybrid", "divisions": 5}
     shot(page, "hybrid-fields")
+
+
+def test_catalogue_surface_handles_drag_its_radius(browser, tmp_path):
+    torus = (Path(__file__).resolve().parents[1] / "examples" / "fig5b-torus.toml").read_text()
+    path = tmp_path / "torus.toml"
+    path.write_text(torus)
+    server = make_server(Session(torus, path), port=0)
+    thread = threading.Thread(target=server.serve_forever, daemon=True)
+    thread.start()
+    pg = browser.new_page()
+    try:
+        pg.goto(server.url)
+        pg.wait_for_selector("body[data-version]", timeout=20_000)
+        pg.click('[data-view="top"]')
+        pg.wait_for_function("window.designer.view === 'top'")
+        handles = {h["label"]: h for h in pg.evaluate("window.designer.handles()")}
+        assert {"R", "r"} <= set(handles)
+        h = handles["R"]
+        R0 = server.session.design["surface"]["R"]
+        v = pg.evaluate("window.designer.version")
+        pg.mouse.move(h["x"], h["y"])
+        pg.mouse.down()
+        for k in range(1, 7):
+            pg.mouse.move(h["x"] + 8 * k, h["y"] + 3 * k)   # mostly along +x: a larger R
+        pg.mouse.up()
+        wait_version(pg, v)
+        pg.wait_for_function("!window.designer.busy()")
+        R1 = server.session.design["surface"]["R"]
+        assert R1 > R0 + 0.2
+        # the handle sits at the new radius from the centre, on the x axis
+        lo, hi = server.session.built.mesh.bounding_box()
+        assert hi[0] == pytest.approx(R1 + server.session.design["surface"]["r"], rel=0.02)
+        shot(pg, "torus-radius")
+    finally:
+        pg.close()
+        server.shutdown()
+        server.server_close()

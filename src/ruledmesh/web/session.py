@@ -950,4 +950,51 @@ def _handles(design: Mapping, mesh: Mesh) -> list[dict[str, Any]]:
         for key, value in surface.items():
             if _is_points(value) and len(value) >= 2 or key in _POSITION_KEYS:
                 points(["surface", key], value, key)
+            elif isinstance(value, Mapping) and _is_point(value.get("point")):
+                # an axis {point, direction}: the point, and the direction as a normal handle
+                points(["surface", key, "point"], value["point"], f"{key}.point")
+                _direction_handle(handles, ["surface", key, "direction"], value.get("direction"),
+                                  np.asarray(value["point"], float), mesh, f"{key}.direction")
+        _size_handles(handles, surface, mesh)
     return handles
+
+
+# Length fields of catalogue surfaces with a handle: the axis it is measured along from the
+# surface's centre, and the distance per unit of the field (height: half above the centre).
+_SIZE_KEYS = {"R": (0, 1.0), "radius": (0, 1.0), "a": (0, 1.0), "r": (1, 1.0), "b": (1, 1.0),
+              "c": (2, 1.0), "height": (2, 0.5)}
+
+
+def _direction_handle(handles: list, path: list, direction: Any, anchor: np.ndarray, mesh: Mesh,
+                      label: str) -> None:
+    if not _is_point(direction) or not mesh.n_vertices:
+        return
+    n = np.asarray(direction, dtype=float)
+    norm = float(np.linalg.norm(n))
+    if norm > 0:
+        length = 0.35 * (mesh.diagonal() or 1.0)
+        handles.append({"path": path, "kind": "normal", "anchor": anchor.tolist(),
+                        "position": (anchor + n / norm * length).tolist(), "label": label})
+
+
+def _size_handles(handles: list, surface: Mapping, mesh: Mesh) -> None:
+    """Handles for a catalogue surface's lengths (radius, R, r, a, b, c, height).
+
+    Each is ``{"kind": "size", "anchor", "axis", "scale", "position"}``: the
+    handle sits at ``anchor + value * scale * axis`` and moves along ``axis``.
+    """
+    if not mesh.n_vertices:
+        return
+    centre = mesh.bounding_box().mean(axis=0)
+    for key, (axis, scale) in _SIZE_KEYS.items():
+        value = surface.get(key)
+        if isinstance(value, bool) or not isinstance(value, (int, float)) or value <= 0:
+            continue
+        unit = np.eye(3)[axis]
+        anchor = centre
+        big = surface.get("R")
+        if key == "r" and isinstance(big, (int, float)) and not isinstance(big, bool):
+            anchor, unit = centre + big * np.eye(3)[0], np.eye(3)[0]  # the tube about R
+        handles.append({"path": ["surface", key], "kind": "size", "anchor": anchor.tolist(),
+                        "axis": unit.tolist(), "scale": scale,
+                        "position": (anchor + value * scale * unit).tolist(), "label": key})

@@ -307,7 +307,8 @@ function drawLegend(mode) {
     : '';
   legend.innerHTML = `${sc.label}${values ? '' : ' (computing...)'}<div class="ramp" style="background:linear-gradient(90deg,${
     rampCss()})">${mark}</div><div class="ticks"><span>${tick(sc.lo)}</span>${sc.mark !== undefined
-    ? '<span>tol</span>' : ''}<span>${tick(sc.hi)}</span></div>${figures}`;
+    ? `<span class="tol" style="left:${100 * (sc.mark - sc.lo) / (sc.hi - sc.lo)}%">tolerance</span>`
+    : ''}<span>${tick(sc.hi)}</span></div>${figures}`;
   return stats;
 }
 
@@ -462,6 +463,7 @@ let generatorsTouched = false;
 function drawGenerators(reuse) {
   const G = current.arrays.generators;
   const old = layers.generators.children[0];
+  if (!G.length) { clearGroup(layers.generators); return; }  // a catalogue surface: none
   if (reuse && old && old.geometry.getAttribute('position').array.length === G.length) {
     setAttribute(old.geometry, 'position', G, 3);
     old.computeLineDistances();
@@ -598,21 +600,26 @@ function drawHandles() {
   clearGroup(layers.handles);
   const r = 0.012 * size;
   const sphere = new THREE.SphereGeometry(1, 16, 12);
+  const cube = new THREE.BoxGeometry(1.6, 1.6, 1.6);
   const labels = new Set(current.header.handles.map((h) => h.label));
   for (const l of [...selection]) if (!labels.has(l)) selection.delete(l);
   if (primaryLabel && !labels.has(primaryLabel)) primaryLabel = null;
   for (const h of current.header.handles) {
-    const normal = h.kind === 'normal';
+    const normal = h.kind === 'normal', sized = h.kind === 'size';
     const picked = selection.has(h.label);
-    const mat = new THREE.MeshBasicMaterial({ color: picked ? 0x1d4ed8 : normal ? 0x10a060 : 0xff6a00 });
-    const m = new THREE.Mesh(sphere.clone(), mat);
+    // Drawn over the faces: a handle inside a tube or behind a sheet can still be taken.
+    const mat = new THREE.MeshBasicMaterial({
+      color: picked ? 0x1d4ed8 : normal ? 0x10a060 : sized ? 0x8a2be2 : 0xff6a00,
+      depthTest: false, transparent: true, opacity: 0.95 });
+    const m = new THREE.Mesh(sized ? cube.clone() : sphere.clone(), mat);
+    m.renderOrder = 10;
     m.scale.setScalar((normal ? 1.4 : 1) * (picked ? 1.35 : 1) * r);
     m.position.set(...h.position);
     m.userData.handle = h;
     layers.handles.add(m);
-    if (normal) {
+    if (normal || sized) {
       const seg = new Float32Array([...h.anchor, ...h.position]);
-      const line = lines(seg, null, 0x10a060);
+      const line = lines(seg, null, sized ? 0x8a2be2 : 0x10a060);
       line.userData.isLeash = true;
       m.userData.leash = line;
       layers.handles.add(line);
@@ -620,6 +627,7 @@ function drawHandles() {
     if (attached && h.label === attached && !dragging) gizmo.attach(m);
   }
   sphere.dispose();
+  cube.dispose();
   showSelection();
 }
 
@@ -652,7 +660,7 @@ function showSelection() {
     : selection.size === 1 ? primaryLabel : `${selection.size} points (${primaryLabel} typed)`;
   for (const [i, axis] of ['x', 'y', 'z'].entries()) {
     const input = $(`sel-${axis}`);
-    input.disabled = !h;
+    input.disabled = !h || h.kind !== 'point';
     if (document.activeElement !== input) input.value = h ? +h.position[i].toFixed(6) : '';
   }
   const list = h && h.kind === 'point' ? listOf(h) : null;
@@ -1410,6 +1418,10 @@ function pick(event) {
 
 function handleValue(h, pos) {
   const r = (x) => +x.toFixed(6);
+  if (h.kind === 'size') {   // the length along the handle's axis, kept positive
+    const along = pos.clone().sub(new THREE.Vector3(...h.anchor)).dot(new THREE.Vector3(...h.axis));
+    return along > 0 ? r(along / h.scale) : null;
+  }
   if (h.kind === 'normal') {
     const n = pos.clone().sub(new THREE.Vector3(...h.anchor));
     if (n.length() < 1e-9 * size) return null;
@@ -1434,6 +1446,10 @@ function selectionStarts() {
 function moveHandle(m, pos, starts) {
   const h = m.userData.handle;
   if (h.kind === 'point') pos = snapped(pos, h);
+  if (h.kind === 'size') {   // slides along its axis
+    const a = new THREE.Vector3(...h.anchor), u = new THREE.Vector3(...h.axis);
+    pos = a.clone().addScaledVector(u, pos.clone().sub(a).dot(u));
+  }
   m.position.copy(pos);
   if (m.userData.leash) {
     const a = m.userData.leash.geometry.attributes.position;
