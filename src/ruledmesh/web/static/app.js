@@ -55,7 +55,9 @@ async function api(method, name, body) {
   if ((response.headers.get('Content-Type') || '').startsWith('application/json')) {
     return response.json();
   }
-  const msg = decode(await response.arrayBuffer());
+  const raw = await response.arrayBuffer();
+  const msg = decode(raw);
+  msg.raw = raw;
   const timing = /dur=([0-9.]+)/.exec(response.headers.get('Server-Timing') || '');
   msg.serverMs = timing ? parseFloat(timing[1]) : null;
   return msg;
@@ -84,7 +86,19 @@ function status(text) { $('status').textContent = text; }
 
 // ------------------------------------------------------------------ scene
 const canvas = $('canvas');
-const renderer = new THREE.WebGLRenderer({ canvas, antialias: true, preserveDrawingBuffer: true });
+// Multisampling is cheap on a graphics card but costs a software renderer (SwiftShader, as
+// in headless or GPU-less browsers) most of each frame: there it is off.
+function softwareGL() {
+  try {
+    const gl = document.createElement('canvas').getContext('webgl2');
+    const info = gl && gl.getExtension('WEBGL_debug_renderer_info');
+    const name = info ? gl.getParameter(info.UNMASKED_RENDERER_WEBGL) : '';
+    gl?.getExtension('WEBGL_lose_context')?.loseContext();
+    return /swiftshader|llvmpipe|software/i.test(name);
+  } catch (err) { return false; }
+}
+const SOFTWARE_GL = softwareGL();
+const renderer = new THREE.WebGLRenderer({ canvas, antialias: !SOFTWARE_GL, preserveDrawingBuffer: true });
 renderer.setPixelRatio(Math.min(window.devicePixelRatio, 2));
 const scene = new THREE.Scene();
 scene.background = new THREE.Color(0xfafafa);
@@ -577,15 +591,16 @@ function drawScene() {
   size = Math.hypot(hi[0] - lo[0], hi[1] - lo[1], hi[2] - lo[2]) || 1;
   // Buffers of the same size are written in place (no new GPU buffers, no garbage): a
   // moved point or a continuous slider mostly keeps the face and edge counts.
-  faceGeometry();
-  drawFaces();
-  drawEdges();
-  drawGenerators(true);
-  drawCurves();
-  drawConstruction();
-  drawGrid();
-  drawHandles();
-  render();
+  // How long each part of drawing takes (window.designer.drawTimes, for the speed figures).
+  const times = {};
+  let t = performance.now();
+  const lap = (name) => { const now = performance.now(); times[name] = now - t; t = now; };
+  faceGeometry(); lap('areas');
+  drawFaces(); lap('faces');
+  drawEdges(); drawGenerators(true); lap('lines');
+  drawCurves(); drawConstruction(); drawGrid(); drawHandles(); lap('construction');
+  render(); lap('render');
+  window.designer.drawTimes = times;
 }
 
 // ------------------------------------------------------------------ handles and selection
@@ -1340,6 +1355,7 @@ async function goTo(steps) {
 let tomlDirty = false;
 let firstState = true;
 function applyState(msg) {
+  const applyStart = performance.now();
   // An answer overtaken by a newer state (another tab, a live refresh) is not drawn.
   if (current && msg.header.version < current.header.version) return;
   const changed = !current || current.header.version !== msg.header.version;
@@ -1369,6 +1385,7 @@ function applyState(msg) {
   document.body.dataset.version = h.version;
   window.designer.version = h.version;
   window.designer.renders += 1;
+  window.designer.applyMs = performance.now() - applyStart;
   if (changed) scheduleSlowFigures();
 }
 
@@ -1695,6 +1712,17 @@ window.designer = {
   version: null, renders: 0, frames: 0, figuresVersion: null, lastExport: null, timings,
   breakdown, frameTimes, legend: null, hover: null, panel: null, reused: false, view: null,
   busy: () => inFlight || jobs.length > 0,
+  softwareGL: SOFTWARE_GL,
+  // The page's own part of an update, without the server: decode the last state message
+  // again, draw it, and wait for the frame; resolves to the milliseconds it took.
+  replay: () => new Promise((resolve) => {
+    const t0 = performance.now();
+    const msg = decode(current.raw);
+    msg.raw = current.raw;
+    current = null;
+    applyState(msg);
+    requestAnimationFrame(() => resolve(performance.now() - t0));
+  }),
   selection: () => [...selection],
   camera: () => ({ ortho: camera === orthographic, direction:
     camera.getWorldDirection(new THREE.Vector3()).toArray() }),
