@@ -9,18 +9,18 @@ import re
 import socket
 import threading
 import time
-import tomllib
 import tracemalloc
 from pathlib import Path
 
 import numpy as np
 import pytest
+import tomllib
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from ruledmesh import io
 from ruledmesh.design import build_design, parse_design
-from ruledmesh.errors import DesignError, ParameterError
+from ruledmesh.errors import DesignError, ExportError, ParameterError
 from ruledmesh.web.server import make_server
 from ruledmesh.web.session import Session, fan_triangles
 from ruledmesh.web.toml_writer import dumps
@@ -204,6 +204,25 @@ def test_catalogue_surfaces_build_in_the_worker_process():
         worker.close()
 
 
+def test_an_answer_with_the_same_faces_leaves_them_out():
+    from ruledmesh.web.session import topology_key
+
+    s = Session(SMALL)
+    full, arrays = decode(s.payload())
+    key = full["topology"]
+    assert key == topology_key(s.built.mesh) and not full["same_topology"]
+    assert {"triangles", "edges", "face_indices"} <= set(arrays)
+    # the same mesh again for a page that has these faces: vertices and planarity only
+    short, few = decode(s.payload(key))
+    assert short["same_topology"] and set(few) == {"vertices", "planarity", "generators",
+                                                   "torsal", "curve_points"}
+    np.testing.assert_array_equal(few["vertices"], arrays["vertices"])
+    # other faces (more rows): everything again, whatever the page says it has
+    s.edit([(["mesh", "rows"], 7)])
+    again, arrays = decode(s.payload(key))
+    assert not again["same_topology"] and again["topology"] != key and "triangles" in arrays
+
+
 def test_bad_edit_is_refused_with_the_field_and_state_kept():
     s = Session(SMALL)
     before, v = s.design, s.version
@@ -232,7 +251,7 @@ def test_export_every_format(tmp_path, ext):
     s = Session(SMALL, tmp_path / "small.toml")
     try:
         path = s.export(ext)
-    except Exception as exc:  # an optional writer package missing: a clear message, no file
+    except ExportError as exc:  # an optional writer package missing: a clear message, no file
         assert "optional package" in str(exc)
         pytest.skip(f"{ext}: {exc}")
     assert path == tmp_path / f"small{ext}" and path.stat().st_size > 0
@@ -311,7 +330,7 @@ def test_http_page_and_api(server, tmp_path):
     assert request(server, "GET", "/../../pyproject.toml")[0] == 404
     assert request(server, "GET", "/api/state", token=False)[0] == 401
     status, _, data = request(server, "POST", "/api/edit", {"changes": [[["mesh", "rows"], 8]]})
-    header, arrays = decode(data)
+    header, _ = decode(data)
     assert status == 200 and header["design"]["mesh"]["rows"] == 8
     assert server.session.design["mesh"]["rows"] == 8
     status, ctype, data = request(server, "POST", "/api/edit", {"changes": [[["mesh", "rows"], -1]]})

@@ -274,6 +274,7 @@ def test_update_latency_100_by_100(browser, tmp_path):
             reused.append(pg.evaluate("window.designer.reused"))
         moves = pg.evaluate("window.designer.frameTimes.slice(-12)")
         move_steps = pg.evaluate("window.designer.breakdown.slice(-12)")
+        same = pg.evaluate("window.designer.sameTopology")
         # the page alone: the last answer decoded and drawn again, to the next frame
         replays = [pg.evaluate("window.designer.replay()") for _ in range(12)]
     finally:
@@ -289,7 +290,8 @@ def test_update_latency_100_by_100(browser, tmp_path):
           f"control point moved: median {move:.0f} ms (server "
           f"{statistics.median(s['server'] for s in move_steps):.0f} ms, page "
           f"{statistics.median(s['page'] for s in move_steps):.0f} ms, min {min(moves):.0f} ms, "
-          f"buffers reused {sum(reused)}/{len(reused)}); page alone (decode, draw, frame): "
+          f"buffers reused {sum(reused)}/{len(reused)}, answers without the faces (same "
+          f"topology) {same}); page alone (decode, draw, frame): "
           f"median {statistics.median(replays):.0f} ms, min {min(replays):.0f} ms; "
           f"load {os.getloadavg()[0]:.1f}")
     assert faces > 5000

@@ -298,6 +298,18 @@ class _Guard:
 
 
 # ---------------------------------------------------------------------- application
+@dataclass(frozen=True)
+class _Call:
+    """What every endpoint gets besides its arguments.
+
+    ``topology`` is the page's ``X-Ruledmesh-Topology`` header: the fingerprint
+    of the faces it has, so an answer with the same faces leaves them out.
+    """
+
+    started: float
+    topology: str | None = None
+
+
 class _Api:
     """The endpoints; blocking work (builds, encoding, files) runs in worker threads."""
 
@@ -352,9 +364,9 @@ class _Api:
             raise _HttpError(400, "expected a JSON object")
         return body
 
-    def state(self, started: float) -> Response:
-        body = self.session.payload()
-        ms = (time.perf_counter() - started) * 1000
+    def state(self, call: _Call) -> Response:
+        body = self.session.payload(call.topology)
+        ms = (time.perf_counter() - call.started) * 1000
         # Server-Timing lets the page tell server time (build + encode) from its own.
         return Response(body, media_type="application/octet-stream",
                         headers={"Server-Timing": f"app;dur={ms:.1f}"})
@@ -368,7 +380,8 @@ class _Api:
             if fn is None:
                 raise _HttpError(404, f"no API {request.method} /api/{name}")
             arg = await self.body(request) if method == "post" else dict(request.query_params)
-            return await run_in_threadpool(fn, arg, started)
+            call = _Call(started, request.headers.get("x-ruledmesh-topology"))
+            return await run_in_threadpool(fn, arg, call)
         except _HttpError as exc:
             return exc.response()
         except OverwriteRefused as exc:
@@ -383,10 +396,10 @@ class _Api:
             return JSONResponse({"error": f"internal error: {type(exc).__name__}: {exc}"}, 500)
 
     # ------------------------------------------------------------ endpoints (worker threads)
-    def get_state(self, query: dict, started: float) -> Response:
-        return self.state(started)
+    def get_state(self, query: dict, call: _Call) -> Response:
+        return self.state(call)
 
-    def post_edit(self, body: dict, started: float) -> Response:
+    def post_edit(self, body: dict, call: _Call) -> Response:
         changes = body.get("changes")
         if not isinstance(changes, list) or not all(
                 isinstance(c, list) and len(c) == 2 for c in changes):
@@ -394,9 +407,9 @@ class _Api:
         coalesce = body.get("coalesce")
         self.session.edit([(p, v) for p, v in changes],
                           coalesce=str(coalesce) if coalesce else None)
-        return self.state(started)
+        return self.state(call)
 
-    def post_design(self, body: dict, started: float) -> Response:
+    def post_design(self, body: dict, call: _Call) -> Response:
         if "toml" in body:
             if not isinstance(body["toml"], str):
                 raise _HttpError(400, "expected toml: a string")
@@ -407,15 +420,15 @@ class _Api:
             self.session.replace(body["design"])
         else:
             raise _HttpError(400, "expected design: {...} or toml: \"...\"")
-        return self.state(started)
+        return self.state(call)
 
-    def post_undo(self, body: dict, started: float) -> Response:
+    def post_undo(self, body: dict, call: _Call) -> Response:
         self.session.undo()
-        return self.state(started)
+        return self.state(call)
 
-    def post_redo(self, body: dict, started: float) -> Response:
+    def post_redo(self, body: dict, call: _Call) -> Response:
         self.session.redo()
-        return self.state(started)
+        return self.state(call)
 
     @staticmethod
     def _name(body: dict, key: str = "path") -> str | None:
@@ -426,18 +439,18 @@ class _Api:
             raise ParameterError(f"expected a file name, got {type(value).__name__}", key)
         return value
 
-    def post_save(self, body: dict, started: float) -> Response:
+    def post_save(self, body: dict, call: _Call) -> Response:
         path = self.session.save(self._name(body), overwrite=body.get("overwrite") is True)
         return JSONResponse({"path": str(path)})
 
-    def post_export(self, body: dict, started: float) -> Response:
+    def post_export(self, body: dict, call: _Call) -> Response:
         fmt = body.get("format")
         if not isinstance(fmt, str) or not fmt:
             raise _HttpError(400, "expected format, e.g. \".obj\"")
         path = self.session.export(fmt, self._name(body), overwrite=body.get("overwrite") is True)
         return JSONResponse({"path": str(path)})
 
-    def get_download(self, query: dict, started: float) -> Response:
+    def get_download(self, query: dict, call: _Call) -> Response:
         fmt = query.get("format") or ""
         if not fmt:
             raise _HttpError(400, "expected ?format=.obj")
@@ -447,7 +460,7 @@ class _Api:
         return Response(data, media_type="application/octet-stream",
                         headers={"Content-Disposition": f'attachment; filename="{stem}{ext}"'})
 
-    def get_panel(self, query: dict, started: float) -> Response:
+    def get_panel(self, query: dict, call: _Call) -> Response:
         try:
             face = int(query.get("face", ""))
         except ValueError:
@@ -458,7 +471,7 @@ class _Api:
         return Response(encode_message({"version": version, "stale": True}, []),
                         media_type="application/octet-stream")
 
-    def get_figures(self, query: dict, started: float) -> Response:
+    def get_figures(self, query: dict, call: _Call) -> Response:
         session = self.session
         try:
             version = int(query.get("version", session.version))

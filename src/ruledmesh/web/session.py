@@ -46,6 +46,7 @@ __all__ = [
     "fan_triangles",
     "fast_figures",
     "set_path",
+    "topology_key",
 ]
 
 # Shown when the designer starts without a design file (paper Fig. 10, a skew surface).
@@ -224,6 +225,21 @@ def edit_label(changes: Sequence[tuple[Sequence[str | int], Any]]) -> str:
             words.append(f"{dotted} changed")
     more = len(changes) - 3
     return ", ".join(words) + (f" (+{more} more)" if more > 0 else "") if words else "edit"
+
+
+def topology_key(mesh: Mesh) -> str:
+    """A fingerprint of a mesh's faces: vertex count, face corners and face kinds.
+
+    Two meshes with the same key have the same display triangles and edges, so
+    the page keeps its own (only the vertices move).
+    """
+    import hashlib
+
+    h = hashlib.blake2b(digest_size=12)
+    h.update(np.int64(mesh.n_vertices).tobytes())
+    for arr in (mesh.face_offsets, mesh.face_indices, mesh.face_kind):
+        h.update(np.ascontiguousarray(arr).tobytes())
+    return h.hexdigest()
 
 
 def fan_triangles(mesh: Mesh) -> tuple[np.ndarray, np.ndarray]:
@@ -736,26 +752,41 @@ class Session:
             },
         }
 
-    def payload(self) -> bytes:
-        """The current state and mesh as one binary message (:func:`encode_message`)."""
+    def payload(self, topology: str | None = None) -> bytes:
+        """The current state and mesh as one binary message (:func:`encode_message`).
+
+        Parameters
+        ----------
+        topology : str, optional
+            The fingerprint (:func:`topology_key`) of the faces the page already
+            has: when the current mesh's is the same, the face arrays (triangles,
+            edges, faces, kinds) are left out and ``header["same_topology"]`` is
+            true; the vertices, planarity and the rest are always sent.
+        """
         with self._lock:
             snap = self._current
             header = self.describe()
         built = snap.built
         mesh = built.mesh
         figures, plan = fast_figures(mesh)
-        tris, tri_face = fan_triangles(mesh)
+        key = topology_key(mesh)
+        header["topology"] = key
+        header["same_topology"] = same = topology == key
         arrays: list[tuple[str, np.ndarray]] = [
             ("vertices", mesh.vertices.astype(np.float32)),
-            ("triangles", tris.astype(np.uint32)),
-            ("triangle_face", tri_face.astype(np.uint32)),
             ("planarity", plan.astype(np.float32)),
-            ("kind", mesh.face_kind.astype(np.uint8)),
-            ("edges", mesh.edges().astype(np.uint32)),
-            # The faces themselves (the page's read-out measures areas and angles from them).
-            ("face_offsets", mesh.face_offsets.astype(np.uint32)),
-            ("face_indices", mesh.face_indices.astype(np.uint32)),
         ]
+        if not same:
+            tris, tri_face = fan_triangles(mesh)
+            arrays += [
+                ("triangles", tris.astype(np.uint32)),
+                ("triangle_face", tri_face.astype(np.uint32)),
+                ("kind", mesh.face_kind.astype(np.uint8)),
+                ("edges", mesh.edges().astype(np.uint32)),
+                # The faces themselves (the page's read-out measures areas and angles).
+                ("face_offsets", mesh.face_offsets.astype(np.uint32)),
+                ("face_indices", mesh.face_indices.astype(np.uint32)),
+            ]
         rulings = built.rulings
         if rulings is not None and getattr(rulings, "a", None) is not None:
             gens = np.stack([rulings.a, rulings.b], axis=1)

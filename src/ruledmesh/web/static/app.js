@@ -28,6 +28,8 @@ const TOKEN = new URLSearchParams(location.search).get('token') || '';
 
 async function request(method, name, body) {
   const init = { method, headers: { Authorization: `Bearer ${TOKEN}` } };
+  // The faces this page has: an answer with the same ones leaves them out (see applyState).
+  if (current?.header.topology) init.headers['X-Ruledmesh-Topology'] = current.header.topology;
   if (body !== undefined) {
     init.headers['Content-Type'] = 'application/json';
     init.body = JSON.stringify(body);
@@ -1294,6 +1296,18 @@ async function send(name, body) {
   }
 }
 
+// The whole state, faces included (when an answer without them found other faces here).
+async function refreshFull() {
+  const saved = current;
+  current = null;  // no topology header: the server sends everything
+  try {
+    applyState(await api('GET', 'state'));
+  } catch (err) {
+    current = saved;
+    showError(err.message);
+  }
+}
+
 async function refresh() {
   try {
     applyState(await api('GET', 'state'));
@@ -1354,10 +1368,17 @@ async function goTo(steps) {
 
 let tomlDirty = false;
 let firstState = true;
+const FACE_ARRAYS = ['triangles', 'triangle_face', 'kind', 'edges', 'face_offsets', 'face_indices'];
 function applyState(msg) {
   const applyStart = performance.now();
   // An answer overtaken by a newer state (another tab, a live refresh) is not drawn.
   if (current && msg.header.version < current.header.version) return;
+  if (msg.header.same_topology) {
+    // Same faces as drawn: only the vertices (and figures) came; keep our face arrays.
+    if (!current || current.header.topology !== msg.header.topology) { refreshFull(); return; }
+    for (const name of FACE_ARRAYS) msg.arrays[name] = current.arrays[name];
+    window.designer.sameTopology += 1;
+  }
   const changed = !current || current.header.version !== msg.header.version;
   current = msg;
   if (changed) { closeness = null; classes = null; }
@@ -1710,7 +1731,7 @@ window.addEventListener('keydown', (event) => {
 // ------------------------------------------------------------------ test and debugging hooks
 window.designer = {
   version: null, renders: 0, frames: 0, figuresVersion: null, lastExport: null, timings,
-  breakdown, frameTimes, legend: null, hover: null, panel: null, reused: false, view: null,
+  breakdown, frameTimes, sameTopology: 0, legend: null, hover: null, panel: null, reused: false, view: null,
   busy: () => inFlight || jobs.length > 0,
   softwareGL: SOFTWARE_GL,
   // The page's own part of an update, without the server: decode the last state message
@@ -1719,6 +1740,8 @@ window.designer = {
     const t0 = performance.now();
     const msg = decode(current.raw);
     msg.raw = current.raw;
+    for (const name of FACE_ARRAYS) msg.arrays[name] ||= current.arrays[name];
+    msg.header.same_topology = false;
     current = null;
     applyState(msg);
     requestAnimationFrame(() => resolve(performance.now() - t0));
