@@ -169,6 +169,7 @@ function useCamera(next) {
 let renderPending = false;
 function render() {
   renderPending = false;
+  fadeEdges();
   renderer.render(scene, camera);
   if (layers.labels.visible) drawLabels();
   window.designer.frames += 1;
@@ -470,6 +471,34 @@ function drawEdges() {
   fitBuffer(seg.geometry, 'index', E, 1);
   seg.geometry.setDrawRange(0, E.length);
   seg.geometry.computeBoundingSphere();
+  // The faces' median width (area / longest edge, of up to 2,000 faces): the spacing of the
+  // edges across the faces, also for long thin ones; fadeEdges dims dense meshes by it.
+  const { face_offsets: off, face_indices: idx } = current.arrays;
+  const nf = off.length - 1, stride = Math.max(1, Math.floor(nf / 2000)), widths = [];
+  for (let f = 0; f < nf; f += stride) {
+    let longest = 0;
+    for (let k = off[f]; k < off[f + 1]; k++) {
+      const a = 3 * idx[k], b = 3 * idx[k + 1 < off[f + 1] ? k + 1 : off[f]];
+      longest = Math.max(longest, Math.hypot(V[a] - V[b], V[a + 1] - V[b + 1], V[a + 2] - V[b + 2]));
+    }
+    if (longest > 0) widths.push(areas[f] / longest);
+  }
+  widths.sort((x, y) => x - y);
+  seg.userData.edgeLength = widths.length ? widths[widths.length >> 1] : 0;
+}
+
+// Where edges come closer on screen than about 6 pixels they fade, so a dense mesh reads
+// as a surface with a fine net rather than a black moiré; zooming in brings them back.
+function fadeEdges() {
+  const seg = layers.edges.children[0];
+  if (!seg || !seg.userData.edgeLength) return;
+  const h = canvas.clientHeight || 1;
+  const pxPerUnit = camera === orthographic
+    ? h * camera.zoom / (camera.top - camera.bottom)
+    : h / (2 * camera.position.distanceTo(orbit.target) * Math.tan(THREE.MathUtils.degToRad(camera.fov / 2)));
+  const px = seg.userData.edgeLength * pxPerUnit;
+  seg.material.opacity = Math.min(0.8, Math.max(0.08, 0.8 * px / 6));
+  window.designer.edgeOpacity = seg.material.opacity;
 }
 
 // The generators are the rulings the mesh was built on: a separate, dashed layer, shown by
@@ -1622,6 +1651,7 @@ function startDrawing() {
   if (drawing) { finishDrawing(); return; }
   drawing = { points: [], line: null };
   $('new-curve').textContent = 'Finish curve';
+  $('new-curve').blur();  // Enter finishes the curve, it does not press the button again
   status('click points on the construction plane; Enter finishes, Esc cancels');
 }
 
@@ -1718,7 +1748,10 @@ window.addEventListener('keydown', (event) => {
     if (event.key === 'Escape') {
       if (drawing) stopDrawing(); else { gizmo.detach(); select(null, false); }
       render();
-    } else if (event.key === 'Enter' && drawing) finishDrawing();
+    } else if (event.key === 'Enter' && drawing) {
+      event.preventDefault();  // not also a click of the focused "Finish curve" button
+      finishDrawing();
+    }
     else if ((event.key === 'Delete' || event.key === 'Backspace') && tag !== 'INPUT'
              && primaryLabel) editPoints('delete');
     return;
