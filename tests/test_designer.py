@@ -187,6 +187,15 @@ def test_panel_read_out_is_the_schedule_row_and_the_unrolled_outline():
         s.panel(mesh.n_faces)
 
 
+def test_panel_read_out_is_bounded(monkeypatch):
+    from ruledmesh.web import session as session_module
+
+    s = Session(SMALL)
+    monkeypatch.setattr(session_module, "MAX_PANEL_FACES", s.built.mesh.n_faces - 1)
+    with pytest.raises(ParameterError, match=r"up to .* faces; this one has"):
+        s.panel(0)
+
+
 def test_catalogue_surfaces_build_in_the_worker_process():
     """Regression: a catalogue surface's reference (a closure) made every edit a 500."""
     from ruledmesh.web.builder import BuildWorker

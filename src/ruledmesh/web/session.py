@@ -77,6 +77,9 @@ extend = "auto"
 trim = true
 """
 
+# Faces of a mesh whose panel read-out (the whole panels.csv table, congruence classes
+# included, computed in the server on a click) is given: beyond this it would take seconds.
+MAX_PANEL_FACES = 200_000
 # Undo steps kept; older ones are dropped so a long session stays bounded in memory.
 UNDO_LIMIT = 200
 # Points sampled along each director curve for display.
@@ -830,6 +833,10 @@ class Session:
         if isinstance(face, bool) or not isinstance(face, int) or not 0 <= face < mesh.n_faces:
             raise ParameterError(f"expected a face index 0 .. {mesh.n_faces - 1}, got {face!r}",
                                  "face")
+        if mesh.n_faces > MAX_PANEL_FACES:
+            raise ParameterError(f"the panel read-out is given for meshes of up to "
+                                 f"{MAX_PANEL_FACES:,} faces; this one has {mesh.n_faces:,} "
+                                 "(ruledmesh fabricate writes panels.csv for any size)", "face")
         cached = self._panels
         if cached is None or cached[0] != snap.version:
             # The whole table once per version (congruence classes need every face).
