@@ -985,6 +985,66 @@ function numberRange(name, v, isInt) {
   return [lo, hi, (hi - lo) / 400];
 }
 
+// A slider with a number field (and a button widening its range) for a numeric field.
+function numberControl(row, path, name, value, send) {
+  const k = keyOf(path);
+  const isInt = Number.isInteger(value) && !(name === 'extend');
+  let numeric = typeof value === 'number' ? value : 0;
+  let [lo, hi, step] = numberRange(name, numeric, isInt);
+  if (name === 'primary') { lo = 0; hi = Math.max((current.header.design.rulings?.count || 3) - 1, 1); step = 1;
+    if (typeof value !== 'number') numeric = Math.floor(hi / 2); }
+  if (name === 'extend') { lo = 0; hi = Math.max(2, 2 * numeric); step = 0.01; }
+  const slider = document.createElement('input');
+  slider.type = 'range';
+  Object.assign(slider, { min: lo, max: hi, step });
+  slider.value = numeric;
+  slider.dataset.path = path.join('.');
+  const field = document.createElement('input');
+  field.type = 'text';
+  field.className = 'val';
+  field.value = String(value);
+  field.dataset.path = path.join('.');
+  slider.addEventListener('input', () => {
+    activeInput = slider;
+    const v = isInt || step === 1 ? parseInt(slider.value, 10) : parseFloat(slider.value);
+    field.value = String(v);
+    field.dataset.synced = field.value;
+    send(v, `slider:${k}:${gestures[k] || 0}`);
+  });
+  slider.addEventListener('change', () => { gestures[k] = (gestures[k] || 0) + 1; activeInput = null; });
+  field.dataset.synced = field.value;
+  field.addEventListener('change', () => {
+    field.dataset.synced = field.value;
+    const text = field.value.trim();
+    const num = Number(text);
+    const v = text !== '' && !Number.isNaN(num) ? num
+      : (name in NUMERIC_OR_WORD ? text : text);
+    // A typed value past the slider's ends widens it.
+    if (typeof v === 'number') {
+      if (v > +slider.max) slider.max = v;
+      if (v < +slider.min) slider.min = v;
+    }
+    send(v);
+  });
+  // The range can be widened: twice as far either side of the value (integers: up).
+  const widen = document.createElement('button');
+  widen.className = 'widen';
+  widen.textContent = '↔';
+  widen.title = 'widen the slider range';
+  widen.dataset.widen = path.join('.');
+  widen.addEventListener('click', () => {
+    const v = +slider.value, lo = +slider.min, hi = +slider.max;
+    if (isInt) { slider.max = Math.max(2 * hi, hi + 10); if (lo < 0) slider.min = 2 * lo; }
+    else {
+      const span = Math.max(hi - lo, 1e-9);
+      slider.min = lo >= 0 && v - span >= 0 ? v - span : lo >= 0 ? 0 : v - span;
+      slider.max = v + span;
+      slider.step = (slider.max - slider.min) / 400;
+    }
+  });
+  row.append(slider, field, widen);
+}
+
 function control(parent, path, name, value) {
   const row = document.createElement('div');
   row.className = 'ctl';
@@ -994,7 +1054,6 @@ function control(parent, path, name, value) {
   label.textContent = name;
   label.title = path.join('.');
   row.append(label);
-  const k = keyOf(path);
   const send = (v, coalesce) => queueEdit([[path, v]], coalesce);
 
   if (typeof value === 'boolean') {
@@ -1004,61 +1063,7 @@ function control(parent, path, name, value) {
     box.addEventListener('change', () => send(box.checked));
     row.append(box);
   } else if (typeof value === 'number' || name in NUMERIC_OR_WORD) {
-    const isInt = Number.isInteger(value) && !(name === 'extend');
-    let numeric = typeof value === 'number' ? value : 0;
-    let [lo, hi, step] = numberRange(name, numeric, isInt);
-    if (name === 'primary') { lo = 0; hi = Math.max((current.header.design.rulings?.count || 3) - 1, 1); step = 1;
-      if (typeof value !== 'number') numeric = Math.floor(hi / 2); }
-    if (name === 'extend') { lo = 0; hi = Math.max(2, 2 * numeric); step = 0.01; }
-    const slider = document.createElement('input');
-    slider.type = 'range';
-    Object.assign(slider, { min: lo, max: hi, step });
-    slider.value = numeric;
-    slider.dataset.path = path.join('.');
-    const field = document.createElement('input');
-    field.type = 'text';
-    field.className = 'val';
-    field.value = String(value);
-    field.dataset.path = path.join('.');
-    slider.addEventListener('input', () => {
-      activeInput = slider;
-      const v = isInt || step === 1 ? parseInt(slider.value, 10) : parseFloat(slider.value);
-      field.value = String(v);
-      field.dataset.synced = field.value;
-      send(v, `slider:${k}:${gestures[k] || 0}`);
-    });
-    slider.addEventListener('change', () => { gestures[k] = (gestures[k] || 0) + 1; activeInput = null; });
-    field.dataset.synced = field.value;
-    field.addEventListener('change', () => {
-      field.dataset.synced = field.value;
-      const text = field.value.trim();
-      const num = Number(text);
-      const v = text !== '' && !Number.isNaN(num) ? num
-        : (name in NUMERIC_OR_WORD ? text : text);
-      // A typed value past the slider's ends widens it.
-      if (typeof v === 'number') {
-        if (v > +slider.max) slider.max = v;
-        if (v < +slider.min) slider.min = v;
-      }
-      send(v);
-    });
-    // The range can be widened: twice as far either side of the value (integers: up).
-    const widen = document.createElement('button');
-    widen.className = 'widen';
-    widen.textContent = '↔';
-    widen.title = 'widen the slider range';
-    widen.dataset.widen = path.join('.');
-    widen.addEventListener('click', () => {
-      const v = +slider.value, lo = +slider.min, hi = +slider.max;
-      if (isInt) { slider.max = Math.max(2 * hi, hi + 10); if (lo < 0) slider.min = 2 * lo; }
-      else {
-        const span = Math.max(hi - lo, 1e-9);
-        slider.min = lo >= 0 && v - span >= 0 ? v - span : lo >= 0 ? 0 : v - span;
-        slider.max = v + span;
-        slider.step = (slider.max - slider.min) / 400;
-      }
-    });
-    row.append(slider, field, widen);
+    numberControl(row, path, name, value, send);
   } else if (typeof value === 'string') {
     const choices = choiceList(path, name);
     if (choices) {
