@@ -297,7 +297,9 @@ def test_pipelining_works_so_the_smuggling_test_can_fail(designer):
     # Control: the same bytes after an accepted request ARE executed (two answers, rows 13).
     data = (f"GET /api/state HTTP/1.1\r\nHost: 127.0.0.1:{designer.port}\r\n"
             f"Authorization: Bearer {designer.token}\r\n\r\n").encode() + smuggled(designer, 13)
-    out = designer.raw(data, wait=8.0)
+    # 20 s between bytes: the first edit waits for the build worker process to start, which
+    # took over 8 s on a loaded machine (the server closes the idle connection after 5 s).
+    out = designer.raw(data, wait=20.0)
     assert out.count(b"HTTP/1.1 200") == 3
     assert designer.session.design["mesh"]["rows"] == 13
     assert (designer.folder / "smuggled.toml").exists()
