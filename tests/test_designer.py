@@ -20,7 +20,7 @@ from hypothesis import strategies as st
 
 from ruledmesh import io
 from ruledmesh.design import build_design, parse_design
-from ruledmesh.errors import DesignError, ParameterError
+from ruledmesh.errors import DesignError, ExportError, ParameterError
 from ruledmesh.web.server import make_server
 from ruledmesh.web.session import Session, fan_triangles
 from ruledmesh.web.toml_writer import dumps
@@ -141,6 +141,97 @@ def test_session_drag_gesture_is_one_undo_step():
     assert not s.can_undo
 
 
+def test_history_lists_every_step_and_follows_undo_and_redo():
+    s = Session(SMALL)
+    seen = []
+    s.add_listener(seen.append)
+    s.edit([(["mesh", "rows"], 8)])
+    pts = s.design["curves"]["c1"]["points"]
+    s.edit([(["curves", "c1", "points"], [*pts[:2], [4.5, 0, 0], *pts[2:]])])  # inserted
+    for k in range(3):  # a drag: one step
+        s.edit([(["curves", "c2", "points", 1], [3, 4 + 0.1 * k, 5])], coalesce="drag:c2")
+    assert s.history() == {"undo": ["opened", "mesh.rows = 8", "curves.c1.points: 5 points"],
+                           "current": "curves.c2.points[1] moved", "redo": []}
+    s.undo()
+    s.undo()
+    assert s.history() == {"undo": ["opened"], "current": "mesh.rows = 8",
+                           "redo": ["curves.c1.points: 5 points", "curves.c2.points[1] moved"]}
+    assert len(s.design["curves"]["c1"]["points"]) == 4
+    s.redo()
+    assert s.history()["current"] == "curves.c1.points: 5 points"
+    assert len(s.design["curves"]["c1"]["points"]) == 5
+    # every change was announced, once, with its version
+    assert seen == list(range(1, 9))
+    with pytest.raises(DesignError):
+        s.edit([(["mesh", "rows"], -1)])
+    assert seen == list(range(1, 9))  # a refused edit announces nothing
+
+
+def test_panel_read_out_is_the_schedule_row_and_the_unrolled_outline():
+    from ruledmesh.fabricate import panel_table
+
+    s = Session(SMALL)
+    mesh = s.built.mesh
+    table = panel_table(mesh)
+    f = mesh.n_faces // 2
+    info = s.panel(f)
+    assert info["row"]["label"] == f"P{f}" == table["label"][f]
+    assert info["row"]["area"] == pytest.approx(table["area"][f])
+    outline = np.array(info["outline"])
+    assert outline.shape == (mesh.valences[f], 2)
+    # the outline is the face laid flat: the same edge lengths as in space
+    corners = mesh.vertices[mesh.face(f)]
+    assert np.allclose(np.linalg.norm(np.roll(outline, -1, 0) - outline, axis=1),
+                       np.linalg.norm(np.roll(corners, -1, 0) - corners, axis=1))
+    with pytest.raises(ParameterError, match="face"):
+        s.panel(mesh.n_faces)
+
+
+def test_panel_read_out_is_bounded(monkeypatch):
+    from ruledmesh.web import session as session_module
+
+    s = Session(SMALL)
+    monkeypatch.setattr(session_module, "MAX_PANEL_FACES", s.built.mesh.n_faces - 1)
+    with pytest.raises(ParameterError, match=r"up to .* faces; this one has"):
+        s.panel(0)
+
+
+def test_catalogue_surfaces_build_in_the_worker_process():
+    """Regression: a catalogue surface's reference (a closure) made every edit a 500."""
+    from ruledmesh.web.builder import BuildWorker
+
+    worker = BuildWorker()
+    try:
+        for name in ("fig5b-torus", "fig8-helicoid", "sec2-rotational"):
+            path = ROOT / "examples" / f"{name}.toml"
+            s = Session(path.read_text(), path, builder=worker)
+            key = "R" if name.endswith("torus") else "radius" if "helicoid" in name else "angle"
+            value = s.design["surface"][key]
+            s.edit([(["surface", key], value * 1.25)])
+            assert s.design["surface"][key] == value * 1.25 and s.built.mesh.n_faces > 0
+    finally:
+        worker.close()
+
+
+def test_an_answer_with_the_same_faces_leaves_them_out():
+    from ruledmesh.web.session import topology_key
+
+    s = Session(SMALL)
+    full, arrays = decode(s.payload())
+    key = full["topology"]
+    assert key == topology_key(s.built.mesh) and not full["same_topology"]
+    assert {"triangles", "edges", "face_indices"} <= set(arrays)
+    # the same mesh again for a page that has these faces: vertices and planarity only
+    short, few = decode(s.payload(key))
+    assert short["same_topology"] and set(few) == {"vertices", "planarity", "generators",
+                                                   "torsal", "curve_points"}
+    np.testing.assert_array_equal(few["vertices"], arrays["vertices"])
+    # other faces (more rows): everything again, whatever the page says it has
+    s.edit([(["mesh", "rows"], 7)])
+    again, arrays = decode(s.payload(key))
+    assert not again["same_topology"] and again["topology"] != key and "triangles" in arrays
+
+
 def test_bad_edit_is_refused_with_the_field_and_state_kept():
     s = Session(SMALL)
     before, v = s.design, s.version
@@ -169,7 +260,7 @@ def test_export_every_format(tmp_path, ext):
     s = Session(SMALL, tmp_path / "small.toml")
     try:
         path = s.export(ext)
-    except Exception as exc:  # noqa: BLE001 - an optional writer package missing: a clear message, no file
+    except ExportError as exc:  # an optional writer package missing: a clear message, no file
         assert "optional package" in str(exc)
         pytest.skip(f"{ext}: {exc}")
     assert path == tmp_path / f"small{ext}" and path.stat().st_size > 0

@@ -129,11 +129,104 @@ def designer(tmp_path):
 
 
 API = [("GET", "/api/state", None), ("GET", "/api/figures?version=0", None),
-       ("GET", "/api/download?format=.obj", None),
+       ("GET", "/api/download?format=.obj", None), ("GET", "/api/panel?face=0", None),
        ("POST", "/api/edit", {"changes": [[["mesh", "rows"], 13]]}),
        ("POST", "/api/design", {"toml": SMALL.replace("rows = 6", "rows = 13")}),
        ("POST", "/api/undo", {}), ("POST", "/api/save", {"path": "evil.toml"}),
        ("POST", "/api/export", {"format": ".obj", "path": "evil.obj"})]
+
+
+# ---------------------------------------------------------------- live updates (WebSocket)
+def ws_handshake(d: Designer, query: str, origin: str | None = "own", host: str | None = None,
+                 wait: float = 5.0) -> tuple[socket.socket, bytes]:
+    """Open ``/api/live`` with a raw WebSocket handshake; the socket and the first bytes read."""
+    s = socket.create_connection((d.host, d.port), timeout=wait)
+    lines = [f"GET /api/live{query} HTTP/1.1", f"Host: {host or f'127.0.0.1:{d.port}'}",
+             "Upgrade: websocket", "Connection: Upgrade",
+             "Sec-WebSocket-Key: dGhlIHNhbXBsZSBub25jZQ==", "Sec-WebSocket-Version: 13"]
+    if origin is not None:
+        lines.append(f"Origin: {f'http://127.0.0.1:{d.port}' if origin == 'own' else origin}")
+    s.sendall(("\r\n".join(lines) + "\r\n\r\n").encode())
+    data = b""
+    try:
+        while b"\r\n\r\n" not in data:
+            chunk = s.recv(4096)
+            if not chunk:
+                break
+            data += chunk
+    except TimeoutError:
+        pass
+    return s, data
+
+
+@pytest.mark.parametrize(("query", "origin", "host"), [
+    ("", "own", None),                                   # no token
+    ("?token=wrong", "own", None),                       # a wrong token
+    ("?token={token}", None, None),                      # no Origin (not a browser page)
+    ("?token={token}", "http://127.0.0.1:1", None),       # another local origin
+    ("?token={token}", "https://evil.example", None),     # a foreign page
+    ("?token={token}", "http://evil.example", "evil.example"),  # DNS rebinding
+])
+def test_live_socket_needs_token_origin_and_host(designer, query, origin, host):
+    s, answer = ws_handshake(designer, query.format(token=designer.token), origin, host)
+    s.close()
+    assert answer.startswith(b"HTTP/1.1 403"), answer[:80]
+    # a refused socket learns nothing and changes nothing
+    assert b"version" not in answer
+    designer.untouched()
+
+
+def read_versions(s: socket.socket, buf: bytes, last: int, wait: float = 20.0) -> list[int]:
+    """Versions in the server's text frames until ``last`` arrives, the socket ends or ``wait``."""
+    s.settimeout(1.0)
+    deadline = time.monotonic() + wait
+    versions: list[int] = []
+    while time.monotonic() < deadline and last not in versions:
+        while len(buf) >= 2 and (buf[1] & 0x7F) < 126 and len(buf) >= 2 + (buf[1] & 0x7F):
+            n = buf[1] & 0x7F
+            if buf[0] & 0x0F == 1:  # a text frame (pings and the like are skipped)
+                versions.append(json.loads(buf[2:2 + n])["version"])
+            buf = buf[2 + n:]
+        if last in versions:
+            break
+        try:
+            chunk = s.recv(4096)
+        except TimeoutError:
+            continue
+        if not chunk:  # closed by the server
+            break
+        buf += chunk
+    return versions
+
+
+def test_live_socket_with_token_tells_every_change(designer):
+    s, answer = ws_handshake(designer, f"?token={designer.token}")
+    assert answer.startswith(b"HTTP/1.1 101"), answer[:80]
+    rest = answer.split(b"\r\n\r\n", 1)[1]
+    status, _ = designer.request("POST", "/api/edit", {"changes": [[["mesh", "rows"], 7]]})
+    assert status == 200
+    status, _ = designer.request("POST", "/api/undo", {})
+    assert status == 200
+    versions = read_versions(s, rest, last=2)
+    s.close()
+    # the version on connecting first, then the newer ones in order, ending with the undo's
+    # (versions announced while the socket was busy may be merged into the newest)
+    assert versions[0] == 0 and versions[-1] == 2 and versions == sorted(set(versions)), versions
+
+
+def test_live_sockets_are_bounded(designer):
+    from ruledmesh.web.server import MAX_LIVE
+
+    socks = [ws_handshake(designer, f"?token={designer.token}") for _ in range(MAX_LIVE)]
+    assert all(a.startswith(b"HTTP/1.1 101") for _, a in socks)
+    extra, answer = ws_handshake(designer, f"?token={designer.token}")
+    # over the limit: accepted by none (closed with "try again later" or refused)
+    assert not answer.startswith(b"HTTP/1.1 101"), answer[:80]
+    for s, _ in [*socks, (extra, b"")]:
+        s.close()
+    # the server still answers at once
+    status, _ = designer.request("GET", "/api/state")
+    assert status == 200
 
 
 # ---------------------------------------------------------------- token, Host, Origin
@@ -204,7 +297,9 @@ def test_pipelining_works_so_the_smuggling_test_can_fail(designer):
     # Control: the same bytes after an accepted request ARE executed (two answers, rows 13).
     data = (f"GET /api/state HTTP/1.1\r\nHost: 127.0.0.1:{designer.port}\r\n"
             f"Authorization: Bearer {designer.token}\r\n\r\n").encode() + smuggled(designer, 13)
-    out = designer.raw(data, wait=8.0)
+    # 20 s between bytes: the first edit waits for the build worker process to start, which
+    # took over 8 s on a loaded machine (the server closes the idle connection after 5 s).
+    out = designer.raw(data, wait=20.0)
     assert out.count(b"HTTP/1.1 200") == 3
     assert designer.session.design["mesh"]["rows"] == 13
     assert (designer.folder / "smuggled.toml").exists()

@@ -19,6 +19,8 @@ or already finished, so only the newest edit's result can become current.
 
 from __future__ import annotations
 
+import contextlib
+import dataclasses
 import multiprocessing as mp
 import threading
 import time
@@ -63,7 +65,11 @@ def _worker_main(conn) -> None:  # pragma: no cover - runs in the child process
             return
         data, source, base_dir = job
         try:
-            reply: tuple[str, Any] = ("ok", build_design(Design(data, source, Path(base_dir))))
+            built = build_design(Design(data, source, Path(base_dir)))
+            # The smooth reference surface stays here: the server never measures with it (the
+            # figures process builds its own), and the catalogue's references are closures,
+            # which cannot be pickled.
+            reply: tuple[str, Any] = ("ok", dataclasses.replace(built, reference=None))
         except RuledMeshError as exc:
             reply = ("error", exc)
         except MemoryError:
@@ -73,6 +79,10 @@ def _worker_main(conn) -> None:  # pragma: no cover - runs in the child process
         try:
             conn.send(reply)
         except Exception:  # noqa: BLE001 - an unpicklable error: say so instead of hanging
+            if reply[0] == "ok" and reply[1].extras:
+                with contextlib.suppress(Exception):  # the extras are for reports only
+                    conn.send(("ok", dataclasses.replace(reply[1], extras={})))
+                    continue
             try:
                 conn.send(("bug", f"cannot return the result: {reply[0]}"))
             except OSError:

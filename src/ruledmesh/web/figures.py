@@ -40,7 +40,8 @@ def _worker_main(conn) -> None:  # pragma: no cover - runs in the child process
         try:
             built = build_design(Design(data, source, Path(base_dir)))
             figures, per_face = slow_figures(built)
-            reply: tuple = (version, figures, per_face, None)
+            reply: tuple[int, dict[str, Any], dict[str, Any] | None, str | None] = (
+                version, figures, per_face, None)
         except RuledMeshError as exc:
             reply = (version, {}, None, str(exc))
         except Exception as exc:  # noqa: BLE001 - reported to the page, never a dead worker
@@ -62,7 +63,7 @@ class FigureWorker:
     def __init__(self) -> None:
         self._ctx = mp.get_context("spawn")  # never fork a threaded server
         self._cond = threading.Condition()
-        self._wanted: Any = None  # None or (version, data, source, base_dir)
+        self._wanted: Any = None  # (version, data, source, base_dir)
         self._result: tuple | None = None  # (version, figures, per_face, error)
         self._closed = False
         self._proc: Any = None
@@ -114,8 +115,11 @@ class FigureWorker:
 
     # ---------------------------------------------------------------- API
     def request(self, version: int, data: dict, source: str, base_dir: str | Path,
-                timeout: float = 120.0) -> tuple[dict[str, Any], np.ndarray | None, str | None] | None:
+                timeout: float = 120.0
+                ) -> tuple[dict[str, Any], dict[str, np.ndarray] | None, str | None] | None:
         """Figures of design ``data`` at ``version``: ``(figures, per_face, error)``.
+
+        ``per_face`` maps names (``"closeness"``, ``"class"``) to (F,) arrays.
 
         Returns ``None`` when a newer version was asked for meanwhile or the
         timeout passed.

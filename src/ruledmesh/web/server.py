@@ -12,7 +12,9 @@ one's body; this module adds the designer's own rules.  The API:
 ``POST /api/save``          ``{"path", "overwrite"}`` (both optional) -> ``{"path"}``
 ``POST /api/export``        ``{"format": ".obj", "path", "overwrite"}`` -> ``{"path"}``
 ``GET /api/download?format=.glb``  the exported bytes as a download
-``GET /api/figures?version=N``     binary message: closeness, coverage, panels
+``GET /api/figures?version=N``     binary message: closeness, coverage, panels, classes
+``GET /api/panel?face=F``   JSON: the face's unrolled outline and ``panels.csv`` row
+``WS /api/live?token=T``    pushes ``{"version": N}`` after every change of the design
 ==========================  ==================================================
 
 Edits answer like ``GET /api/state`` (one round trip per change).  Errors
@@ -35,13 +37,17 @@ Safety (see docs/designer.md, "Security"):
 - builds run in a worker process with a time limit (:mod:`.builder`), off the
   event loop, so a long build never holds up other requests.
 
-WebSockets (live updates across tabs) fit as a ``WebSocketRoute`` next to the
-API routes; :class:`_Guard` already refuses WebSocket connections, which will
-then need the token as a query parameter (browsers cannot set headers there).
+The WebSocket ``/api/live`` tells every open page when the design changed
+(an edit in another tab, undo, redo), so the pages fetch the new state
+instead of showing an old one.  Browsers cannot set headers on a WebSocket:
+its token travels as the query parameter ``token``; its ``Origin`` must be
+the page's own (browsers always send one); at most :data:`MAX_LIVE`
+connections are kept.
 """
 
 from __future__ import annotations
 
+import asyncio
 import errno
 import hmac
 import ipaddress
@@ -55,7 +61,7 @@ from dataclasses import dataclass
 from importlib import resources
 from pathlib import Path
 from typing import Any
-from urllib.parse import urlsplit
+from urllib.parse import parse_qsl, urlsplit
 
 import numpy as np
 
@@ -73,8 +79,9 @@ try:
     from starlette.datastructures import Headers
     from starlette.requests import Request
     from starlette.responses import JSONResponse, Response
-    from starlette.routing import Mount, Route
+    from starlette.routing import Mount, Route, WebSocketRoute
     from starlette.staticfiles import StaticFiles
+    from starlette.websockets import WebSocket, WebSocketDisconnect
     from uvicorn.protocols.http.h11_impl import H11Protocol
 except ImportError as exc:  # pragma: no cover - checked by the CLI before importing this
     raise ImportError(f"the designer needs Starlette and uvicorn ({exc.name}); "
@@ -93,6 +100,8 @@ REQUEST_TIMEOUT = 10.0
 KEEP_ALIVE = 5
 # A body over the limit but under this is read and dropped before the 413 answer (see _drain).
 DRAIN_LIMIT = 64 * 2**20
+# Open live-update WebSockets (one per tab): a few are normal, hundreds an attack.
+MAX_LIVE = 32
 _LOOPBACK_NAMES = {"localhost", "127.0.0.1", "::1", "[::1]"}
 _SECURITY_HEADERS = [
     (b"cache-control", b"no-store"),
@@ -234,6 +243,8 @@ class _Guard:
             parts = urlsplit(origin)
             if f"{parts.scheme}://{parts.netloc}".lower() != f"http://{host}".lower():
                 return _HttpError(403, f"refused: request from {origin}", close=True)
+        if scope["type"] == "websocket":
+            return self.check_socket(scope, origin)
         auth = headers.get("authorization", "")
         if not auth:
             return _HttpError(401, "refused: no token; open the URL that ruledmesh design "
@@ -248,9 +259,26 @@ class _Guard:
                 return _HttpError(415, "expected Content-Type: application/json", close=True)
         return None
 
+    def check_socket(self, scope: dict, origin: str | None) -> _HttpError | None:
+        """A WebSocket needs an ``Origin`` (the page's, checked above) and ``?token=``."""
+        if origin is None:
+            return _HttpError(403, "refused: a WebSocket without Origin")
+        query = dict(parse_qsl(scope.get("query_string", b"").decode("latin-1")))
+        given = query.get("token", "")
+        if not given:
+            return _HttpError(401, "refused: no token")
+        if not hmac.compare_digest(given.encode(), self.token.encode()):
+            return _HttpError(403, "refused: wrong token")
+        return None
+
     async def __call__(self, scope: dict, receive: Callable, send: Callable) -> None:
-        if scope["type"] == "websocket":  # none yet; when there are, they need the token too
-            await send({"type": "websocket.close", "code": 1008})
+        if scope["type"] == "websocket":
+            problem = self.check(scope, Headers(scope=scope))
+            if problem is not None or not scope["path"].startswith("/api/"):
+                # Closing before accepting answers the handshake with HTTP 403.
+                await send({"type": "websocket.close", "code": 1008})
+                return
+            await self.app(scope, receive, send)
             return
         if scope["type"] != "http":
             await self.app(scope, receive, send)
@@ -270,6 +298,18 @@ class _Guard:
 
 
 # ---------------------------------------------------------------------- application
+@dataclass(frozen=True)
+class _Call:
+    """What every endpoint gets besides its arguments.
+
+    ``topology`` is the page's ``X-Ruledmesh-Topology`` header: the fingerprint
+    of the faces it has, so an answer with the same faces leaves them out.
+    """
+
+    started: float
+    topology: str | None = None
+
+
 class _Api:
     """The endpoints; blocking work (builds, encoding, files) runs in worker threads."""
 
@@ -324,9 +364,9 @@ class _Api:
             raise _HttpError(400, "expected a JSON object")
         return body
 
-    def state(self, started: float) -> Response:
-        body = self.session.payload()
-        ms = (time.perf_counter() - started) * 1000
+    def state(self, call: _Call) -> Response:
+        body = self.session.payload(call.topology)
+        ms = (time.perf_counter() - call.started) * 1000
         # Server-Timing lets the page tell server time (build + encode) from its own.
         return Response(body, media_type="application/octet-stream",
                         headers={"Server-Timing": f"app;dur={ms:.1f}"})
@@ -340,7 +380,8 @@ class _Api:
             if fn is None:
                 raise _HttpError(404, f"no API {request.method} /api/{name}")
             arg = await self.body(request) if method == "post" else dict(request.query_params)
-            return await run_in_threadpool(fn, arg, started)
+            call = _Call(started, request.headers.get("x-ruledmesh-topology"))
+            return await run_in_threadpool(fn, arg, call)
         except _HttpError as exc:
             return exc.response()
         except OverwriteRefused as exc:
@@ -355,10 +396,10 @@ class _Api:
             return JSONResponse({"error": f"internal error: {type(exc).__name__}: {exc}"}, 500)
 
     # ------------------------------------------------------------ endpoints (worker threads)
-    def get_state(self, query: dict, started: float) -> Response:
-        return self.state(started)
+    def get_state(self, query: dict, call: _Call) -> Response:
+        return self.state(call)
 
-    def post_edit(self, body: dict, started: float) -> Response:
+    def post_edit(self, body: dict, call: _Call) -> Response:
         changes = body.get("changes")
         if not isinstance(changes, list) or not all(
                 isinstance(c, list) and len(c) == 2 for c in changes):
@@ -366,9 +407,9 @@ class _Api:
         coalesce = body.get("coalesce")
         self.session.edit([(p, v) for p, v in changes],
                           coalesce=str(coalesce) if coalesce else None)
-        return self.state(started)
+        return self.state(call)
 
-    def post_design(self, body: dict, started: float) -> Response:
+    def post_design(self, body: dict, call: _Call) -> Response:
         if "toml" in body:
             if not isinstance(body["toml"], str):
                 raise _HttpError(400, "expected toml: a string")
@@ -379,15 +420,15 @@ class _Api:
             self.session.replace(body["design"])
         else:
             raise _HttpError(400, "expected design: {...} or toml: \"...\"")
-        return self.state(started)
+        return self.state(call)
 
-    def post_undo(self, body: dict, started: float) -> Response:
+    def post_undo(self, body: dict, call: _Call) -> Response:
         self.session.undo()
-        return self.state(started)
+        return self.state(call)
 
-    def post_redo(self, body: dict, started: float) -> Response:
+    def post_redo(self, body: dict, call: _Call) -> Response:
         self.session.redo()
-        return self.state(started)
+        return self.state(call)
 
     @staticmethod
     def _name(body: dict, key: str = "path") -> str | None:
@@ -398,18 +439,18 @@ class _Api:
             raise ParameterError(f"expected a file name, got {type(value).__name__}", key)
         return value
 
-    def post_save(self, body: dict, started: float) -> Response:
+    def post_save(self, body: dict, call: _Call) -> Response:
         path = self.session.save(self._name(body), overwrite=body.get("overwrite") is True)
         return JSONResponse({"path": str(path)})
 
-    def post_export(self, body: dict, started: float) -> Response:
+    def post_export(self, body: dict, call: _Call) -> Response:
         fmt = body.get("format")
         if not isinstance(fmt, str) or not fmt:
             raise _HttpError(400, "expected format, e.g. \".obj\"")
         path = self.session.export(fmt, self._name(body), overwrite=body.get("overwrite") is True)
         return JSONResponse({"path": str(path)})
 
-    def get_download(self, query: dict, started: float) -> Response:
+    def get_download(self, query: dict, call: _Call) -> Response:
         fmt = query.get("format") or ""
         if not fmt:
             raise _HttpError(400, "expected ?format=.obj")
@@ -419,11 +460,18 @@ class _Api:
         return Response(data, media_type="application/octet-stream",
                         headers={"Content-Disposition": f'attachment; filename="{stem}{ext}"'})
 
+    def get_panel(self, query: dict, call: _Call) -> Response:
+        try:
+            face = int(query.get("face", ""))
+        except ValueError:
+            raise _HttpError(400, "expected face=<integer>") from None
+        return JSONResponse(self.session.panel(face))
+
     def _stale(self, version: int) -> Response:
         return Response(encode_message({"version": version, "stale": True}, []),
                         media_type="application/octet-stream")
 
-    def get_figures(self, query: dict, started: float) -> Response:
+    def get_figures(self, query: dict, call: _Call) -> Response:
         session = self.session
         try:
             version = int(query.get("version", session.version))
@@ -436,9 +484,70 @@ class _Api:
         if result is None:
             return self._stale(version)
         figures, per_face, error = result
-        arrays = [] if per_face is None else [("closeness", np.asarray(per_face, np.float32))]
+        dtypes = {"closeness": np.float32, "class": np.uint32}
+        arrays = [(k, np.asarray(v, dtypes.get(k, np.float32)))
+                  for k, v in (per_face or {}).items()]
         return Response(encode_message({"version": version, "figures": figures, "error": error},
                                        arrays), media_type="application/octet-stream")
+
+
+class _Live:
+    """The open live-update WebSockets: each gets the new version after every change."""
+
+    def __init__(self, session: Session, limit: int = MAX_LIVE):
+        self.session = session
+        self.limit = limit
+        self.queues: set[asyncio.Queue] = set()
+        self.loop: asyncio.AbstractEventLoop | None = None
+        self.lock = threading.Lock()
+
+    def notify(self, version: int) -> None:
+        """Called in any thread after the session changed."""
+        with self.lock:
+            loop, queues = self.loop, list(self.queues)
+        if loop is None:
+            return
+        for q in queues:
+            try:
+                loop.call_soon_threadsafe(q.put_nowait, version)
+            except RuntimeError:  # the loop closed: the server is stopping
+                return
+
+    async def endpoint(self, websocket: WebSocket) -> None:
+        with self.lock:
+            full = len(self.queues) >= self.limit
+        if full:
+            await websocket.close(code=1013)  # try again later
+            return
+        await websocket.accept()
+        queue: asyncio.Queue = asyncio.Queue()
+        with self.lock:
+            self.loop = asyncio.get_running_loop()
+            self.queues.add(queue)
+        try:
+            await websocket.send_json({"version": self.session.version})
+
+            async def pump() -> None:
+                while True:
+                    version = await queue.get()
+                    while not queue.empty():  # only the newest matters
+                        version = queue.get_nowait()
+                    await websocket.send_json({"version": version})
+
+            async with anyio.create_task_group() as tasks:
+                tasks.start_soon(pump)
+                try:
+                    while True:  # the page sends nothing; this notices when it goes away
+                        message = await websocket.receive()
+                        if message["type"] == "websocket.disconnect":
+                            break
+                finally:
+                    tasks.cancel_scope.cancel()
+        except (WebSocketDisconnect, RuntimeError, OSError):
+            pass
+        finally:
+            with self.lock:
+                self.queues.discard(queue)
 
 
 # ---------------------------------------------------------------------- server
@@ -458,6 +567,15 @@ def _bind(host: str, port: int) -> socket.socket:
             raise PortInUse(port) from None
         raise
     return sock
+
+
+def _ws_protocol() -> str:
+    """uvicorn's WebSocket implementation: wsproto (the ``web`` extra), else none at all."""
+    try:
+        import wsproto  # noqa: F401
+    except ImportError:  # live updates off; the page then polls the state
+        return "none"
+    return "wsproto"
 
 
 class _Uvicorn(uvicorn.Server):
@@ -511,11 +629,15 @@ class DesignerServer:
         self._builder = BuildWorker(self.limits.build_seconds)
         session.set_builder(self._builder)
         api = _Api(self)
-        routes = [Route("/api/{name:str}", api.dispatch, methods=["GET", "HEAD", "POST"]),
+        self.live = _Live(session)
+        session.add_listener(self.live.notify)
+        routes = [WebSocketRoute("/api/live", self.live.endpoint),
+                  Route("/api/{name:str}", api.dispatch, methods=["GET", "HEAD", "POST"]),
                   Mount("/", StaticFiles(directory=_static_root(), html=True))]
         self.app = _Guard(Starlette(routes=routes), self.token, self.loopback)
         protocol = type("_Protocol", (_DeadlineH11,), {"deadline": self.limits.request_timeout})
-        config = uvicorn.Config(self.app, http=protocol, ws="none", lifespan="off",
+        config = uvicorn.Config(self.app, http=protocol, ws=_ws_protocol(), lifespan="off",
+                                ws_max_size=2**16, ws_ping_interval=20.0, ws_ping_timeout=20.0,
                                 log_level="error", access_log=False, server_header=False,
                                 timeout_keep_alive=KEEP_ALIVE, timeout_graceful_shutdown=3)
         self._uvicorn = _Uvicorn(config, self._stop_workers)

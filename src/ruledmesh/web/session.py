@@ -15,12 +15,13 @@ and refuses designs over the limits (:func:`check_limits`) before building.
 
 from __future__ import annotations
 
+import contextlib
 import copy
 import importlib
 import json
 import math
 import threading
-from collections.abc import Mapping, Sequence
+from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
@@ -40,10 +41,12 @@ __all__ = [
     "OverwriteRefused",
     "Session",
     "check_limits",
+    "edit_label",
     "encode_message",
     "fan_triangles",
     "fast_figures",
     "set_path",
+    "topology_key",
 ]
 
 # Shown when the designer starts without a design file (paper Fig. 10, a skew surface).
@@ -74,6 +77,9 @@ extend = "auto"
 trim = true
 """
 
+# Faces of a mesh whose panel read-out (the whole panels.csv table, congruence classes
+# included, computed in the server on a click) is given: beyond this it would take seconds.
+MAX_PANEL_FACES = 200_000
 # Undo steps kept; older ones are dropped so a long session stays bounded in memory.
 UNDO_LIMIT = 200
 # Points sampled along each director curve for display.
@@ -198,6 +204,47 @@ def set_path(data: dict, path: Sequence[str | int], value: Any) -> None:
         raise DesignError(f"no such field (at {last!r})", dotted)
 
 
+def edit_label(changes: Sequence[tuple[Sequence[str | int], Any]]) -> str:
+    """A short description of an edit for the history list, e.g. ``"mesh.rows = 8"``.
+
+    >>> edit_label([(["mesh", "rows"], 8)])
+    'mesh.rows = 8'
+    >>> edit_label([(["curves", "c1", "points", 2], [1, 2, 3])])
+    'curves.c1.points[2] moved'
+    """
+    words = []
+    for path, value in list(changes)[:3]:
+        dotted = ".".join(str(p) for p in path if not isinstance(p, int))
+        dotted += "".join(f"[{p}]" for p in path if isinstance(p, int))
+        if value is None:
+            words.append(f"{dotted} removed")
+        elif isinstance(value, (bool, int, float, str)):
+            words.append(f"{dotted} = {value}"[:60])
+        elif isinstance(value, list) and path and path[-1] == "points":
+            words.append(f"{dotted}: {len(value)} points")
+        elif _is_point(value):
+            words.append(f"{dotted} moved")
+        else:
+            words.append(f"{dotted} changed")
+    more = len(changes) - 3
+    return ", ".join(words) + (f" (+{more} more)" if more > 0 else "") if words else "edit"
+
+
+def topology_key(mesh: Mesh) -> str:
+    """A fingerprint of a mesh's faces: vertex count, face corners and face kinds.
+
+    Two meshes with the same key have the same display triangles and edges, so
+    the page keeps its own (only the vertices move).
+    """
+    import hashlib
+
+    h = hashlib.blake2b(digest_size=12)
+    h.update(np.int64(mesh.n_vertices).tobytes())
+    for arr in (mesh.face_offsets, mesh.face_indices, mesh.face_kind):
+        h.update(np.ascontiguousarray(arr).tobytes())
+    return h.hexdigest()
+
+
 def fan_triangles(mesh: Mesh) -> tuple[np.ndarray, np.ndarray]:
     """Triangles of every face for display (a fan from each face's first corner).
 
@@ -251,24 +298,30 @@ def fast_figures(mesh: Mesh) -> tuple[dict[str, Any], np.ndarray]:
     }, plan
 
 
-def slow_figures(built: Built) -> tuple[dict[str, Any], np.ndarray | None]:
+def slow_figures(built: Built) -> tuple[dict[str, Any], dict[str, np.ndarray]]:
     """Closeness, coverage and panel count: too slow for every edit on some designs.
 
-    Returns the figures and the (F,) per-face closeness of the face centroids
-    (relative to the bounding-box diagonal) or ``None`` without a reference.
+    Returns
+    -------
+    figures : dict
+    per_face : dict
+        ``"closeness"``: (F,) the distance of each face centroid from the
+        smooth surface relative to the bounding-box diagonal (absent without a
+        reference); ``"class"``: (F,) the congruence class of each panel.
     """
     from ..analysis import faces as F
     from ..fabricate.panels import congruence_classes
 
     mesh = built.mesh
     figures: dict[str, Any] = {}
-    per_face = None
+    per_face: dict[str, np.ndarray] = {}
     diag = mesh.diagonal() or 1.0
     if built.reference is not None and mesh.n_faces:
-        per_face = built.reference.distance(F.face_centroids(mesh)) / diag
+        close = built.reference.distance(F.face_centroids(mesh)) / diag
+        per_face["closeness"] = close
         vert = built.reference.distance(mesh.vertices[np.unique(mesh.face_indices)]) / diag
-        figures["closeness"] = {"centroids_max": float(per_face.max()),
-                                "centroids_mean": float(per_face.mean()),
+        figures["closeness"] = {"centroids_max": float(close.max()),
+                                "centroids_mean": float(close.mean()),
                                 "vertices_max": float(vert.max())}
         patch = built.reference.area()
         if patch:
@@ -276,6 +329,7 @@ def slow_figures(built: Built) -> tuple[dict[str, Any], np.ndarray | None]:
             figures["coverage"] = float(areas.sum() / patch)
     if mesh.n_faces:
         classes = congruence_classes(mesh)
+        per_face["class"] = classes
         figures["panels"] = int(classes.max()) + 1
     return figures, per_face
 
@@ -388,8 +442,30 @@ class Session:
         self._current = _Snapshot(data, self._build(data), 0, dumps(data))
         self._undo: list[dict] = []
         self._redo: list[dict] = []
+        # What each step did, in the words of the page's history list (parallel to the stacks).
+        self._undo_labels: list[str] = []
+        self._redo_labels: list[str] = []
+        self._label = "opened"
         self._coalesce: str | None = None
         self.undo_limit = int(undo_limit)
+        # Called (version) after every change of the current design: the server pushes it to
+        # every open page, so two tabs never show different designs.
+        self._listeners: list[Callable[[int], None]] = []
+        self._panels: tuple[int, dict[str, np.ndarray], Any] | None = None
+
+    def add_listener(self, listener: Callable[[int], None]) -> None:
+        """Call ``listener(version)`` after every change of the current design."""
+        self._listeners.append(listener)
+
+    def history(self) -> dict[str, Any]:
+        """The session's steps: ``{"undo": [...], "current": label, "redo": [...]}``.
+
+        ``undo`` lists what the steps that can be undone did (oldest first),
+        ``redo`` the steps that can be redone (next first).
+        """
+        with self._lock:
+            return {"undo": list(self._undo_labels), "current": self._label,
+                    "redo": list(reversed(self._redo_labels))}
 
     def set_builder(self, builder: InProcessBuilder) -> None:
         """Build the next edits with ``builder`` (the server's worker process)."""
@@ -429,18 +505,28 @@ class Session:
         return build_design(Design(data, self.source, self.base_dir))
 
     def _commit(self, generation: int, push: bool, data: dict, built: Built,
-                text: str | None = None, coalesce: str | None = None) -> int:
+                text: str | None = None, coalesce: str | None = None,
+                label: str | None = None) -> int:
         """Make ``data`` current unless a newer edit arrived while it built (under the lock)."""
         if self._builder.superseded(generation):
             raise Superseded("superseded by a newer edit")
         if push:
             if coalesce is None or coalesce != self._coalesce:
                 self._undo.append(self._current.design)
+                self._undo_labels.append(self._label)
                 del self._undo[:-self.undo_limit]
+                del self._undo_labels[:-self.undo_limit]
             self._redo.clear()
+            self._redo_labels.clear()
+            self._label = label or "edit"
         self._coalesce = coalesce
         self._make_current(data, built, text)
         return self.version
+
+    def _notify(self, version: int) -> None:
+        for listener in list(self._listeners):
+            with contextlib.suppress(Exception):  # a closed page must not refuse an edit
+                listener(version)
 
     def _make_current(self, data: dict, built: Built, text: str | None = None) -> None:
         self._current = _Snapshot(data, built, self._current.version + 1,
@@ -448,7 +534,7 @@ class Session:
 
     # ------------------------------------------------------------- edits
     def replace(self, data: Mapping[str, Any], coalesce: str | None = None,
-                generation: int | None = None) -> int:
+                generation: int | None = None, label: str = "design replaced") -> int:
         """Make ``data`` the current design if it builds; returns the new version.
 
         Parameters
@@ -460,6 +546,8 @@ class Session:
             gesture) make a single undo step.
         generation : int, optional
             Taken by :meth:`edit` when it read the design it changed.
+        label : str
+            What the step did, for the history list.
 
         Raises
         ------
@@ -480,7 +568,9 @@ class Session:
         # Built outside the lock: state requests (and newer edits) never wait for a build.
         built = self._builder.build(generation, candidate, self.source, self.base_dir)
         with self._lock:
-            return self._commit(generation, True, candidate, built, text, coalesce)
+            version = self._commit(generation, True, candidate, built, text, coalesce, label)
+        self._notify(version)
+        return version
 
     def edit(self, changes: Sequence[tuple[Sequence[str | int], Any]],
              coalesce: str | None = None) -> int:
@@ -496,12 +586,12 @@ class Session:
             if not isinstance(path, (list, tuple)):
                 raise DesignError(f"expected a list of keys, got {path!r}", "edit")
             set_path(data, list(path), value)
-        return self.replace(data, coalesce, generation)
+        return self.replace(data, coalesce, generation, edit_label(changes))
 
     def load_text(self, text: str) -> int:
         """Replace the design by TOML ``text`` (one undo step)."""
         design = parse_design(text, self.source, self.base_dir)
-        return self.replace(design.data)
+        return self.replace(design.data, label="design TOML applied")
 
     def _step(self, back: bool) -> int:
         name = "undo" if back else "redo"
@@ -516,8 +606,14 @@ class Session:
             if self._builder.superseded(generation):
                 raise Superseded("superseded by a newer edit")
             stack.pop()
+            labels = self._undo_labels if back else self._redo_labels
+            label = labels.pop() if labels else "edit"
             (self._redo if back else self._undo).append(self._current.design)
-            return self._commit(generation, False, data, built)
+            (self._redo_labels if back else self._undo_labels).append(self._label)
+            self._label = label
+            version = self._commit(generation, False, data, built)
+        self._notify(version)
+        return version
 
     def undo(self) -> int:
         """Go back one edit; raises :class:`ParameterError` when there is none."""
@@ -648,6 +744,7 @@ class Session:
             "save_name": self.save_name(),
             "can_undo": self.can_undo,
             "can_redo": self.can_redo,
+            "history": self.history(),
             "choices": {
                 "kinds": sorted(SURFACE_KINDS),
                 "methods": sorted(MESH_METHODS),
@@ -658,23 +755,41 @@ class Session:
             },
         }
 
-    def payload(self) -> bytes:
-        """The current state and mesh as one binary message (:func:`encode_message`)."""
+    def payload(self, topology: str | None = None) -> bytes:
+        """The current state and mesh as one binary message (:func:`encode_message`).
+
+        Parameters
+        ----------
+        topology : str, optional
+            The fingerprint (:func:`topology_key`) of the faces the page already
+            has: when the current mesh's is the same, the face arrays (triangles,
+            edges, faces, kinds) are left out and ``header["same_topology"]`` is
+            true; the vertices, planarity and the rest are always sent.
+        """
         with self._lock:
             snap = self._current
             header = self.describe()
         built = snap.built
         mesh = built.mesh
         figures, plan = fast_figures(mesh)
-        tris, tri_face = fan_triangles(mesh)
+        key = topology_key(mesh)
+        header["topology"] = key
+        header["same_topology"] = same = topology == key
         arrays: list[tuple[str, np.ndarray]] = [
             ("vertices", mesh.vertices.astype(np.float32)),
-            ("triangles", tris.astype(np.uint32)),
-            ("triangle_face", tri_face.astype(np.uint32)),
             ("planarity", plan.astype(np.float32)),
-            ("kind", mesh.face_kind.astype(np.uint8)),
-            ("edges", mesh.edges().astype(np.uint32)),
         ]
+        if not same:
+            tris, tri_face = fan_triangles(mesh)
+            arrays += [
+                ("triangles", tris.astype(np.uint32)),
+                ("triangle_face", tri_face.astype(np.uint32)),
+                ("kind", mesh.face_kind.astype(np.uint8)),
+                ("edges", mesh.edges().astype(np.uint32)),
+                # The faces themselves (the page's read-out measures areas and angles).
+                ("face_offsets", mesh.face_offsets.astype(np.uint32)),
+                ("face_indices", mesh.face_indices.astype(np.uint32)),
+            ]
         rulings = built.rulings
         if rulings is not None and getattr(rulings, "a", None) is not None:
             gens = np.stack([rulings.a, rulings.b], axis=1)
@@ -683,7 +798,9 @@ class Session:
         else:
             gens = np.zeros((0, 2, 3))
         arrays.append(("generators", gens.astype(np.float32)))
+        arrays.append(("torsal", _torsal(np.asarray(gens, dtype=np.float64), mesh)))
         header["figures"] = figures
+        header["construction"] = _construction(snap.design, len(gens))
         names, counts, points = _curve_polylines(snap.design)
         header["curves"] = [{"name": n, "count": c} for n, c in zip(names, counts)]
         arrays.append(("curve_points", points.astype(np.float32)))
@@ -691,6 +808,88 @@ class Session:
         bbox = mesh.bounding_box() if mesh.n_vertices else np.zeros((2, 3))
         header["bbox"] = bbox.tolist()
         return encode_message(header, arrays)
+
+
+    def panel(self, face: int) -> dict[str, Any]:
+        """The unrolled outline and the ``panels.csv`` row of one face of the current mesh.
+
+        Returns
+        -------
+        dict
+            ``{"version", "face", "outline": (k, 2) list, "row": {column: value}}``;
+            the row has the columns of ``ruledmesh fabricate``'s ``panels.csv``.
+
+        Raises
+        ------
+        ParameterError
+            ``face`` is not a face of the current mesh.
+        """
+        from ..fabricate.panels import panel_table
+        from ..fabricate.unroll import unroll
+
+        with self._lock:
+            snap = self._current
+        mesh = snap.built.mesh
+        if isinstance(face, bool) or not isinstance(face, int) or not 0 <= face < mesh.n_faces:
+            raise ParameterError(f"expected a face index 0 .. {mesh.n_faces - 1}, got {face!r}",
+                                 "face")
+        if mesh.n_faces > MAX_PANEL_FACES:
+            raise ParameterError(f"the panel read-out is given for meshes of up to "
+                                 f"{MAX_PANEL_FACES:,} faces; this one has {mesh.n_faces:,} "
+                                 "(ruledmesh fabricate writes panels.csv for any size)", "face")
+        cached = self._panels
+        if cached is None or cached[0] != snap.version:
+            # The whole table once per version (congruence classes need every face).
+            unrolled = unroll(mesh, require_planar=False)
+            cached = (snap.version, panel_table(mesh, unrolled=unrolled), unrolled)
+            self._panels = cached
+        _, table, unrolled = cached
+        row = {k: v[face].item() if hasattr(v[face], "item") else v[face]
+               for k, v in table.items()}
+        return {"version": snap.version, "face": face,
+                "outline": unrolled.polygon(face).tolist(), "row": row}
+
+
+def _torsal(gens: np.ndarray, mesh: Mesh) -> np.ndarray:
+    """(k,) uint32: the torsal generators, where the mesher restarts its rows.
+
+    As the PQ mesher finds them: a pair of consecutive generators that is
+    coplanar (twist :func:`ruledmesh.hop.coplanarity` within the tolerance
+    ``degenerate``) marks both, a change of the twist's sign marks the
+    generator where it changes.
+
+    Parameters
+    ----------
+    gens : (m, 2, 3) float64
+        End points of the generators.
+    """
+    from ..hop import coplanarity
+    from ..tolerances import DEFAULT
+
+    if len(gens) < 3:
+        return np.zeros(0, np.uint32)
+    a, d = gens[:, 0], gens[:, 1] - gens[:, 0]
+    twist = coplanarity(a, d, mesh.diagonal() or 1.0)
+    flat = np.abs(twist) <= DEFAULT.degenerate
+    sign = np.sign(np.where(flat, 0.0, twist))
+    flips = np.flatnonzero(sign[:-1] * sign[1:] < 0) + 1
+    pairs = np.flatnonzero(flat)
+    marked = np.unique(np.concatenate([flips, pairs, pairs + 1]))
+    return marked.astype(np.uint32)
+
+
+def _construction(design: Mapping, generators: int) -> dict[str, Any]:
+    """What the page draws of the construction: the primary generator and its division."""
+    mesh = design.get("mesh")
+    if not isinstance(mesh, Mapping) or generators == 0:
+        return {}
+    primary = mesh.get("primary", "middle")
+    if isinstance(primary, int) and not isinstance(primary, bool):
+        index = primary % generators
+    else:
+        index = generators // 2  # the mesher's "middle"
+    rows = mesh.get("rows", 20)
+    return {"primary": index, "rows": rows if isinstance(rows, int) else 20}
 
 
 def _plain(value: Any) -> Any:
@@ -729,7 +928,7 @@ def _curve_polylines(design: Mapping) -> tuple[list[str], list[int], np.ndarray]
             try:
                 pts = np.asarray(curve_from_spec(spec, f"curves.{name}").sample(CURVE_SAMPLES),
                                  dtype=np.float64).reshape(-1, 3)
-            except Exception:  # noqa: BLE001 - display only
+            except Exception:  # noqa: BLE001 - display only; the build reports the error
                 continue
             names.append(name)
             counts.append(len(pts))
@@ -789,4 +988,51 @@ def _handles(design: Mapping, mesh: Mesh) -> list[dict[str, Any]]:
         for key, value in surface.items():
             if (_is_points(value) and len(value) >= 2) or key in _POSITION_KEYS:
                 points(["surface", key], value, key)
+            elif isinstance(value, Mapping) and _is_point(value.get("point")):
+                # an axis {point, direction}: the point, and the direction as a normal handle
+                points(["surface", key, "point"], value["point"], f"{key}.point")
+                _direction_handle(handles, ["surface", key, "direction"], value.get("direction"),
+                                  np.asarray(value["point"], float), mesh, f"{key}.direction")
+        _size_handles(handles, surface, mesh)
     return handles
+
+
+# Length fields of catalogue surfaces with a handle: the axis it is measured along from the
+# surface's centre, and the distance per unit of the field (height: half above the centre).
+_SIZE_KEYS = {"R": (0, 1.0), "radius": (0, 1.0), "a": (0, 1.0), "r": (1, 1.0), "b": (1, 1.0),
+              "c": (2, 1.0), "height": (2, 0.5)}
+
+
+def _direction_handle(handles: list, path: list, direction: Any, anchor: np.ndarray, mesh: Mesh,
+                      label: str) -> None:
+    if not _is_point(direction) or not mesh.n_vertices:
+        return
+    n = np.asarray(direction, dtype=float)
+    norm = float(np.linalg.norm(n))
+    if norm > 0:
+        length = 0.35 * (mesh.diagonal() or 1.0)
+        handles.append({"path": path, "kind": "normal", "anchor": anchor.tolist(),
+                        "position": (anchor + n / norm * length).tolist(), "label": label})
+
+
+def _size_handles(handles: list, surface: Mapping, mesh: Mesh) -> None:
+    """Handles for a catalogue surface's lengths (radius, R, r, a, b, c, height).
+
+    Each is ``{"kind": "size", "anchor", "axis", "scale", "position"}``: the
+    handle sits at ``anchor + value * scale * axis`` and moves along ``axis``.
+    """
+    if not mesh.n_vertices:
+        return
+    centre = mesh.bounding_box().mean(axis=0)
+    for key, (axis, scale) in _SIZE_KEYS.items():
+        value = surface.get(key)
+        if isinstance(value, bool) or not isinstance(value, (int, float)) or value <= 0:
+            continue
+        unit = np.eye(3)[axis]
+        anchor = centre
+        big = surface.get("R")
+        if key == "r" and isinstance(big, (int, float)) and not isinstance(big, bool):
+            anchor, unit = centre + big * np.eye(3)[0], np.eye(3)[0]  # the tube about R
+        handles.append({"path": ["surface", key], "kind": "size", "anchor": anchor.tolist(),
+                        "axis": unit.tolist(), "scale": scale,
+                        "position": (anchor + value * scale * unit).tolist(), "label": key})

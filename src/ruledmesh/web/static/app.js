@@ -28,6 +28,8 @@ const TOKEN = new URLSearchParams(location.search).get('token') || '';
 
 async function request(method, name, body) {
   const init = { method, headers: { Authorization: `Bearer ${TOKEN}` } };
+  // The faces this page has: an answer with the same ones leaves them out (see applyState).
+  if (current?.header.topology) init.headers['X-Ruledmesh-Topology'] = current.header.topology;
   if (body !== undefined) {
     init.headers['Content-Type'] = 'application/json';
     init.body = JSON.stringify(body);
@@ -55,7 +57,9 @@ async function api(method, name, body) {
   if ((response.headers.get('Content-Type') || '').startsWith('application/json')) {
     return response.json();
   }
-  const msg = decode(await response.arrayBuffer());
+  const raw = await response.arrayBuffer();
+  const msg = decode(raw);
+  msg.raw = raw;
   const timing = /dur=([0-9.]+)/.exec(response.headers.get('Server-Timing') || '');
   msg.serverMs = timing ? parseFloat(timing[1]) : null;
   return msg;
@@ -84,38 +88,91 @@ function status(text) { $('status').textContent = text; }
 
 // ------------------------------------------------------------------ scene
 const canvas = $('canvas');
-const renderer = new THREE.WebGLRenderer({ canvas, antialias: true, preserveDrawingBuffer: true });
+// Multisampling is cheap on a graphics card but costs a software renderer (SwiftShader, as
+// in headless or GPU-less browsers) most of each frame: there it is off.
+function softwareGL() {
+  try {
+    const gl = document.createElement('canvas').getContext('webgl2');
+    const info = gl && gl.getExtension('WEBGL_debug_renderer_info');
+    const name = info ? gl.getParameter(info.UNMASKED_RENDERER_WEBGL) : '';
+    gl?.getExtension('WEBGL_lose_context')?.loseContext();
+    return /swiftshader|llvmpipe|software/i.test(name);
+  } catch (err) { return false; }
+}
+const SOFTWARE_GL = softwareGL();
+const renderer = new THREE.WebGLRenderer({ canvas, antialias: !SOFTWARE_GL, preserveDrawingBuffer: true });
 renderer.setPixelRatio(Math.min(window.devicePixelRatio, 2));
 const scene = new THREE.Scene();
 scene.background = new THREE.Color(0xfafafa);
-const camera = new THREE.PerspectiveCamera(40, 1, 0.01, 1e6);
-camera.up.set(0, 0, 1);
+// Two cameras, one shared orbit target: the orthographic one for the view presets
+// (top, front, right) and measured drawings, the perspective one for looking around.
+const perspective = new THREE.PerspectiveCamera(40, 1, 0.01, 1e6);
+const orthographic = new THREE.OrthographicCamera(-1, 1, 1, -1, -1e6, 1e6);
+for (const cam of [perspective, orthographic]) { cam.up.set(0, 0, 1); scene.add(cam); }
+let camera = perspective;
 camera.position.set(10, -20, 12);
 const orbit = new OrbitControls(camera, canvas);
-orbit.addEventListener('change', () => requestRender());
+orbit.addEventListener('change', () => { syncOrtho(); requestRender(); });
 scene.add(new THREE.HemisphereLight(0xffffff, 0x8090a0, 1.6));
 const sun = new THREE.DirectionalLight(0xffffff, 1.4);
-scene.add(sun);
-scene.add(camera);
 sun.position.set(0.4, 0.3, 1);
-camera.add(sun);
+perspective.add(sun);
+const orthoSun = sun.clone();
+orthographic.add(orthoSun);
 
 const gizmo = new TransformControls(camera, canvas);
 gizmo.setSize(0.7);
 gizmo.addEventListener('dragging-changed', (e) => { orbit.enabled = !e.value; });
 gizmo.addEventListener('change', () => requestRender());
 scene.add(gizmo.getHelper());
+// The arrows move a point along one axis; the free-move square in their middle would cover
+// the sphere and steal its drags (and moving all selected points with it), so it goes.
+for (const part of ['picker', 'gizmo']) {
+  const group = gizmo._gizmo?.[part]?.translate;
+  for (const o of [...(group?.children || [])]) if (o.name === 'XYZ') group.remove(o);
+}
 
 const layers = {
   faces: new THREE.Group(), edges: new THREE.Group(), generators: new THREE.Group(),
-  curves: new THREE.Group(), handles: new THREE.Group(),
+  curves: new THREE.Group(), construction: new THREE.Group(), handles: new THREE.Group(),
+  grid: new THREE.Group(), labels: new THREE.Group(),
 };
 for (const g of Object.values(layers)) scene.add(g);
+layers.labels.visible = false;
+
+// The orthographic frustum follows the distance to the target, so zooming (which moves the
+// perspective camera) and switching cameras keep the same scale on screen.
+function syncOrtho() {
+  if (camera !== orthographic) return;
+  const dist = camera.position.distanceTo(orbit.target);
+  const h = dist * Math.tan(THREE.MathUtils.degToRad(perspective.fov / 2)) / camera.zoom;
+  const aspect = perspective.aspect;
+  Object.assign(camera, { left: -h * aspect, right: h * aspect, top: h, bottom: -h });
+  camera.updateProjectionMatrix();
+}
+
+function useCamera(next) {
+  if (next === camera) return;
+  next.position.copy(camera.position);
+  next.quaternion.copy(camera.quaternion);
+  next.zoom = 1;
+  camera = next;
+  orbit.object = camera;
+  gizmo.camera = camera;
+  orbit.update();
+  syncOrtho();
+  camera.updateProjectionMatrix();
+  $('ortho').checked = camera === orthographic;
+  requestRender();
+}
 
 let renderPending = false;
 function render() {
   renderPending = false;
+  fadeEdges();
   renderer.render(scene, camera);
+  if (layers.labels.visible) drawLabels();
+  window.designer.frames += 1;
 }
 function requestRender() {
   if (!renderPending) { renderPending = true; requestAnimationFrame(render); }
@@ -124,8 +181,9 @@ function resize() {
   const view = $('view');
   const w = view.clientWidth, h = view.clientHeight;
   renderer.setSize(w, h, false);
-  camera.aspect = w / Math.max(h, 1);
-  camera.updateProjectionMatrix();
+  perspective.aspect = w / Math.max(h, 1);
+  perspective.updateProjectionMatrix();
+  syncOrtho();
   render();
 }
 window.addEventListener('resize', resize);
@@ -144,59 +202,196 @@ function clearGroup(group) {
 const KIND_COLOURS = ['#4f86c6', '#7cb35a', '#e0a030', '#d05050', '#9060c0', '#909090'];
 const RAMP = [[0.23, 0.30, 0.75], [0.35, 0.70, 0.90], [0.55, 0.80, 0.45], [0.95, 0.80, 0.25],
               [0.85, 0.25, 0.20]];
-const SCALES = {  // log10 range of each relative measure
-  planarity: [-16, -6, 'planarity (relative, log scale)'],
-  closeness: [-6, -1, 'closeness: centroid distance / diagonal (log scale)'],
-};
+const CLASS_PALETTE = ['#4e79a7', '#f28e2b', '#e15759', '#76b7b2', '#59a14f', '#edc948',
+                       '#b07aa1', '#ff9da7', '#9c755f', '#bab0ac', '#1f77b4', '#aec7e8'];
+let closeness = null;     // per-face closeness of the current version (slow figures)
+let classes = null;       // per-face congruence class of the current version (slow figures)
+let areas = null;         // per-face area, computed here from the faces
+
 function ramp(t) {
   t = Math.min(Math.max(t, 0), 1) * (RAMP.length - 1);
   const i = Math.min(Math.floor(t), RAMP.length - 2), f = t - i;
   return RAMP[i].map((c, k) => c + (RAMP[i + 1][k] - c) * f);
 }
+const rampCss = () => RAMP.map((c, i) => `rgb(${c.map((x) => Math.round(255 * x)).join(',')}) ${
+  100 * i / (RAMP.length - 1)}%`).join(',');
+
+// The scale of each colouring: {lo, hi, log, label, mark} from the current figures.
+function scaleOf(mode) {
+  const fig = current.header.figures;
+  if (mode === 'planarity') {
+    // From exact (1e-16) to two decades past the tolerance: the tolerance sits at 80 %, so
+    // faces within it are blue-green and the ones over it orange to red.
+    const tol = fig.planarity_tolerance || 1e-12;
+    const hi = Math.log10(tol) + 2;
+    return { lo: -16, hi, log: true, mark: Math.log10(tol),
+             label: `planarity (relative, log scale); tolerance ${tol.toExponential(0)}` };
+  }
+  if (mode === 'closeness') {
+    return { lo: -6, hi: -1, log: true, label: 'closeness: centroid distance / diagonal (log)' };
+  }
+  const [lo, hi] = range(areas);
+  return { lo, hi: hi > lo ? hi : lo + 1, log: false, label: 'panel area (design units²)' };
+}
+
+function range(values) {
+  let lo = Infinity, hi = -Infinity;
+  for (let i = 0; i < values.length; i++) {
+    const v = values[i];
+    if (v < lo) lo = v;
+    if (v > hi) hi = v;
+  }
+  return values.length ? [lo, hi] : [0, 1];
+}
+
+function valuesOf(mode) {
+  if (mode === 'planarity') return current.arrays.planarity;
+  if (mode === 'closeness') return closeness;
+  if (mode === 'area') return areas;
+  return null;
+}
+
 function faceColours(mode) {
   const nf = current.arrays.kind.length;
   const out = new Float32Array(nf * 3);
-  if (mode === 'kind' || (mode === 'closeness' && !closeness)) {
-    const rgb = KIND_COLOURS.map((c) => new THREE.Color(c));
+  const values = valuesOf(mode);
+  if (mode === 'kind' || mode === 'class' || !values) {
+    const byClass = mode === 'class' && classes;
+    const grey = !byClass && mode !== 'kind';  // slow figures not there yet
+    const palette = (byClass ? CLASS_PALETTE : KIND_COLOURS).map((c) => new THREE.Color(c));
     const kind = current.arrays.kind;
-    const grey = mode === 'closeness';
+    const g = new THREE.Color(KIND_COLOURS[5]);
     for (let f = 0; f < nf; f++) {
-      const c = grey ? rgb[5] : rgb[kind[f]] || rgb[5];
+      const c = grey ? g : byClass ? palette[classes[f] % palette.length] : palette[kind[f]] || g;
       out[3 * f] = c.r; out[3 * f + 1] = c.g; out[3 * f + 2] = c.b;
     }
     return out;
   }
-  const values = mode === 'closeness' ? closeness : current.arrays.planarity;
-  const [lo, hi] = SCALES[mode];
+  const { lo, hi, log } = scaleOf(mode);
   for (let f = 0; f < nf; f++) {
-    const v = Math.log10(Math.max(values[f], 1e-30));
+    const v = log ? Math.log10(Math.max(values[f], 1e-30)) : values[f];
     const c = ramp((v - lo) / (hi - lo));
     out[3 * f] = c[0]; out[3 * f + 1] = c[1]; out[3 * f + 2] = c[2];
   }
   return out;
 }
+
+function median(values) {
+  if (!values.length) return 0;
+  const sorted = Float64Array.from(values).sort();
+  return sorted[Math.floor(sorted.length / 2)];
+}
+
+// The legend names the scale and gives the figures of the faces drawn (min, median, max,
+// and for planarity how many faces exceed the tolerance).
 function drawLegend(mode) {
   const legend = $('legend');
+  const kinds = current.header.choices.face_kinds || [];
+  const stats = {};
   if (mode === 'kind') {
-    legend.innerHTML = (current?.header.choices.face_kinds || []).map(
-      (k, i) => `<span class="swatch" style="background:${KIND_COLOURS[i]}"></span>${k}`).join('');
-    return;
+    const counts = new Array(kinds.length).fill(0);
+    for (const k of current.arrays.kind) counts[k] += 1;
+    legend.innerHTML = kinds.map((k, i) => (counts[i] ? `<span class="swatch" style="background:${
+      KIND_COLOURS[i]}"></span>${k} <b>${counts[i]}</b>` : '')).join('');
+    return stats;
   }
-  const [lo, hi, label] = SCALES[mode];
-  const stops = RAMP.map((c, i) => `rgb(${c.map((x) => Math.round(255 * x)).join(',')}) ${
-    100 * i / (RAMP.length - 1)}%`).join(',');
-  const note = mode === 'closeness' && !closeness ? ' (computing...)' : '';
-  legend.innerHTML = `${label}${note}<div class="ramp" style="background:linear-gradient(90deg,${
-    stops})"></div>1e${lo} &le; &hellip; &le; 1e${hi}`;
+  if (mode === 'class') {
+    const n = classes ? Math.max(...classes) + 1 : null;
+    legend.innerHTML = classes ? `congruence classes: <b>${n}</b> different panels for ${
+      classes.length} faces (colours repeat every ${CLASS_PALETTE.length})`
+      : 'congruence classes (computing...)';
+    stats.classes = n;
+    return stats;
+  }
+  const values = valuesOf(mode);
+  const sc = scaleOf(mode);
+  const tick = (x) => (sc.log ? `1e${+x.toFixed(1)}` : fmt(x));
+  let figures = '';
+  if (values) {
+    const [lo, hi] = range(values);
+    Object.assign(stats, { min: lo, median: median(values), max: hi });
+    figures = `min <b>${fmt(lo)}</b> · median <b>${fmt(stats.median)}</b> · max <b>${fmt(hi)}</b>`;
+    if (mode === 'planarity') {
+      const tol = current.header.figures.planarity_tolerance;
+      let over = 0;
+      for (const v of values) if (v > tol) over += 1;
+      stats.over = over;
+      figures += `<br>over the tolerance: <b data-legend="over">${over}</b> of ${values.length}`;
+    }
+  }
+  const mark = sc.mark !== undefined
+    ? `<div class="mark" style="left:${100 * (sc.mark - sc.lo) / (sc.hi - sc.lo)}%" title="tolerance"></div>`
+    : '';
+  legend.innerHTML = `${sc.label}${values ? '' : ' (computing...)'}<div class="ramp" style="background:linear-gradient(90deg,${
+    rampCss()})">${mark}</div><div class="ticks"><span>${tick(sc.lo)}</span>${sc.mark !== undefined
+    ? `<span class="tol" style="left:${100 * (sc.mark - sc.lo) / (sc.hi - sc.lo)}%">tolerance</span>`
+    : ''}<span>${tick(sc.hi)}</span></div>${figures}`;
+  return stats;
 }
 
 // ------------------------------------------------------------------ drawing
 let current = null;       // last decoded state message {header, arrays}
-let closeness = null;     // per-face closeness of the current version (slow figures)
 let size = 1;             // bounding-box diagonal
 
+// Per-face area and the interior angles of each face, in space (the read-out and the
+// "panel area" colouring use them).
+function faceGeometry() {
+  const { vertices: V, face_offsets: off, face_indices: idx } = current.arrays;
+  const nf = off.length - 1;
+  areas = new Float64Array(nf);
+  for (let f = 0; f < nf; f++) {
+    let x = 0, y = 0, z = 0;
+    const a = 3 * idx[off[f]];
+    for (let k = off[f] + 1; k < off[f + 1] - 1; k++) {
+      const b = 3 * idx[k], c = 3 * idx[k + 1];
+      const ux = V[b] - V[a], uy = V[b + 1] - V[a + 1], uz = V[b + 2] - V[a + 2];
+      const vx = V[c] - V[a], vy = V[c + 1] - V[a + 1], vz = V[c + 2] - V[a + 2];
+      x += uy * vz - uz * vy; y += uz * vx - ux * vz; z += ux * vy - uy * vx;
+    }
+    areas[f] = 0.5 * Math.hypot(x, y, z);
+  }
+}
+
+function faceInfo(f) {
+  const { vertices: V, face_offsets: off, face_indices: idx, planarity, kind } = current.arrays;
+  const pts = [];
+  for (let k = off[f]; k < off[f + 1]; k++) {
+    pts.push(new THREE.Vector3(V[3 * idx[k]], V[3 * idx[k] + 1], V[3 * idx[k] + 2]));
+  }
+  const n = pts.length;
+  const angles = pts.map((p, i) => {
+    const a = pts[(i + n - 1) % n].clone().sub(p), b = pts[(i + 1) % n].clone().sub(p);
+    return THREE.MathUtils.radToDeg(a.angleTo(b));
+  });
+  const edges = pts.map((p, i) => p.distanceTo(pts[(i + 1) % n]));
+  return { face: f, label: `P${f}`, kind: current.header.choices.face_kinds[kind[f]],
+           planarity: planarity[f], area: areas[f], corners: n, angles, edges,
+           cls: classes ? classes[f] : null };
+}
+
+// Writes `data` into the geometry's buffer when it is large enough (only the used part is
+// uploaded), else makes a buffer with a quarter of headroom, so the next updates of a drag
+// or a slider (whose counts change a little) are written in place. Returns true if reused.
+function fitBuffer(geom, name, data, itemSize) {
+  const attr = name === 'index' ? geom.index : geom.getAttribute(name);
+  if (attr && attr.array.length >= data.length && attr.array.length <= 2 * data.length + 64) {
+    attr.array.set(data);
+    attr.clearUpdateRanges();
+    attr.addUpdateRange(0, data.length);
+    attr.needsUpdate = true;
+    return true;
+  }
+  const big = new data.constructor(Math.ceil(1.25 * data.length) + 16);
+  big.set(data);
+  const fresh = new THREE.BufferAttribute(big, itemSize);
+  if (name === 'index') geom.setIndex(fresh); else geom.setAttribute(name, fresh);
+  return false;
+}
+const setAttribute = fitBuffer;
+
+// Triangles for display, each with its face's colour, written into the buffers drawn until
+// now where they fit (the draw range then hides what is left of the old picture).
 function drawFaces() {
-  clearGroup(layers.faces);
   const { vertices: V, triangles: T, triangle_face: TF } = current.arrays;
   const nt = TF.length;
   const pos = new Float32Array(nt * 9);
@@ -210,34 +405,133 @@ function drawFaces() {
       col[o] = fc[3 * f]; col[o + 1] = fc[3 * f + 1]; col[o + 2] = fc[3 * f + 2];
     }
   }
-  const geom = new THREE.BufferGeometry();
-  geom.setAttribute('position', new THREE.BufferAttribute(pos, 3));
-  geom.setAttribute('color', new THREE.BufferAttribute(col, 3));
-  geom.computeVertexNormals();
-  const mat = new THREE.MeshLambertMaterial({
-    vertexColors: true, side: THREE.DoubleSide, polygonOffset: true,
-    polygonOffsetFactor: 1, polygonOffsetUnits: 1 });
-  layers.faces.add(new THREE.Mesh(geom, mat));
-  drawLegend($('colour').value);
+  let mesh = layers.faces.children[0];
+  if (!mesh) {
+    const mat = new THREE.MeshLambertMaterial({
+      vertexColors: true, side: THREE.DoubleSide, polygonOffset: true,
+      polygonOffsetFactor: 1, polygonOffsetUnits: 1 });
+    mesh = new THREE.Mesh(new THREE.BufferGeometry(), mat);
+    layers.faces.add(mesh);
+  }
+  const geom = mesh.geometry;
+  const reused = fitBuffer(geom, 'position', pos, 3);
+  fitBuffer(geom, 'color', col, 3);
+  geom.setDrawRange(0, 3 * nt);
+  computeNormals(geom, pos);
+  geom.computeBoundingSphere();
+  window.designer.reused = reused;
+  window.designer.legend = drawLegend($('colour').value);
 }
 
-function lines(positions, index, colour, opacity = 1) {
+// Flat normals of the triangles drawn (each triangle's own: the faces are planar).
+function computeNormals(geom, pos) {
+  const nt = pos.length / 9;
+  const nor = new Float32Array(pos.length);
+  for (let t = 0; t < nt; t++) {
+    const o = 9 * t;
+    const ux = pos[o + 3] - pos[o], uy = pos[o + 4] - pos[o + 1], uz = pos[o + 5] - pos[o + 2];
+    const vx = pos[o + 6] - pos[o], vy = pos[o + 7] - pos[o + 1], vz = pos[o + 8] - pos[o + 2];
+    let x = uy * vz - uz * vy, y = uz * vx - ux * vz, z = ux * vy - uy * vx;
+    const l = Math.hypot(x, y, z) || 1;
+    x /= l; y /= l; z /= l;
+    for (let k = 0; k < 3; k++) { nor[o + 3 * k] = x; nor[o + 3 * k + 1] = y; nor[o + 3 * k + 2] = z; }
+  }
+  fitBuffer(geom, 'normal', nor, 3);
+}
+
+function recolour() {
+  if (!layers.faces.children[0]) return;
+  drawFaces();
+  render();
+}
+
+function lines(positions, index, colour, opacity = 1, dashed = false) {
   const geom = new THREE.BufferGeometry();
   geom.setAttribute('position', new THREE.BufferAttribute(positions, 3));
   if (index) geom.setIndex(new THREE.BufferAttribute(index, 1));
-  const mat = new THREE.LineBasicMaterial({ color: colour, transparent: opacity < 1, opacity });
-  return new THREE.LineSegments(geom, mat);
+  const mat = dashed
+    ? new THREE.LineDashedMaterial({ color: colour, transparent: opacity < 1, opacity,
+                                      dashSize: 0.012 * size, gapSize: 0.008 * size })
+    : new THREE.LineBasicMaterial({ color: colour, transparent: opacity < 1, opacity });
+  const seg = new THREE.LineSegments(geom, mat);
+  if (dashed) seg.computeLineDistances();
+  return seg;
 }
 
-function drawScene() {
+// Face edges (the quads as quads), in the buffers drawn until now where they fit.
+function drawEdges() {
+  const { vertices: V, edges: E } = current.arrays;
+  let seg = layers.edges.children[0];
+  if (!seg) {
+    seg = new THREE.LineSegments(new THREE.BufferGeometry(),
+      new THREE.LineBasicMaterial({ color: 0x202020, transparent: true, opacity: 0.8 }));
+    layers.edges.add(seg);
+  }
+  fitBuffer(seg.geometry, 'position', V, 3);
+  fitBuffer(seg.geometry, 'index', E, 1);
+  seg.geometry.setDrawRange(0, E.length);
+  seg.geometry.computeBoundingSphere();
+  // The faces' median width (area / longest edge, of up to 2,000 faces): the spacing of the
+  // edges across the faces, also for long thin ones; fadeEdges dims dense meshes by it.
+  const { face_offsets: off, face_indices: idx } = current.arrays;
+  const nf = off.length - 1, stride = Math.max(1, Math.floor(nf / 2000)), widths = [];
+  for (let f = 0; f < nf; f += stride) {
+    let longest = 0;
+    for (let k = off[f]; k < off[f + 1]; k++) {
+      const a = 3 * idx[k], b = 3 * idx[k + 1 < off[f + 1] ? k + 1 : off[f]];
+      longest = Math.max(longest, Math.hypot(V[a] - V[b], V[a + 1] - V[b + 1], V[a + 2] - V[b + 2]));
+    }
+    if (longest > 0) widths.push(areas[f] / longest);
+  }
+  widths.sort((x, y) => x - y);
+  seg.userData.edgeLength = widths.length ? widths[widths.length >> 1] : 0;
+}
+
+// Where edges come closer on screen than about 6 pixels they fade, so a dense mesh reads
+// as a surface with a fine net rather than a black moiré; zooming in brings them back.
+function fadeEdges() {
+  const seg = layers.edges.children[0];
+  if (!seg || !seg.userData.edgeLength) return;
+  const h = canvas.clientHeight || 1;
+  const pxPerUnit = camera === orthographic
+    ? h * camera.zoom / (camera.top - camera.bottom)
+    : h / (2 * camera.position.distanceTo(orbit.target) * Math.tan(THREE.MathUtils.degToRad(camera.fov / 2)));
+  const px = seg.userData.edgeLength * pxPerUnit;
+  seg.material.opacity = Math.min(0.8, Math.max(0.08, 0.8 * px / 6));
+  window.designer.edgeOpacity = seg.material.opacity;
+}
+
+// The generators are the rulings the mesh was built on: a separate, dashed layer, shown by
+// default only while they are few enough not to cover the quads.
+const GENERATORS_SHOWN_UP_TO = 40;
+let generatorsTouched = false;
+function drawGenerators(reuse) {
+  const G = current.arrays.generators;
+  const old = layers.generators.children[0];
+  if (!G.length) { clearGroup(layers.generators); return; }  // a catalogue surface: none
+  if (reuse && old && old.geometry.getAttribute('position').array.length === G.length) {
+    setAttribute(old.geometry, 'position', G, 3);
+    old.computeLineDistances();
+  } else {
+    clearGroup(layers.generators);
+    layers.generators.add(lines(G, null, 0x1f5fbf, 0.55, true));
+  }
+  if (!generatorsTouched) {
+    const show = G.length / 6 <= GENERATORS_SHOWN_UP_TO;
+    layers.generators.visible = show;
+    document.querySelector('[data-layer=generators]').checked = show;
+  }
+}
+
+function polyline(points, colour, opacity = 1) {
+  const geom = new THREE.BufferGeometry();
+  geom.setAttribute('position', new THREE.BufferAttribute(new Float32Array(points.flat()), 3));
+  return new THREE.Line(geom, new THREE.LineBasicMaterial({ color: colour, transparent: opacity < 1,
+                                                           opacity }));
+}
+
+function drawCurves() {
   const { header, arrays } = current;
-  const [lo, hi] = header.bbox;
-  size = Math.hypot(hi[0] - lo[0], hi[1] - lo[1], hi[2] - lo[2]) || 1;
-  drawFaces();
-  clearGroup(layers.edges);
-  layers.edges.add(lines(arrays.vertices, arrays.edges, 0x303030, 0.55));
-  clearGroup(layers.generators);
-  layers.generators.add(lines(arrays.generators, null, 0x1f5fbf, 0.8));
   clearGroup(layers.curves);
   let start = 0;
   for (const c of header.curves) {
@@ -247,9 +541,104 @@ function drawScene() {
     start += c.count;
     layers.curves.add(new THREE.Line(geom, new THREE.LineBasicMaterial({ color: 0xd0308a })));
   }
-  drawHandles();
-  render();
 }
+
+// The construction: control polygons, the directrix line, the director plane, the primary
+// generator with its division, the torsal generators.
+function drawConstruction() {
+  clearGroup(layers.construction);
+  const { header, arrays } = current;
+  const design = header.design;
+  const add = (o, name) => { o.userData.construction = name; layers.construction.add(o); };
+  for (const [name, spec] of Object.entries(design.curves || {})) {
+    if (Array.isArray(spec.points) && spec.points.length > 1 && spec.type !== 'polyline') {
+      add(polyline(spec.points, 0xff8c3a, 0.7), `control polygon ${name}`);
+    }
+  }
+  const r = design.rulings || {};
+  const directrix = r.directrix || r.conoid?.directrix;
+  if (Array.isArray(directrix) && directrix.length === 2) {
+    const a = new THREE.Vector3(...directrix[0]), b = new THREE.Vector3(...directrix[1]);
+    const d = b.clone().sub(a).normalize().multiplyScalar(0.6 * size);
+    add(polyline([a.clone().sub(d).toArray(), b.clone().add(d).toArray()], 0x008a8a), 'directrix');
+  }
+  const normal = header.handles.find((h) => h.kind === 'normal');
+  if (normal) {
+    const n = new THREE.Vector3(...normal.position).sub(new THREE.Vector3(...normal.anchor)).normalize();
+    const plane = new THREE.Mesh(new THREE.PlaneGeometry(0.6 * size, 0.6 * size),
+      new THREE.MeshBasicMaterial({ color: 0x10a060, transparent: true, opacity: 0.12,
+                                    side: THREE.DoubleSide, depthWrite: false }));
+    plane.position.set(...normal.anchor);
+    plane.quaternion.setFromUnitVectors(new THREE.Vector3(0, 0, 1), n);
+    add(plane, 'director plane');
+  }
+  const G = arrays.generators;
+  const m = G.length / 6;
+  const gen = (i) => [[G[6 * i], G[6 * i + 1], G[6 * i + 2]], [G[6 * i + 3], G[6 * i + 4], G[6 * i + 5]]];
+  const cons = header.construction || {};
+  if (m && cons.primary !== undefined && cons.primary < m) {
+    const [a, b] = gen(cons.primary);
+    add(polyline([a, b], 0xc01010), 'primary generator');
+    const rows = Math.min(cons.rows || 20, 2000);
+    const ticks = new Float32Array(3 * (rows + 1));
+    for (let k = 0; k <= rows; k++) {
+      for (let j = 0; j < 3; j++) ticks[3 * k + j] = a[j] + (b[j] - a[j]) * k / rows;
+    }
+    const geom = new THREE.BufferGeometry();
+    geom.setAttribute('position', new THREE.BufferAttribute(ticks, 3));
+    add(new THREE.Points(geom, new THREE.PointsMaterial({ color: 0xc01010, size: 5,
+                                                          sizeAttenuation: false })),
+        'division of the primary generator');
+  }
+  for (const i of arrays.torsal || []) {
+    if (i >= m) continue;
+    const seg = lines(new Float32Array(gen(i).flat()), null, 0xe00000, 1, true);
+    add(seg, `torsal generator ${i}`);
+  }
+}
+
+function drawGrid() {
+  clearGroup(layers.grid);
+  const [lo, hi] = current.header.bbox;
+  const span = Math.max(hi[0] - lo[0], hi[1] - lo[1], 1e-9);
+  const step = 10 ** Math.floor(Math.log10(span / 5));
+  const half = Math.ceil(span / step) * step;
+  const n = Math.round(2 * half / step);
+  const grid = new THREE.GridHelper(2 * half, n, 0xb0b0b0, 0xdddddd);
+  grid.rotation.x = Math.PI / 2;  // three's grid lies in XZ; the designer is Z-up
+  grid.position.set(Math.round((lo[0] + hi[0]) / 2 / step) * step,
+                    Math.round((lo[1] + hi[1]) / 2 / step) * step, lo[2]);
+  grid.userData.step = step;
+  layers.grid.add(grid);
+  const axes = new THREE.AxesHelper(0.25 * size);
+  axes.position.set(0, 0, 0);
+  layers.grid.add(axes);
+  $('grid-step').textContent = `grid ${fmt(step)}`;
+}
+
+function drawScene() {
+  const { header, arrays } = current;
+  const [lo, hi] = header.bbox;
+  size = Math.hypot(hi[0] - lo[0], hi[1] - lo[1], hi[2] - lo[2]) || 1;
+  // Buffers of the same size are written in place (no new GPU buffers, no garbage): a
+  // moved point or a continuous slider mostly keeps the face and edge counts.
+  // How long each part of drawing takes (window.designer.drawTimes, for the speed figures).
+  const times = {};
+  let t = performance.now();
+  const lap = (name) => { const now = performance.now(); times[name] = now - t; t = now; };
+  faceGeometry(); lap('areas');
+  drawFaces(); lap('faces');
+  drawEdges(); drawGenerators(true); lap('lines');
+  drawCurves(); drawConstruction(); drawGrid(); drawHandles(); lap('construction');
+  render(); lap('render');
+  window.designer.drawTimes = times;
+}
+
+// ------------------------------------------------------------------ handles and selection
+const selection = new Set();   // labels of the selected handles
+let primaryLabel = null;       // the handle the axis arrows and typed coordinates act on
+
+function handleMeshes() { return layers.handles.children.filter((o) => o.userData.handle); }
 
 function drawHandles() {
   const attached = gizmo.object?.userData.handle?.label;
@@ -257,17 +646,26 @@ function drawHandles() {
   clearGroup(layers.handles);
   const r = 0.012 * size;
   const sphere = new THREE.SphereGeometry(1, 16, 12);
+  const cube = new THREE.BoxGeometry(1.6, 1.6, 1.6);
+  const labels = new Set(current.header.handles.map((h) => h.label));
+  for (const l of [...selection]) if (!labels.has(l)) selection.delete(l);
+  if (primaryLabel && !labels.has(primaryLabel)) primaryLabel = null;
   for (const h of current.header.handles) {
-    const normal = h.kind === 'normal';
-    const mat = new THREE.MeshBasicMaterial({ color: normal ? 0x10a060 : 0xff6a00 });
-    const m = new THREE.Mesh(sphere.clone(), mat);
-    m.scale.setScalar(normal ? 1.4 * r : r);
+    const normal = h.kind === 'normal', sized = h.kind === 'size';
+    const picked = selection.has(h.label);
+    // Drawn over the faces: a handle inside a tube or behind a sheet can still be taken.
+    const mat = new THREE.MeshBasicMaterial({
+      color: picked ? 0x1d4ed8 : normal ? 0x10a060 : sized ? 0x8a2be2 : 0xff6a00,
+      depthTest: false, transparent: true, opacity: 0.95 });
+    const m = new THREE.Mesh(sized ? cube.clone() : sphere.clone(), mat);
+    m.renderOrder = 10;
+    m.scale.setScalar((normal ? 1.4 : 1) * (picked ? 1.35 : 1) * r);
     m.position.set(...h.position);
     m.userData.handle = h;
     layers.handles.add(m);
-    if (normal) {
+    if (normal || sized) {
       const seg = new Float32Array([...h.anchor, ...h.position]);
-      const line = lines(seg, null, 0x10a060);
+      const line = lines(seg, null, sized ? 0x8a2be2 : 0x10a060);
       line.userData.isLeash = true;
       m.userData.leash = line;
       layers.handles.add(line);
@@ -275,18 +673,242 @@ function drawHandles() {
     if (attached && h.label === attached && !dragging) gizmo.attach(m);
   }
   sphere.dispose();
+  cube.dispose();
+  showSelection();
+}
+
+function select(label, add) {
+  if (!add) selection.clear();
+  if (label === null) { primaryLabel = null; gizmo.detach(); }
+  else if (add && selection.has(label)) {
+    selection.delete(label);
+    if (primaryLabel === label) primaryLabel = [...selection][0] || null;
+  } else { selection.add(label); primaryLabel = label; }
+  drawHandles();
+  render();
+}
+
+function handleByLabel(label) { return current.header.handles.find((h) => h.label === label); }
+
+// The point list a handle belongs to (a curve's points or a [surface] list) and its index.
+function listOf(h) {
+  const path = h.path;
+  if (!path.length || typeof path[path.length - 1] !== 'number') return null;
+  const listPath = path.slice(0, -1);
+  if (listPath[0] === 'rulings') return null;  // a directrix has exactly two points
+  return { listPath, index: path[path.length - 1], points: valueAt(listPath) };
+}
+
+function showSelection() {
+  const box = $('selection');
+  const h = primaryLabel && handleByLabel(primaryLabel);
+  $('sel-name').textContent = !selection.size ? 'nothing selected (click a sphere; Shift+click adds)'
+    : selection.size === 1 ? primaryLabel : `${selection.size} points (${primaryLabel} typed)`;
+  for (const [i, axis] of ['x', 'y', 'z'].entries()) {
+    const input = $(`sel-${axis}`);
+    input.disabled = !h || h.kind !== 'point';
+    if (document.activeElement !== input) input.value = h ? +h.position[i].toFixed(6) : '';
+  }
+  const list = h && h.kind === 'point' ? listOf(h) : null;
+  for (const id of ['pt-insert', 'pt-delete', 'pt-append']) $(id).disabled = !list;
+  box.dataset.count = selection.size;
+}
+
+// Typing one coordinate of the typed point moves every selected point by the same amount.
+function typeCoordinate(axis) {
+  const h = primaryLabel && handleByLabel(primaryLabel);
+  const v = Number($(`sel-${'xyz'[axis]}`).value);
+  if (!h || !Number.isFinite(v)) { showSelection(); return; }
+  const delta = v - h.position[axis];
+  const changes = [];
+  for (const label of selection) {
+    const o = handleByLabel(label);
+    if (!o || o.kind !== 'point') continue;
+    const p = [...o.position];
+    p[axis] = +(p[axis] + delta).toFixed(9);
+    changes.push([o.path, p]);
+  }
+  if (changes.length) queueEdit(changes);
+}
+
+// Insert a point after the typed one (half way to the next, or continuing the last span),
+// delete it, or add one after the end: the whole list is sent, one edit, one undo step.
+function editPoints(action) {
+  const h = primaryLabel && handleByLabel(primaryLabel);
+  const list = h && listOf(h);
+  if (!list) return;
+  const pts = list.points.map((p) => [...p]);
+  const i = list.index;
+  const mid = (a, b) => a.map((x, k) => +((x + b[k]) / 2).toFixed(6));
+  const beyond = (a, b) => b.map((x, k) => +(2 * x - a[k]).toFixed(6));
+  let chosen = i;
+  if (action === 'delete') {
+    pts.splice(i, 1);
+    chosen = Math.min(i, pts.length - 1);
+  } else if (action === 'insert') {
+    const p = i + 1 < pts.length ? mid(pts[i], pts[i + 1]) : beyond(pts[i - 1] || pts[i], pts[i]);
+    pts.splice(i + 1, 0, p);
+    chosen = i + 1;
+  } else {
+    const n = pts.length;
+    pts.push(beyond(pts[n - 2] || pts[n - 1], pts[n - 1]));
+    chosen = n;
+  }
+  const base = h.label.replace(/\[\d+\]$/, '');
+  selection.clear();
+  selection.add(`${base}[${chosen}]`);
+  primaryLabel = `${base}[${chosen}]`;
+  queueEdit([[list.listPath, pts]]);
+}
+
+// Snapping while dragging: to the grid (its step) and to the other points (within 10 px).
+function snapped(pos, h) {
+  if ($('snap-points').checked) {
+    let best = null, bestD = 10;
+    const rect = canvas.getBoundingClientRect();
+    const screen = (v) => { const p = v.clone().project(camera);
+      return [(p.x + 1) / 2 * rect.width, (1 - p.y) / 2 * rect.height]; };
+    const [sx, sy] = screen(pos);
+    for (const o of current.header.handles) {
+      if (o.label === h.label || selection.has(o.label) || o.kind !== 'point') continue;
+      const [x, y] = screen(new THREE.Vector3(...o.position));
+      const d = Math.hypot(x - sx, y - sy);
+      if (d < bestD) { bestD = d; best = o; }
+    }
+    if (best) return new THREE.Vector3(...best.position);
+  }
+  if ($('snap-grid').checked) {
+    const step = layers.grid.children[0]?.userData.step || 1;
+    return new THREE.Vector3(...pos.toArray().map((x) => Math.round(x / step) * step));
+  }
+  return pos;
 }
 
 function fitView() {
   const [lo, hi] = current.header.bbox;
   const c = new THREE.Vector3((lo[0] + hi[0]) / 2, (lo[1] + hi[1]) / 2, (lo[2] + hi[2]) / 2);
+  const dir = camera.position.clone().sub(orbit.target);
+  if (dir.lengthSq() < 1e-20) dir.set(0.55, -1, 0.6);
   orbit.target.copy(c);
-  const dir = new THREE.Vector3(0.55, -1, 0.6).normalize();
-  camera.position.copy(c).addScaledVector(dir, 1.5 * size);
-  camera.near = size / 1000; camera.far = size * 100;
-  camera.updateProjectionMatrix();
+  camera.position.copy(c).addScaledVector(dir.normalize(), 1.5 * size);
+  camera.zoom = 1;
+  perspective.near = size / 1000; perspective.far = size * 100;
+  perspective.updateProjectionMatrix();
   orbit.update();
+  syncOrtho();
   render();
+}
+
+// View presets: top (looking down -Z), front (looking along +Y), right (along -X), and the
+// perspective three-quarter view. Presets other than perspective use the orthographic camera.
+const VIEWS = { top: [0, 0, 1], front: [0, -1, 0], right: [1, 0, 0], perspective: [0.55, -1, 0.6] };
+function setView(name) {
+  useCamera(name === 'perspective' ? perspective : orthographic);
+  const dir = new THREE.Vector3(...VIEWS[name]);
+  // OrbitControls keeps +Z up: straight down is its pole, so look down a hair off it
+  // (then +Y is up on screen, as on a plan).
+  if (name === 'top') dir.set(0, -1e-3, 1);
+  camera.position.copy(orbit.target).addScaledVector(dir.normalize(), 1.5 * size);
+  camera.lookAt(orbit.target);
+  orbit.update();
+  window.designer.view = name;
+  fitView();
+}
+
+function screenshot() {
+  render();
+  const a = document.createElement('a');
+  a.href = canvas.toDataURL('image/png');
+  a.download = `${(current.header.save_name || 'design').replace(/\.toml$/, '').replace(/\//g, '_')}.png`;
+  document.body.append(a);
+  a.click();
+  a.remove();
+}
+
+// ------------------------------------------------------------------ face read-out and panels
+const faceRay = new THREE.Raycaster();
+function faceAt(event) {
+  const mesh = layers.faces.children[0];
+  if (!mesh || !layers.faces.visible) return null;
+  const rect = canvas.getBoundingClientRect();
+  const p = new THREE.Vector2(((event.clientX - rect.left) / rect.width) * 2 - 1,
+    -((event.clientY - rect.top) / rect.height) * 2 + 1);
+  faceRay.setFromCamera(p, camera);
+  const hit = faceRay.intersectObject(mesh, false)[0];
+  return hit ? current.arrays.triangle_face[hit.faceIndex] : null;
+}
+
+function readoutHtml(info) {
+  const ang = info.angles;
+  return `<b>${info.label}</b> ${info.kind}, ${info.corners} corners<br>planarity ${
+    fmt(info.planarity)}<br>area ${fmt(info.area)}<br>angles ${ang.map((a) => a.toFixed(1)).join(
+    '°, ')}°<br>edges ${info.edges.map((e) => fmt(e)).join(', ')}${info.cls !== null
+    ? `<br>class ${info.cls}` : ''}`;
+}
+
+function showReadout(event, f) {
+  const box = $('readout');
+  if (f === null) { box.hidden = true; window.designer.hover = null; return; }
+  const info = faceInfo(f);
+  box.innerHTML = readoutHtml(info);
+  box.style.left = `${event.offsetX + 14}px`;
+  box.style.top = `${event.offsetY + 14}px`;
+  box.hidden = false;
+  window.designer.hover = info;
+}
+
+async function openPanel(f) {
+  let data;
+  try {
+    data = await api('GET', `panel?face=${f}`);
+  } catch (err) { showError(err.message); return; }
+  const drawer = $('drawer');
+  drawer.hidden = false;
+  $('drawer-title').textContent = `panel ${data.row.label}`;
+  const pts = data.outline;
+  const xs = pts.map((p) => p[0]), ys = pts.map((p) => p[1]);
+  const [x0, x1, y0, y1] = [Math.min(...xs), Math.max(...xs), Math.min(...ys), Math.max(...ys)];
+  const w = x1 - x0 || 1, h = y1 - y0 || 1, pad = 0.08 * Math.max(w, h);
+  const poly = pts.map((p) => `${p[0]},${-p[1]}`).join(' ');
+  const edgeLabels = pts.map((p, i) => {
+    const q = pts[(i + 1) % pts.length];
+    const len = Math.hypot(q[0] - p[0], q[1] - p[1]);
+    return `<text x="${(p[0] + q[0]) / 2}" y="${-(p[1] + q[1]) / 2}" font-size="${
+      0.05 * Math.max(w, h)}" text-anchor="middle">${fmt(len)}</text>`;
+  }).join('');
+  $('drawer-shape').innerHTML = `<svg viewBox="${x0 - pad} ${-y1 - pad} ${w + 2 * pad} ${h + 2 * pad}"
+    width="280" height="${Math.min(280, 280 * (h + 2 * pad) / (w + 2 * pad))}">
+    <polygon points="${poly}" fill="#dde8f6" stroke="#1d4ed8" stroke-width="${0.006 * Math.max(w, h)}"/>
+    ${edgeLabels}</svg>`;
+  $('drawer-row').innerHTML = Object.entries(data.row).map(([k, v]) => `<tr><th>${k}</th><td>${
+    typeof v === 'number' ? fmt(v) : v}</td></tr>`).join('');
+  window.designer.panel = data;
+}
+
+// Labels of the faces, on demand: the fabrication names (P0, P1, ... as on the cutting
+// sheets and in panels.csv), drawn for the faces whose centres are on screen (at most 400).
+const MAX_LABELS = 400;
+function drawLabels() {
+  const box = $('labels');
+  if (!layers.labels.visible || !current) { box.innerHTML = ''; box.hidden = true; return; }
+  box.hidden = false;
+  const { vertices: V, face_offsets: off, face_indices: idx } = current.arrays;
+  const rect = canvas.getBoundingClientRect();
+  const out = [];
+  const v = new THREE.Vector3();
+  for (let f = 0; f < off.length - 1 && out.length <= MAX_LABELS; f++) {
+    v.set(0, 0, 0);
+    for (let k = off[f]; k < off[f + 1]; k++) {
+      v.x += V[3 * idx[k]]; v.y += V[3 * idx[k] + 1]; v.z += V[3 * idx[k] + 2];
+    }
+    v.divideScalar(off[f + 1] - off[f]).project(camera);
+    if (Math.abs(v.x) > 1 || Math.abs(v.y) > 1 || v.z > 1) continue;
+    out.push(`<span style="left:${(v.x + 1) / 2 * rect.width}px;top:${
+      (1 - v.y) / 2 * rect.height}px">P${f}</span>`);
+  }
+  box.innerHTML = out.length > MAX_LABELS
+    ? `<em class="note">${off.length - 1} faces: zoom in to label them</em>` : out.join('');
+  window.designer.labels = out.length > MAX_LABELS ? -1 : out.length;
 }
 
 // ------------------------------------------------------------------ figures
@@ -339,8 +961,9 @@ async function fetchSlowFigures() {
     status('figures: ' + msg.header.error);
   }
   closeness = msg.arrays.closeness ? new Float32Array(msg.arrays.closeness) : null;
+  classes = msg.arrays.class ? new Uint32Array(msg.arrays.class) : null;
   window.designer.figuresVersion = version;
-  if ($('colour').value === 'closeness') { drawFaces(); render(); }
+  if (['closeness', 'class'].includes($('colour').value)) recolour();
 }
 
 // ------------------------------------------------------------------ controls
@@ -362,6 +985,66 @@ function numberRange(name, v, isInt) {
   return [lo, hi, (hi - lo) / 400];
 }
 
+// A slider with a number field (and a button widening its range) for a numeric field.
+function numberControl(row, path, name, value, send) {
+  const k = keyOf(path);
+  const isInt = Number.isInteger(value) && !(name === 'extend');
+  let numeric = typeof value === 'number' ? value : 0;
+  let [lo, hi, step] = numberRange(name, numeric, isInt);
+  if (name === 'primary') { lo = 0; hi = Math.max((current.header.design.rulings?.count || 3) - 1, 1); step = 1;
+    if (typeof value !== 'number') numeric = Math.floor(hi / 2); }
+  if (name === 'extend') { lo = 0; hi = Math.max(2, 2 * numeric); step = 0.01; }
+  const slider = document.createElement('input');
+  slider.type = 'range';
+  Object.assign(slider, { min: lo, max: hi, step });
+  slider.value = numeric;
+  slider.dataset.path = path.join('.');
+  const field = document.createElement('input');
+  field.type = 'text';
+  field.className = 'val';
+  field.value = String(value);
+  field.dataset.path = path.join('.');
+  slider.addEventListener('input', () => {
+    activeInput = slider;
+    const v = isInt || step === 1 ? parseInt(slider.value, 10) : parseFloat(slider.value);
+    field.value = String(v);
+    field.dataset.synced = field.value;
+    send(v, `slider:${k}:${gestures[k] || 0}`);
+  });
+  slider.addEventListener('change', () => { gestures[k] = (gestures[k] || 0) + 1; activeInput = null; });
+  field.dataset.synced = field.value;
+  field.addEventListener('change', () => {
+    field.dataset.synced = field.value;
+    const text = field.value.trim();
+    const num = Number(text);
+    const v = text !== '' && !Number.isNaN(num) ? num
+      : (name in NUMERIC_OR_WORD ? text : text);
+    // A typed value past the slider's ends widens it.
+    if (typeof v === 'number') {
+      if (v > +slider.max) slider.max = v;
+      if (v < +slider.min) slider.min = v;
+    }
+    send(v);
+  });
+  // The range can be widened: twice as far either side of the value (integers: up).
+  const widen = document.createElement('button');
+  widen.className = 'widen';
+  widen.textContent = '↔';
+  widen.title = 'widen the slider range';
+  widen.dataset.widen = path.join('.');
+  widen.addEventListener('click', () => {
+    const v = +slider.value, lo = +slider.min, hi = +slider.max;
+    if (isInt) { slider.max = Math.max(2 * hi, hi + 10); if (lo < 0) slider.min = 2 * lo; }
+    else {
+      const span = Math.max(hi - lo, 1e-9);
+      slider.min = lo >= 0 && v - span >= 0 ? v - span : lo >= 0 ? 0 : v - span;
+      slider.max = v + span;
+      slider.step = (slider.max - slider.min) / 400;
+    }
+  });
+  row.append(slider, field, widen);
+}
+
 function control(parent, path, name, value) {
   const row = document.createElement('div');
   row.className = 'ctl';
@@ -371,7 +1054,6 @@ function control(parent, path, name, value) {
   label.textContent = name;
   label.title = path.join('.');
   row.append(label);
-  const k = keyOf(path);
   const send = (v, coalesce) => queueEdit([[path, v]], coalesce);
 
   if (typeof value === 'boolean') {
@@ -381,37 +1063,7 @@ function control(parent, path, name, value) {
     box.addEventListener('change', () => send(box.checked));
     row.append(box);
   } else if (typeof value === 'number' || name in NUMERIC_OR_WORD) {
-    const isInt = Number.isInteger(value) && !(name === 'extend');
-    let numeric = typeof value === 'number' ? value : 0;
-    let [lo, hi, step] = numberRange(name, numeric, isInt);
-    if (name === 'primary') { lo = 0; hi = Math.max((current.header.design.rulings?.count || 3) - 1, 1); step = 1;
-      if (typeof value !== 'number') numeric = Math.floor(hi / 2); }
-    if (name === 'extend') { lo = 0; hi = Math.max(2, 2 * numeric); step = 0.01; }
-    const slider = document.createElement('input');
-    slider.type = 'range';
-    Object.assign(slider, { min: lo, max: hi, step });
-    slider.value = numeric;
-    slider.dataset.path = path.join('.');
-    const field = document.createElement('input');
-    field.type = 'text';
-    field.className = 'val';
-    field.value = String(value);
-    field.dataset.path = path.join('.');
-    slider.addEventListener('input', () => {
-      activeInput = slider;
-      const v = isInt || step === 1 ? parseInt(slider.value, 10) : parseFloat(slider.value);
-      field.value = String(v);
-      send(v, `slider:${k}:${gestures[k] || 0}`);
-    });
-    slider.addEventListener('change', () => { gestures[k] = (gestures[k] || 0) + 1; activeInput = null; });
-    field.addEventListener('change', () => {
-      const text = field.value.trim();
-      const num = Number(text);
-      const v = text !== '' && !Number.isNaN(num) ? num
-        : (name in NUMERIC_OR_WORD ? text : text);
-      send(v);
-    });
-    row.append(slider, field);
+    numberControl(row, path, name, value, send);
   } else if (typeof value === 'string') {
     const choices = choiceList(path, name);
     if (choices) {
@@ -492,7 +1144,8 @@ function designShape(design) {
 let shownShape = null;
 function buildControls() {
   const design = current.header.design;
-  const shape = designShape(design) + '|' + (design.surface?.kind || '');
+  const shape = designShape(design) + '|' + (design.surface?.kind || '') + '|'
+    + (design.mesh?.method || 'pq') + '|' + JSON.stringify(design.rulings?.between || null);
   if (shape === shownShape) { syncControls(); return; }
   shownShape = shape;
   const box = $('controls');
@@ -511,12 +1164,51 @@ function buildControls() {
   section('[surface]', design.surface, ['surface']);
   section('[rulings]', design.rulings, ['rulings']);
   if (design.rulings?.conoid) section('[rulings.conoid]', design.rulings.conoid, ['rulings', 'conoid']);
+  if (Array.isArray(design.rulings?.between)) betweenControl(box, design);
   section('[mesh]', design.mesh, ['mesh']);
+  // Every numeric (and boolean) field of the method, also those left at their defaults.
+  const defaults = METHOD_FIELDS[design.mesh?.method || 'pq'] || {};
+  for (const [k, v] of Object.entries(defaults)) {
+    if (design.mesh && k in design.mesh) continue;
+    control(box, ['mesh', k], k, v);
+    box.lastElementChild?.classList.add('default');
+  }
   for (const [name, spec] of Object.entries(design.curves || {})) section(`[curves.${name}]`, spec, ['curves', name]);
   // the primary slider's range follows the generator count
   const count = design.rulings?.count;
   const prim = box.querySelector('input[type=range][data-path="mesh.primary"]');
   if (prim && count) prim.max = count - 1;
+}
+
+// The fields of each mesh method with their defaults (as the builders read them), so every
+// one has a control even while the design leaves it out.
+const METHOD_FIELDS = {
+  pq: { rows: 20, primary: 'middle', option: 0, extend: 'auto', trim: true, max_extend: 20.0,
+        planarity_tolerance: 1e-12, refine: true },
+  hybrid: { midpoints: 1, divisions: 8, flip: false, orient: true },
+};
+
+// The two director curves the surface is ruled between: menus of the design's curves.
+function betweenControl(box, design) {
+  const row = document.createElement('div');
+  row.className = 'ctl';
+  const label = document.createElement('span');
+  label.className = 'name';
+  label.textContent = 'between';
+  row.append(label);
+  const names = Object.keys(design.curves || {});
+  design.rulings.between.forEach((cur, i) => {
+    const sel = document.createElement('select');
+    for (const n of names) sel.add(new Option(n, n, false, n === cur));
+    sel.dataset.between = i;
+    sel.addEventListener('change', () => {
+      const pair = [...design.rulings.between];
+      pair[i] = sel.value;
+      queueEdit([[['rulings', 'between'], pair]]);
+    });
+    row.append(sel);
+  });
+  box.append(row);
 }
 
 function valueAt(path) {
@@ -533,12 +1225,15 @@ function syncControls() {
   const force = forceSync;
   forceSync = false;
   for (const el of $('controls').querySelectorAll('[data-path]')) {
-    if (!force && (el === activeInput || el === document.activeElement && el.type === 'text')) continue;
+    // A focused text field keeps what the user is typing (not yet sent): it differs from the
+    // value last shown or sent; once sent, the server's answers (and other tabs') show again.
+    if (!force && (el === activeInput || (el === document.activeElement && el.type === 'text'
+                                          && el.value !== el.dataset.synced))) continue;
     const v = valueAt(el.dataset.path.split('.'));
     if (v === undefined) continue;
     if (el.type === 'checkbox') el.checked = v;
     else if (el.type === 'range') { if (typeof v === 'number') el.value = v; }
-    else if (el.tagName === 'SELECT' || el.type === 'text') el.value = String(v);
+    else if (el.tagName === 'SELECT' || el.type === 'text') { el.value = String(v); el.dataset.synced = el.value; }
   }
 }
 
@@ -582,6 +1277,7 @@ const jobs = [];      // edits waiting to be sent: {changes: Map key -> [path, v
 let sentAt = 0;
 const timings = [];
 const breakdown = [];  // {total, server, page} ms per edit
+const frameTimes = []; // ms from sending an edit to the next frame after its answer was drawn
 
 // Edits go one at a time; while one is on its way, later moves of the same gesture merge
 // (only the newest position matters), so a fast drag never builds a backlog.
@@ -602,16 +1298,22 @@ async function flush() {
     await send('edit', { changes: [...job.changes.values()], coalesce: job.coalesce });
   }
   inFlight = false;
+  catchUp();
 }
 
 // POST an action that answers with the state; returns false (and shows why) on error.
 async function send(name, body) {
   sentAt = performance.now();
+  const started = sentAt;
   try {
     const msg = await api('POST', name, body || {});
     const received = performance.now();
     showError('');
     applyState(msg);
+    requestAnimationFrame(() => {
+      frameTimes.push(performance.now() - started);
+      if (frameTimes.length > 200) frameTimes.shift();
+    });
     const ms = performance.now() - sentAt;
     timings.push(ms);
     breakdown.push({ total: ms, server: msg.serverMs, page: performance.now() - received });
@@ -628,6 +1330,18 @@ async function send(name, body) {
   }
 }
 
+// The whole state, faces included (when an answer without them found other faces here).
+async function refreshFull() {
+  const saved = current;
+  current = null;  // no topology header: the server sends everything
+  try {
+    applyState(await api('GET', 'state'));
+  } catch (err) {
+    current = saved;
+    showError(err.message);
+  }
+}
+
 async function refresh() {
   try {
     applyState(await api('GET', 'state'));
@@ -636,12 +1350,72 @@ async function refresh() {
   }
 }
 
+// ------------------------------------------------------------------ live updates
+// The server announces every new version on a WebSocket; a tab that did not make the change
+// (another tab's edit, undo) fetches the state, so all tabs show the same design.
+let live = null;
+let liveVersion = null;
+function connectLive(delay = 500) {
+  const url = `${location.protocol === 'https:' ? 'wss' : 'ws'}://${location.host}/api/live?token=${
+    encodeURIComponent(TOKEN)}`;
+  live = new WebSocket(url);
+  live.addEventListener('open', () => { window.designer.live = true; delay = 500; });
+  live.addEventListener('message', (event) => {
+    liveVersion = JSON.parse(event.data).version;
+    catchUp();
+  });
+  live.addEventListener('close', () => {
+    window.designer.live = false;
+    setTimeout(() => connectLive(Math.min(2 * delay, 10_000)), delay);
+  });
+}
+function catchUp() {
+  // While this tab's own edits are on their way, their answers bring the state.
+  if (inFlight || jobs.length || liveVersion === null || !current) return;
+  if (liveVersion !== current.header.version) refresh();
+}
+
+// The session's history: what each step did; a click goes back or forward to it.
+function showHistory(history) {
+  const list = $('history');
+  const items = [
+    ...history.undo.map((t, i) => ({ t, steps: history.undo.length - i, cls: 'past' })),
+    { t: history.current, steps: 0, cls: 'now' },
+    ...history.redo.map((t, i) => ({ t, steps: -(i + 1), cls: 'future' })),
+  ];
+  list.innerHTML = '';
+  for (const it of items) {
+    const li = document.createElement('li');
+    li.textContent = it.t;
+    li.className = it.cls;
+    li.title = it.steps > 0 ? `undo ${it.steps} step(s)` : it.steps < 0 ? `redo ${-it.steps} step(s)` : 'now';
+    if (it.steps) li.addEventListener('click', () => goTo(it.steps));
+    list.append(li);
+  }
+  list.scrollTop = list.scrollHeight;  // the newest steps in sight (the panel does not scroll)
+}
+async function goTo(steps) {
+  for (let k = 0; k < Math.abs(steps); k++) {
+    if (!(await send(steps > 0 ? 'undo' : 'redo'))) break;
+  }
+}
+
 let tomlDirty = false;
 let firstState = true;
+const FACE_ARRAYS = ['triangles', 'triangle_face', 'kind', 'edges', 'face_offsets', 'face_indices'];
 function applyState(msg) {
+  const applyStart = performance.now();
+  // An answer overtaken by a newer state (another tab, a live refresh) is not drawn.
+  if (current && msg.header.version < current.header.version) return;
+  if (msg.header.same_topology) {
+    // Same faces as drawn: only the vertices (and figures) came; keep our face arrays.
+    if (!current || current.header.topology !== msg.header.topology) { refreshFull(); return; }
+    for (const name of FACE_ARRAYS) msg.arrays[name] = current.arrays[name];
+    window.designer.sameTopology += 1;
+  }
   const changed = !current || current.header.version !== msg.header.version;
   current = msg;
-  if (changed) closeness = null;
+  if (changed) { closeness = null; classes = null; }
   const h = msg.header;
   $('file').textContent = h.path || '(unsaved design)';
   $('undo').disabled = !h.can_undo;
@@ -658,6 +1432,7 @@ function applyState(msg) {
   }
   if (!tomlDirty) $('toml').value = h.toml;
   showFigures(h.figures);
+  if (h.history) showHistory(h.history);
   buildKindChooser();
   buildControls();
   drawScene();
@@ -665,6 +1440,7 @@ function applyState(msg) {
   document.body.dataset.version = h.version;
   window.designer.version = h.version;
   window.designer.renders += 1;
+  window.designer.applyMs = performance.now() - applyStart;
   if (changed) scheduleSlowFigures();
 }
 
@@ -694,21 +1470,30 @@ async function download(event) {
 // ------------------------------------------------------------------ handle dragging
 const raycaster = new THREE.Raycaster();
 const pointer = new THREE.Vector2();
-let dragging = null;   // {mesh, plane, offset, id}
+let dragging = null;   // {mesh, plane, offset, moved, starts}
 let dragCount = 0;
+let pressed = null;    // a press on a face (a click opens its panel)
 
-function pick(event) {
-  if (!$('view').contains(event.target) || !layers.handles.visible) return null;
+function setPointer(event) {
   const rect = canvas.getBoundingClientRect();
   pointer.set(((event.clientX - rect.left) / rect.width) * 2 - 1,
     -((event.clientY - rect.top) / rect.height) * 2 + 1);
   raycaster.setFromCamera(pointer, camera);
-  const hits = raycaster.intersectObjects(layers.handles.children.filter((o) => o.userData.handle));
+}
+
+function pick(event) {
+  if (!$('view').contains(event.target) || !layers.handles.visible) return null;
+  setPointer(event);
+  const hits = raycaster.intersectObjects(handleMeshes());
   return hits.length ? hits[0] : null;
 }
 
 function handleValue(h, pos) {
   const r = (x) => +x.toFixed(6);
+  if (h.kind === 'size') {   // the length along the handle's axis, kept positive
+    const along = pos.clone().sub(new THREE.Vector3(...h.anchor)).dot(new THREE.Vector3(...h.axis));
+    return along > 0 ? r(along / h.scale) : null;
+  }
   if (h.kind === 'normal') {
     const n = pos.clone().sub(new THREE.Vector3(...h.anchor));
     if (n.length() < 1e-9 * size) return null;
@@ -718,34 +1503,75 @@ function handleValue(h, pos) {
   return pos.toArray().map(r);
 }
 
-function moveHandle(m, pos) {
-  m.position.copy(pos);
+// Moving one handle moves every selected point by the same amount (from where each was when
+// the drag began, so answers arriving during the drag do not shift them): one edit per move,
+// all the moves of one drag one undo step.
+function selectionStarts() {
+  const starts = new Map();
+  for (const label of selection) {
+    const h = handleByLabel(label);
+    if (h && h.kind === 'point') starts.set(label, new THREE.Vector3(...h.position));
+  }
+  return starts;
+}
+
+function moveHandle(m, pos, starts) {
   const h = m.userData.handle;
+  if (h.kind === 'point') pos = snapped(pos, h);
+  if (h.kind === 'size') {   // slides along its axis
+    const a = new THREE.Vector3(...h.anchor), u = new THREE.Vector3(...h.axis);
+    pos = a.clone().addScaledVector(u, pos.clone().sub(a).dot(u));
+  }
+  m.position.copy(pos);
   if (m.userData.leash) {
     const a = m.userData.leash.geometry.attributes.position;
     a.setXYZ(1, pos.x, pos.y, pos.z);
     a.needsUpdate = true;
   }
   const v = handleValue(h, pos);
-  if (v) queueEdit([[h.path, v]], `drag:${h.label}:${dragCount}`);
+  if (!v) return;
+  const changes = [[h.path, v]];
+  if (starts && starts.size > 1 && starts.has(h.label)) {
+    const delta = pos.clone().sub(starts.get(h.label));
+    for (const [label, p0] of starts) {
+      const oh = handleByLabel(label);
+      if (label === h.label || !oh) continue;
+      const p = p0.clone().add(delta);
+      const om = handleMeshes().find((o) => o.userData.handle.label === label);
+      if (om) om.position.copy(p);
+      changes.push([oh.path, handleValue(oh, p)]);
+    }
+  }
+  queueEdit(changes, `drag:${h.label}:${dragCount}`);
 }
 
-canvas.addEventListener('pointerdown', (event) => {
-  if (event.button !== 0 || gizmo.dragging || gizmo.axis) return;
+// Listened to on the view in the capture phase, before the axis arrows' own listener on the
+// canvas: a press on a sphere drags the sphere (and the selected points) even where the
+// arrows' pick zones overlap it; the arrows are off until the pointer comes up.
+$('view').addEventListener('pointerdown', (event) => {
+  if (event.target !== canvas || event.button !== 0 || gizmo.dragging) return;
+  if (drawing) { addDrawnPoint(event); event.preventDefault(); return; }
   const hit = pick(event);
-  if (!hit) return;
+  if (!hit) {
+    if (!gizmo.axis) pressed = { x: event.clientX, y: event.clientY };
+    return;
+  }
+  gizmo.enabled = false;
   const m = hit.object;
   const normal = camera.getWorldDirection(new THREE.Vector3());
   const plane = new THREE.Plane().setFromNormalAndCoplanarPoint(normal, m.position);
-  dragging = { mesh: m, plane, offset: m.position.clone().sub(hit.point), moved: false };
+  dragging = { mesh: m, plane, offset: m.position.clone().sub(hit.point), moved: false,
+               shift: event.shiftKey };
   dragCount += 1;
   orbit.enabled = false;
   canvas.setPointerCapture(event.pointerId);
   event.preventDefault();
-});
+}, { capture: true });
 
+let hoverPending = null;
 canvas.addEventListener('pointermove', (event) => {
   if (!dragging) {
+    if (gizmo.dragging) return;
     const hit = pick(event);
     const label = $('pick-label');
     if (hit) {
@@ -754,46 +1580,145 @@ canvas.addEventListener('pointermove', (event) => {
       label.style.top = `${event.offsetY + 12}px`;
     }
     label.hidden = !hit;
-    canvas.style.cursor = hit ? 'grab' : '';
+    canvas.style.cursor = hit ? 'grab' : drawing ? 'crosshair' : '';
+    // The face read-out: at most one ray cast per frame.
+    if (!hit && !hoverPending && current) {
+      hoverPending = requestAnimationFrame(() => {
+        hoverPending = null;
+        showReadout(event, faceAt(event));
+      });
+    } else if (hit) showReadout(event, null);
     return;
   }
-  const rect = canvas.getBoundingClientRect();
-  pointer.set(((event.clientX - rect.left) / rect.width) * 2 - 1,
-    -((event.clientY - rect.top) / rect.height) * 2 + 1);
-  raycaster.setFromCamera(pointer, camera);
+  setPointer(event);
   const p = new THREE.Vector3();
   if (!raycaster.ray.intersectPlane(dragging.plane, p)) return;
+  if (!dragging.moved && !selection.has(dragging.mesh.userData.handle.label)) {
+    select(dragging.mesh.userData.handle.label, dragging.shift);
+    dragging.mesh = handleMeshes().find((o) => o.userData.handle.label === primaryLabel) || dragging.mesh;
+  }
+  if (!dragging.moved) dragging.starts = selectionStarts();
   dragging.moved = true;
-  moveHandle(dragging.mesh, p.add(dragging.offset));
+  moveHandle(dragging.mesh, p.add(dragging.offset), dragging.starts);
   render();
 });
 
 function endDrag(event) {
+  if (pressed && !dragging) {
+    const click = Math.hypot(event.clientX - pressed.x, event.clientY - pressed.y) < 4;
+    pressed = null;
+    if (click && event.type === 'pointerup') {
+      const f = faceAt(event);
+      if (f !== null) openPanel(f);
+      else if (!event.shiftKey) select(null, false);
+    }
+    return;
+  }
   if (!dragging) return;
-  const { mesh, moved } = dragging;
+  const { mesh, moved, shift } = dragging;
   dragging = null;
   orbit.enabled = true;
+  gizmo.enabled = true;
   if (canvas.hasPointerCapture(event.pointerId)) canvas.releasePointerCapture(event.pointerId);
-  if (!moved) { gizmo.attach(mesh); render(); }   // a click: axis arrows for precise moves
+  if (!moved) {   // a click: select (Shift adds), axis arrows for precise moves
+    select(mesh.userData.handle.label, shift);
+    const m = handleMeshes().find((o) => o.userData.handle.label === primaryLabel);
+    if (m) gizmo.attach(m);
+    render();
+  }
 }
 canvas.addEventListener('pointerup', endDrag);
 canvas.addEventListener('pointercancel', endDrag);
+canvas.addEventListener('pointerleave', () => { $('readout').hidden = true; });
 
-gizmo.addEventListener('mouseDown', () => { dragCount += 1; });
+// The axis arrows move the sphere themselves; the other selected points follow.
+let gizmoStarts = null;
+gizmo.addEventListener('mouseDown', () => { dragCount += 1; gizmoStarts = selectionStarts(); });
 gizmo.addEventListener('objectChange', () => {
-  if (gizmo.object && gizmo.dragging) moveHandle(gizmo.object, gizmo.object.position.clone());
+  if (gizmo.object && gizmo.dragging) moveHandle(gizmo.object, gizmo.object.position.clone(), gizmoStarts);
 });
+
+// ------------------------------------------------------------------ drawing a new curve
+// "New curve": clicks on the construction plane (through the design's centre, facing the
+// chosen axis) place points; Enter or "Finish" adds the curve as a B-spline (a polyline
+// with two points), Esc cancels.
+let drawing = null;   // {points: [[x,y,z]], line}
+
+function constructionPlane() {
+  const axis = $('cplane').value;
+  const [lo, hi] = current.header.bbox;
+  const c = new THREE.Vector3((lo[0] + hi[0]) / 2, (lo[1] + hi[1]) / 2, (lo[2] + hi[2]) / 2);
+  const n = { xy: [0, 0, 1], xz: [0, 1, 0], yz: [1, 0, 0] }[axis];
+  return new THREE.Plane().setFromNormalAndCoplanarPoint(new THREE.Vector3(...n), c);
+}
+
+function startDrawing() {
+  if (drawing) { finishDrawing(); return; }
+  drawing = { points: [], line: null };
+  $('new-curve').textContent = 'Finish curve';
+  $('new-curve').blur();  // Enter finishes the curve, it does not press the button again
+  status('click points on the construction plane; Enter finishes, Esc cancels');
+}
+
+function addDrawnPoint(event) {
+  setPointer(event);
+  const p = new THREE.Vector3();
+  if (!raycaster.ray.intersectPlane(constructionPlane(), p)) return;
+  const q = $('snap-grid').checked ? snapped(p, { label: '' }) : p;
+  drawing.points.push(q.toArray().map((x) => +x.toFixed(6)));
+  if (drawing.line) layers.construction.remove(drawing.line);
+  drawing.line = polyline(drawing.points.length > 1 ? drawing.points
+    : [drawing.points[0], drawing.points[0]], 0x1d4ed8);
+  layers.construction.add(drawing.line);
+  window.designer.drawn = drawing.points.length;
+  render();
+}
+
+function stopDrawing() {
+  if (drawing?.line) layers.construction.remove(drawing.line);
+  drawing = null;
+  $('new-curve').textContent = 'New curve';
+  render();
+}
+
+function finishDrawing() {
+  const pts = drawing?.points || [];
+  stopDrawing();
+  if (pts.length < 2) { status('a curve needs at least two points'); return; }
+  const curves = current.header.design.curves || {};
+  let k = Object.keys(curves).length + 1;
+  while (`c${k}` in curves) k += 1;
+  const spec = pts.length > 2 ? { type: 'bspline', degree: Math.min(3, pts.length - 1), points: pts }
+    : { type: 'polyline', points: pts };
+  queueEdit([[['curves', `c${k}`], spec]]);
+  status(`added curve c${k}: choose it in "between" to rule the surface on it`);
+}
 
 // ------------------------------------------------------------------ buttons
 $('undo').addEventListener('click', () => send('undo'));
 $('redo').addEventListener('click', () => send('redo'));
 $('fit').addEventListener('click', () => fitView());
-$('colour').addEventListener('change', () => { drawFaces(); render(); });
+$('colour').addEventListener('change', () => recolour());
+for (const b of document.querySelectorAll('[data-view]')) {
+  b.addEventListener('click', () => setView(b.dataset.view));
+}
+$('ortho').addEventListener('change', () => useCamera($('ortho').checked ? orthographic : perspective));
+$('screenshot').addEventListener('click', screenshot);
+$('drawer-close').addEventListener('click', () => { $('drawer').hidden = true; });
+for (const [i, axis] of ['x', 'y', 'z'].entries()) {
+  $(`sel-${axis}`).addEventListener('change', () => typeCoordinate(i));
+}
+$('pt-insert').addEventListener('click', () => editPoints('insert'));
+$('pt-delete').addEventListener('click', () => editPoints('delete'));
+$('pt-append').addEventListener('click', () => editPoints('append'));
+$('new-curve').addEventListener('click', startDrawing);
 $('export-format').addEventListener('change', updateDownload);
 for (const box of document.querySelectorAll('[data-layer]')) {
   box.addEventListener('change', () => {
     layers[box.dataset.layer].visible = box.checked;
     if (box.dataset.layer === 'handles' && !box.checked) gizmo.detach();
+    if (box.dataset.layer === 'generators') generatorsTouched = true;
+    if (box.dataset.layer === 'labels') drawLabels();
     render();
   });
 }
@@ -825,7 +1750,15 @@ window.addEventListener('keydown', (event) => {
   const tag = document.activeElement?.tagName;
   if (tag === 'TEXTAREA' || (tag === 'INPUT' && document.activeElement.type === 'text')) return;
   if (!(event.ctrlKey || event.metaKey)) {
-    if (event.key === 'Escape') { gizmo.detach(); render(); }
+    if (event.key === 'Escape') {
+      if (drawing) stopDrawing(); else { gizmo.detach(); select(null, false); }
+      render();
+    } else if (event.key === 'Enter' && drawing) {
+      event.preventDefault();  // not also a click of the focused "Finish curve" button
+      finishDrawing();
+    }
+    else if ((event.key === 'Delete' || event.key === 'Backspace') && tag !== 'INPUT'
+             && primaryLabel) editPoints('delete');
     return;
   }
   const key = event.key.toLowerCase();
@@ -835,8 +1768,46 @@ window.addEventListener('keydown', (event) => {
 
 // ------------------------------------------------------------------ test and debugging hooks
 window.designer = {
-  version: null, renders: 0, figuresVersion: null, lastExport: null, timings, breakdown,
+  version: null, renders: 0, frames: 0, figuresVersion: null, lastExport: null, timings,
+  breakdown, frameTimes, sameTopology: 0, legend: null, hover: null, panel: null, reused: false, view: null,
   busy: () => inFlight || jobs.length > 0,
+  softwareGL: SOFTWARE_GL,
+  // The page's own part of an update, without the server: decode the last state message
+  // again, draw it, and wait for the frame; resolves to the milliseconds it took.
+  replay: () => new Promise((resolve) => {
+    const t0 = performance.now();
+    const msg = decode(current.raw);
+    msg.raw = current.raw;
+    for (const name of FACE_ARRAYS) msg.arrays[name] ||= current.arrays[name];
+    msg.header.same_topology = false;
+    current = null;
+    applyState(msg);
+    requestAnimationFrame(() => resolve(performance.now() - t0));
+  }),
+  selection: () => [...selection],
+  camera: () => ({ ortho: camera === orthographic, direction:
+    camera.getWorldDirection(new THREE.Vector3()).toArray() }),
+  layer: (name) => layers[name].visible,
+  edgeCount: () => (layers.edges.children[0]?.geometry.drawRange.count || 0) / 2,
+  generatorsDashed: () => !!layers.generators.children[0]?.material.isLineDashedMaterial,
+  construction: () => layers.construction.children.map((o) => o.userData.construction).filter(Boolean),
+  grid: () => layers.grid.children[0]?.userData.step,
+  faceInfo: (f) => faceInfo(f),
+  faceScreen: (f) => {
+    const { vertices: V, face_offsets: off, face_indices: idx } = current.arrays;
+    const v = new THREE.Vector3();
+    for (let k = off[f]; k < off[f + 1]; k++) {
+      v.x += V[3 * idx[k]]; v.y += V[3 * idx[k] + 1]; v.z += V[3 * idx[k] + 2];
+    }
+    v.divideScalar(off[f + 1] - off[f]).project(camera);
+    const rect = canvas.getBoundingClientRect();
+    return { x: rect.left + (v.x + 1) / 2 * rect.width, y: rect.top + (1 - v.y) / 2 * rect.height };
+  },
+  screen: (p) => {
+    const v = new THREE.Vector3(...p).project(camera);
+    const rect = canvas.getBoundingClientRect();
+    return { x: rect.left + (v.x + 1) / 2 * rect.width, y: rect.top + (1 - v.y) / 2 * rect.height };
+  },
   handles: () => layers.handles.children.filter((o) => o.userData.handle).map((o) => {
     const p = o.position.clone().project(camera);
     const rect = canvas.getBoundingClientRect();
@@ -848,4 +1819,4 @@ window.designer = {
 resize();
 if (!TOKEN) showError('this address has no token: open the one that ruledmesh design printed ' +
                       '(it ends in ?token=...)');
-else refresh();
+else { refresh(); connectLive(); }
