@@ -145,9 +145,11 @@ def test_help_examples_work_from_a_wheel_install(wheel_install, tmp_path):
     where = subprocess.run([sys.executable, "-c", "import ruledmesh; print(ruledmesh.__file__)"],
                            check=False, capture_output=True, text=True, env=env, cwd=tmp_path, timeout=60)
     assert Path(where.stdout.strip()).is_relative_to(target), where
-    commands = _help_examples()
+    # The examples that name a bundled design (examples/NAME.toml) are what a wheel install
+    # changes; tests/test_help_examples.py runs every example from the checkout.
+    commands = [c for c in _help_examples() if any(a.startswith("examples/") for a in c)]
     assert commands[0] == ["build", "examples/skew.toml", "-o", "skew.obj"]
-    assert len(commands) >= 8
+    assert len(commands) >= 3
     failed = {}
     for args in commands:
         run = subprocess.run([sys.executable, "-m", "ruledmesh", *args], check=False, capture_output=True,

@@ -74,7 +74,8 @@ def test_fabricate_reports_each_sheet(tmp_path):
 
     mesh = build_file(EXAMPLES / "fig5b-torus.toml").mesh
     rec = Recorder()
-    summary = fabricate(mesh, tmp_path / "fab", sheet=(3.0, 3.0), dxf=False, progress=rec)
+    summary = fabricate(mesh, tmp_path / "fab", sheet=(3.0, 3.0), dxf=False, progress=rec,
+                        nesting="shelf")
     n = summary["sheets"]["count"]
     assert n > 1 and ("sheets", n) in rec.tasks
     assert sum(k for label, k, _ in rec.steps if label == "sheets") == n

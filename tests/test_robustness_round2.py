@@ -100,7 +100,7 @@ def test_rulings_file_dev_zero_says_what_it_is(tmp_path, capsys):
 
 def test_load_design_api_refuses_special_files():
     from ruledmesh.design import load_design
-    from ruledmesh.rulings import from_csv
+    from ruledmesh.design.rulings import from_csv
 
     with pytest.raises(DesignError, match="character device"):
         load_design("/dev/zero")

@@ -31,6 +31,26 @@ def _single_edges(mesh: Mesh) -> np.ndarray:
     return np.stack([key // mesh.n_vertices, key % mesh.n_vertices], axis=1)
 
 
+# Below this many (edge, vertex) pairs the search is brute force in numpy (no scipy import).
+_BRUTE_PAIRS = 4_000_000
+
+
+def _near_pairs(centre: np.ndarray, radius: np.ndarray, pts: np.ndarray):
+    """(edge, point) index pairs with the point within ``radius`` of the edge's ``centre``."""
+    if len(centre) * len(pts) <= _BRUTE_PAIRS:
+        d2 = ((centre[:, None, :] - pts[None, :, :]) ** 2).sum(axis=2)
+        e, w = np.nonzero(d2 <= (radius ** 2)[:, None])
+        return e.astype(np.int64), w.astype(np.int64)
+    from scipy.spatial import cKDTree
+
+    near = cKDTree(pts).query_ball_point(centre, radius)
+    counts = np.fromiter((len(n) for n in near), np.int64, len(near))
+    if counts.sum() == 0:
+        return np.zeros(0, np.int64), np.zeros(0, np.int64)
+    return (np.repeat(np.arange(len(centre)), counts),
+            np.concatenate([np.asarray(n, np.int64) for n in near if n]))
+
+
 def t_junctions(mesh: Mesh, tol: float = 1e-9) -> np.ndarray:
     """Vertices lying strictly inside a border edge of the mesh.
 
@@ -46,22 +66,19 @@ def t_junctions(mesh: Mesh, tol: float = 1e-9) -> np.ndarray:
     (k, 3) int64
         Rows ``(vertex, edge start, edge end)``, sorted.
     """
-    from scipy.spatial import cKDTree
-
     edges = _single_edges(mesh)
-    used = np.unique(mesh.face_indices)
+    # A vertex hanging on a border edge is itself on the border (the end of two
+    # border edges of the faces beside it): only border vertices are candidates.
+    used = np.unique(edges)
     if edges.size == 0 or used.size == 0:
         return np.zeros((0, 3), np.int64)
     v = mesh.vertices
     p, q = v[edges[:, 0]], v[edges[:, 1]]
     length = np.linalg.norm(q - p, axis=1)
-    tree = cKDTree(v[used])
-    near = tree.query_ball_point(0.5 * (p + q), 0.5 * length * (1 + tol))
-    counts = np.fromiter((len(n) for n in near), np.int64, len(near))
-    if counts.sum() == 0:
+    e, w = _near_pairs(0.5 * (p + q), 0.5 * length * (1 + tol), v[used])
+    if e.size == 0:
         return np.zeros((0, 3), np.int64)
-    e = np.repeat(np.arange(len(edges)), counts)
-    w = used[np.concatenate([np.asarray(n, np.int64) for n in near if n])]
+    w = used[w]
     keep = (w != edges[e, 0]) & (w != edges[e, 1])
     e, w = e[keep], w[keep]
     d = q[e] - p[e]

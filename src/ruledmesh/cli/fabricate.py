@@ -42,7 +42,7 @@ def add_parser(sub) -> None:
         epilog="examples:\n"
                "  ruledmesh fabricate skew.obj -o skew-fab\n"
                "  ruledmesh fabricate examples/fig5b-torus.toml -o torus-fab --scale 1000 --unit mm "
-               "--sheet 2500x1250\n",
+               "--sheet 2500x1250 --nesting shelf\n",
     )
     p.add_argument("mesh", help="mesh file (.obj, .ply, ...) or design file (.toml)")
     p.add_argument("-o", "--output", required=True, help="folder to write into (created if missing)")
