@@ -455,3 +455,20 @@ def test_compound_seed_far_out_of_proportion_does_not_overflow(tmp_path, capsys)
     assert "Warning" not in err and code in (0, 2), err
     if code == 2:
         one_error_line(code, err)
+
+
+def test_mesh_load_and_designer_refuse_special_files(tmp_path, capsys):
+    from ruledmesh import io as rio
+
+    with pytest.raises(ParameterError, match="character device"):
+        rio.load(_device_link(tmp_path, "zero.obj"))
+    assert main(["design", _device_link(tmp_path, "zero.toml"), "--no-browser"]) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and "character device" in err[0]
+
+
+def _device_link(tmp_path, name):
+    """A path with the given extension that is the character device /dev/zero."""
+    link = tmp_path / name
+    link.symlink_to("/dev/zero")
+    return str(link)

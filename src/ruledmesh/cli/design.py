@@ -55,10 +55,16 @@ def run(args) -> int:
     text = path = None
     if args.design:
         path = Path(args.design)
+        from .._files import MAX_DESIGN_BYTES, FileRefused, read_capped
+
         try:
-            text = path.read_text(encoding="utf-8")
+            text = read_capped(path, MAX_DESIGN_BYTES, "a design file").decode("utf-8")
         except FileNotFoundError:
             raise ParameterError(f"no such design file: {path}", "design") from None
+        except FileRefused as exc:
+            raise ParameterError(f"{path}: {exc.strerror}", "design") from None
+        except (OSError, UnicodeDecodeError) as exc:
+            raise ParameterError(f"cannot read {path}: {exc}", "design") from None
     session = Session(text, path)
     host = args.host if args.host is not None else DEFAULT_HOST
     try:

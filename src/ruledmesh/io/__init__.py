@@ -211,10 +211,13 @@ def save(path: str | os.PathLike, mesh: Mesh, **options) -> Path:
 
 def load(path: str | os.PathLike) -> Mesh:
     """Read a mesh file written by ruledmesh (or any plain OBJ/PLY polygon mesh)."""
+    from .._files import MAX_MESH_BYTES, read_capped
+
     path = Path(path)
     module = format_module(path.suffix.lower(), READERS, "read")
     try:
-        data = path.read_bytes()
+        # Special files (a device, a pipe) and oversized files are refused before reading.
+        data = read_capped(path, MAX_MESH_BYTES, "a mesh file")
     except OSError as exc:
         raise ParameterError(f"cannot read {path}: {exc.strerror}", "path") from None
     try:
