@@ -173,18 +173,8 @@ def torus(R: float, r: float) -> ImplicitSurface:
                            lambda p: np.abs(value(p)))
 
 
-def _segment_distance_2d(q: np.ndarray, poly: np.ndarray) -> np.ndarray:
-    """(n,) distance of (n, 2) points from an (m, 2) polyline."""
-    a, b = poly[:-1], poly[1:]
-    d = b - a
-    dd = np.maximum(np.einsum("ij,ij->i", d, d), _TINY)
-    t = np.clip(np.einsum("nij,ij->ni", q[:, None, :] - a[None], d) / dd, 0.0, 1.0)
-    foot = a[None] + t[..., None] * d[None]
-    return np.sqrt(np.einsum("nij,nij->ni", q[:, None] - foot, q[:, None] - foot).min(axis=1))
-
-
-def _segment_distance_3d(q: np.ndarray, poly: np.ndarray) -> np.ndarray:
-    """(n,) distance of (n, 3) points from an (m, 3) polyline."""
+def _segment_distance(q: np.ndarray, poly: np.ndarray) -> np.ndarray:
+    """(n,) distance of (n, k) points from an (m, k) polyline, in any dimension k."""
     a, b = poly[:-1], poly[1:]
     d = b - a
     dd = np.maximum(np.einsum("ij,ij->i", d, d), _TINY)
@@ -226,7 +216,7 @@ def revolution_of_polyline(meridian_rz: np.ndarray, origin: np.ndarray, axis: np
     def exact(p):
         h, radial = local(p)
         rho = np.linalg.norm(radial, axis=1)
-        d = _segment_distance_2d(np.stack([rho, h], axis=1), meridian_rz)
+        d = _segment_distance(np.stack([rho, h], axis=1), meridian_rz)
         if full:
             return d
         phi = np.mod(np.arctan2(radial @ y_dir, radial @ x_dir), 2 * np.pi)
@@ -236,7 +226,7 @@ def revolution_of_polyline(meridian_rz: np.ndarray, origin: np.ndarray, axis: np
             for a in (0.0, angle):
                 direction = np.cos(a) * x_dir + np.sin(a) * y_dir
                 curve = origin + meridian_rz[:, :1] * direction + meridian_rz[:, 1:] * axis
-                ends.append(_segment_distance_3d(p[outside], curve))
+                ends.append(_segment_distance(p[outside], curve))
             d = d.copy()
             d[outside] = np.minimum(*ends)
         return d
@@ -252,7 +242,7 @@ def pipe_of_polyline(spine: np.ndarray, radius: float) -> ImplicitSurface:
     """Points at distance ``radius`` from a polyline (a pipe with round joints)."""
 
     def exact(p):
-        return np.abs(_segment_distance_3d(p, spine) - radius)
+        return np.abs(_segment_distance(p, spine) - radius)
 
     length = float(np.linalg.norm(np.diff(spine, axis=0), axis=1).sum())
     return ImplicitSurface("pipe", None, None, 2 * np.pi * radius * length, exact)
