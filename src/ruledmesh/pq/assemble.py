@@ -131,21 +131,19 @@ def _strip_quads(V, chain, gstart, gaps: Gaps, ptol: float):
     return use, strip_quads
 
 
-def _close_gaps(V, T, chain, gstart, gaps: Gaps, ptol: float):
-    """Strip quads where a gap is planar within ``ptol`` and evenly matched; zippers elsewhere."""
-    use, strip_quads = _strip_quads(V, chain, gstart, gaps, ptol)
+def _zipped(V, T, chain, gstart, gaps: Gaps, use: np.ndarray) -> np.ndarray:
+    """Zipper triangles for the gaps that strip quads do not close (``~use``)."""
     z = ~use
-    fill = zippers(V, T, chain, gstart, gaps.strip[z], gaps.k0[z], gaps.l0[z], gaps.na[z],
+    return zippers(V, T, chain, gstart, gaps.strip[z], gaps.k0[z], gaps.l0[z], gaps.na[z],
                    gaps.nb[z])
-    return fill, strip_quads
 
 
-def _with_ladders(V, T, G, FAR, good_v, chain, gstart, gaps: Gaps, a, d, ptol: float, rows: int):
+def _with_ladders(V, T, G, FAR, good_v, chain, gstart, gaps: Gaps, use: np.ndarray, a, d,
+                  rows: int):
     """Points on the long generator edges that only fill triangles use (see :mod:`.ladders`).
 
-    Gaps that strip quads close keep their divisions (a ladder would unmatch them).
+    Gaps that strip quads close (``use``) keep their divisions (a ladder would unmatch them).
     """
-    use, _ = _strip_quads(V, chain, gstart, gaps, ptol)
     open_gaps = Gaps(*(x[~use] for x in (gaps.strip, gaps.k0, gaps.l0, gaps.na, gaps.nb)))
     free = free_edges(open_gaps, gstart, len(a))
     n0 = len(V)
@@ -209,12 +207,15 @@ def assemble(parts: list[Run], a, d, trim: bool, tol: Tolerances, ptol: float,
     cand_r = (R[:, 0] >= 0) & ~POLE & good_v[np.maximum(R, 0)].all(axis=1)
     if trim:
         ok_l, ok_r, gaps, jump_l, jump_r = strip_paths(T, chain, gstart, m, L, R, cand_l, cand_r, CG)
+        use, strip_quads = _strip_quads(V, chain, gstart, gaps, ptol)
         V, T, G, FAR, good_v, chain, gstart, added = _with_ladders(
-            V, T, G, FAR, good_v, chain, gstart, gaps, a, d, ptol, rows)
+            V, T, G, FAR, good_v, chain, gstart, gaps, use, a, d, rows)
         if added:
+            # The ladders renumber the chains: the gaps (and their strip quads) anew.
             ok_l, ok_r, gaps, jump_l, jump_r = strip_paths(T, chain, gstart, m, L, R, cand_l,
                                                            cand_r, CG)
-        fill, strip_quads = _close_gaps(V, T, chain, gstart, gaps, ptol)
+            use, strip_quads = _strip_quads(V, chain, gstart, gaps, ptol)
+        fill = _zipped(V, T, chain, gstart, gaps, use)
     else:
         chain = gstart = None
         jump_l = np.ones(len(L), np.int64)
