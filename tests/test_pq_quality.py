@@ -111,14 +111,16 @@ def test_coplanar_generators_carry_exact_strip_quads():
 
 
 # ---------------------------------------------------------------- regressions
-# (file, at most this share of the area outside quads, at least this smallest face angle)
+# (file, at most this share of the area outside quads, at least this smallest face angle).
+# Runs end before faces thinner than RESTART_ANGLE_DEG and the kept triangles are flipped
+# for their smallest angle: a few points of share traded for far fewer splinters.
 REGRESSIONS = [
-    ("skew.toml", 0.08, 2.0),                    # was 19 %, 0.19 deg (two crease bands)
-    ("fig10-skew-surface.toml", 0.11, 0.02),     # was 20 %, 0.03 deg
-    ("right-conoid-arc.toml", 0.21, 0.005),      # was 30 %
-    ("conoidal-director-plane.toml", 0.18, 0.03),  # was 33 %
-    ("three-directrices.toml", 0.14, None),      # was 20 %
-    ("parameter-distribution.toml", 0.13, 0.1),  # was 18 %
+    ("skew.toml", 0.08, 3.0),                    # was 19 %, 0.19 deg (two crease bands)
+    ("fig10-skew-surface.toml", 0.12, 0.1),      # was 20 %, 0.03 deg
+    ("right-conoid-arc.toml", 0.20, 0.005),      # was 30 %, then 20 % with 109 splinters (now 43)
+    ("conoidal-director-plane.toml", 0.22, 1.0),  # was 33 %, then 16 % with 59 splinters, 0.11 deg
+    ("three-directrices.toml", 0.12, 0.1),       # was 20 %
+    ("parameter-distribution.toml", 0.13, 3.0),  # was 18 %, then 10 % with 17 splinters
 ]
 
 
@@ -135,8 +137,8 @@ def test_example_quality_does_not_regress(name, share, angle):
 
 
 def test_two_bspline_director_curves_51_by_30():
-    """The first quality surface: 55 % of the area was in triangles; generators are added
-    where the rows need them and the share falls under a quarter."""
+    """The first quality surface: 55 % of the area was in triangles and 220 splinters;
+    generators are added where the rows need them and the share falls under a quarter."""
     c1 = [[0.0, 1.34, -1.68], [2.5, -1.44, -0.62], [5.0, 1.66, -0.92], [7.5, -2.19, 0.96],
           [10.0, 1.63, -1.61]]
     c2 = [[0.0, -0.52, 4.67], [2.5, -2.47, 3.40], [5.0, -1.19, 5.13], [7.5, -0.39, 4.77],
@@ -146,7 +148,8 @@ def test_two_bspline_director_curves_51_by_30():
             '[rulings]\nbetween = ["c1", "c2"]\ncount = 51\n[mesh]\nrows = 30\n')
     built = build_design(parse_design(text))
     check_exact(built)
-    assert 1.0 - area_shares(built.mesh)["quads"] <= 0.22
+    assert 1.0 - area_shares(built.mesh)["quads"] <= 0.25
+    assert np.count_nonzero(face_min_angles(built.mesh) < 3.0) <= 30       # was 220, then 107
     assert built.rulings.info["inserted"] > 0
     assert any("generators of the smooth surface added" in w for w in built.mesh.info["warnings"])
     given = build_design(parse_design(text.replace("rows = 30", "rows = 30\nrefine = false")))

@@ -193,6 +193,21 @@ def face_centroids(mesh: Mesh) -> np.ndarray:
     return sums / mesh.valences[:, None]
 
 
+def polygon_angles(corners: np.ndarray) -> np.ndarray:
+    """(F, k) float64: interior angles in degrees of polygons given by their corners.
+
+    Parameters
+    ----------
+    corners : (F, k, 3) float64
+        Corners in order around each polygon.
+    """
+    e1 = np.roll(corners, 1, axis=1) - corners
+    e2 = np.roll(corners, -1, axis=1) - corners
+    cosang = np.einsum("fkc,fkc->fk", e1, e2)
+    sinang = np.linalg.norm(np.cross(e1, e2), axis=2)
+    return np.degrees(np.arctan2(sinang, cosang))
+
+
 def corner_angles(mesh: Mesh) -> np.ndarray:
     """(N,) float64: interior angle in degrees at every face corner, in face_indices order."""
     v = mesh.vertices

@@ -87,6 +87,7 @@ def ladder_points(V, T, G, chain, gstart, free, a, d, rows: int):
     all_len[:-1] = (T[chain[1:]] - T[chain[:-1]]) * glen[G[chain[:-1]]]
     step = glen[g] / max(rows, 1)
     width = np.full(j.size, np.inf)
+    wide = np.zeros(j.size)
     facing = []
     for nb in (g - 1, g + 1):
         ok = (nb >= 0) & (nb < m)
@@ -96,11 +97,14 @@ def ladder_points(V, T, G, chain, gstart, free, a, d, rows: int):
         along = np.einsum("ij,ij->i", r, u)
         dist = np.linalg.norm(r - along[:, None] * u, axis=1)
         width = np.where(ok, np.minimum(width, dist), width)
+        wide = np.where(ok, np.maximum(wide, dist), wide)
         tq = np.clip(along / np.maximum(glen[q], 1e-300), 0.0, 1.0)
         pos = np.clip(np.searchsorted(keys, q * 4.0 + tq, side="right") - 1, gstart[q],
                       gstart[q + 1] - 2)
         facing.append(np.where(ok, pos, -1))
-    base_target = np.clip(_ASPECT * width, _MIN_STEP * step, step)
+    # Points closer than a share of the wider strip make slivers there (a short
+    # base under a long apex), however narrow the other strip is.
+    base_target = np.maximum(np.clip(_ASPECT * width, _MIN_STEP * step, step), wide / _ASPECT)
     length = (t1 - t0) * glen[g]
     # The edges facing this one across each strip: points here are worth their cost only
     # where the facing edge gets (or has) points as close, else they fan out towards it.

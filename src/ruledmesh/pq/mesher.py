@@ -13,6 +13,7 @@ from ..mesh import Mesh
 from ..normalise import normalised
 from ..tolerances import DEFAULT, Tolerances
 from .assemble import assemble
+from .flips import flip_triangles
 from .pairing import pair_triangles
 from .runs import (
     BYTES_PER_GRID_POINT,
@@ -33,6 +34,13 @@ _RESTART_SHARE = 0.05
 _MIN_RUN = 4
 # A run most of whose faces on the patch would not be convex is not meshed as a run.
 _HOPELESS_SHARE = 0.3
+# A strip narrower than this share of a row step everywhere is too narrow for a zipper.
+_NARROW = 0.5
+# Generators closer than this share of a row step everywhere count as one.
+_DOUBLE = 0.01
+# A segment (between torsal strips) whose run has this share of its faces failing
+# carries no rows: cutting it would leave short runs of slivers.
+_NO_ROWS_SHARE = 0.5
 # A build with more than this share of its area outside quads says why.
 _WARN_SHARE = 0.3
 # Tolerance mode pairs triangles into quads planar within this share of the stated tolerance.
@@ -81,8 +89,8 @@ class _Plan:
 def _cut_at(run: Run, primary: int, m: int) -> tuple[int | None, int | None]:
     """Run-local generators where the run must restart (right of, left of the primary)."""
     bad = (run.failing >= 2) & (run.failing >= _RESTART_SHARE * np.maximum(run.on_patch, 1))
-    right = [k for k in np.flatnonzero(bad) if k >= primary + 3 and m - k >= 3]
-    left = [k for k in np.flatnonzero(bad) if k <= primary - 3 and k >= 2]
+    right = [k for k in np.flatnonzero(bad) if k >= primary + 3 and m - k >= 2]
+    left = [k for k in np.flatnonzero(bad) if k <= primary - 3 and k >= 1]
     return (int(right[0]) if right else None), (int(left[-1]) if left else None)
 
 
@@ -90,9 +98,9 @@ def _uniform_t(rows: int) -> np.ndarray:
     return np.linspace(0.0, 1.0, max(rows // 2, 1) + 1)
 
 
-def _hopeless(run: Run) -> bool:
-    """Most of the run's faces on the patch would be bow-ties: rows bunch (K near 0)."""
-    return bool(run.failing.sum() > _HOPELESS_SHARE * max(run.on_patch.sum(), 1))
+def _hopeless(run: Run, share: float = _HOPELESS_SHARE) -> bool:
+    """Most of the run's faces on the patch would fail: rows bunch (K near 0)."""
+    return bool(run.failing.sum() > share * max(run.on_patch.sum(), 1))
 
 
 def _bad_generators(run: Run) -> np.ndarray:
@@ -109,7 +117,7 @@ def _even(plan: _Plan, lo: int, hi: int, rows: int) -> list[Run]:
 
 
 def _build_segment(plan: _Plan, lo: int, hi: int, primary: int, div: Division,
-                   budget: list[int], shared: int | None = None) -> list[Run]:
+                   budget: list[int], shared: int | None = None, home: bool = False) -> list[Run]:
     """Runs covering generators lo..hi, restarted where the chains drift apart.
 
     ``shared`` is the end generator (lo or hi) that the run this one continues
@@ -124,6 +132,15 @@ def _build_segment(plan: _Plan, lo: int, hi: int, primary: int, div: Division,
         return [carrier(a[lo:hi + 1], d[lo:hi + 1], lo, t)]
     run = mesh_run(a[lo:hi + 1], d[lo:hi + 1], lo, primary, div, plan.tol, plan.scale, plan.warnings)
     m = hi - lo + 1
+    if shared is None and _hopeless(run, _NO_ROWS_SHARE):
+        # Most faces would be bow-ties or slivers: from the best-twisted primary if
+        # the rows did not start there; else the segment carries no rows, unless it
+        # holds the primary (its runs are cut where the faces fail instead).
+        better = _well_twisted(plan, lo, hi)
+        if better != primary:
+            return _build_segment(plan, lo, hi, better, div, budget, home=home)
+        if not home or m < 2 * _MIN_RUN:
+            return _even(plan, lo, hi, div.rows)
     if shared is not None and _hopeless(run):
         # Keep the part next to the shared generator where the faces are still convex.
         bad = _bad_generators(run)
@@ -160,7 +177,7 @@ def _build_segment(plan: _Plan, lo: int, hi: int, primary: int, div: Division,
 
 
 def _torsal_cuts(a, d, scale, tol, creases, m):
-    """Shared generators (the twist changes sign) and gap strips (coplanar pairs, creases)."""
+    """Torsal strips: coplanar pairs (flat), the twist changing sign (change), creases."""
     twist = coplanarity(a, d, scale)
     flat = np.abs(twist) <= tol.degenerate
     sign = np.sign(np.where(flat, 0.0, twist))
@@ -177,6 +194,53 @@ def _torsal_cuts(a, d, scale, tol, creases, m):
             raise ParameterError(f"expected pair indices in [0, {m - 2}], got {cr.tolist()}", "creases")
         crease[cr] = True
     return flat, change, crease
+
+
+def _single_generators(a: np.ndarray, d: np.ndarray, rows: int, warnings: list[str]) -> np.ndarray:
+    """Indices of the generators kept: one of each run of generators that nearly coincide.
+
+    Two generators a hundredth of a row step apart (a sample next to a kink, a
+    generator given twice) bound a strip no face can fill without slivers; the
+    second is left out, and every vertex still lies on a given generator.
+    """
+    m = len(a)
+    step = np.linalg.norm(d[:-1], axis=1) / max(rows, 1)
+    gap = np.max([np.linalg.norm((a[1:] + t * d[1:]) - (a[:-1] + t * d[:-1]), axis=1)
+                  for t in (0.0, 0.5, 1.0)], axis=0)
+    double = gap < _DOUBLE * step
+    if not double.any():
+        return np.arange(m)
+    keep = np.r_[True, ~double]
+    if not keep[-1]:
+        # Keep the last generator (the border); leave out the one before it instead.
+        last_kept = np.flatnonzero(keep[:-1])[-1]
+        keep[-1], keep[last_kept] = True, last_kept == 0
+    dropped = np.flatnonzero(~keep)
+    if m - dropped.size < 3:
+        return np.arange(m)
+    warnings.append(f"{dropped.size} generators nearly coincide with a neighbour and were left out "
+                    f"(generators {', '.join(map(str, dropped[:8].tolist()))}"
+                    f"{' ...' if dropped.size > 8 else ''})")
+    return np.flatnonzero(keep)
+
+
+def _renumbered(mesh: Mesh, kept: np.ndarray) -> Mesh:
+    """The mesh with generator indices of the kept generators mapped back to the given ones."""
+    vdata = dict(mesh.vertex_data)
+    vdata["generator"] = kept[np.asarray(vdata["generator"], np.int64)]
+    return Mesh(mesh.vertices, mesh.face_offsets, mesh.face_indices, mesh.face_kind, mesh.members,
+                kept[mesh.member_id], vdata, mesh.info)
+
+
+def _narrow_strips(a: np.ndarray, d: np.ndarray, rows: int) -> np.ndarray:
+    """(m - 1,) bool: strips whose two generators are nowhere a row step's share apart.
+
+    Indexed like the twists (strip ``k`` between generators ``k`` and ``k + 1``)
+    and padded to that length.
+    """
+    ends = [np.linalg.norm((a[1:] + t * d[1:]) - (a[:-1] + t * d[:-1]), axis=1) for t in (0.0, 0.5, 1.0)]
+    step = np.linalg.norm(d[:-1], axis=1) / max(rows, 1)
+    return np.max(ends, axis=0) < _NARROW * step
 
 
 def _listed(ks: np.ndarray) -> str:
@@ -258,32 +322,53 @@ def pq_mesh(a, b, rows: int = 20, primary: int | str = "middle", option: int = 0
     a, b, args = _checked(a, b, rows, primary, option, extend, trim, max_extend,
                           planarity_tolerance, tol)
     rows, ptol = args.rows, args.ptol
-    m = len(a)
     d = b - a
     scale = _patch_scale(a, b, d, tol)
     warnings: list[str] = []
+    m_given = len(a)
+    kept = _single_generators(a, d, rows, warnings)
+    if kept.size < m_given:
+        a, b, d = a[kept], b[kept], d[kept]
+        creases = None if creases is None else \
+            np.searchsorted(kept, np.asarray(creases, np.int64), side="right") - 1
+        crease_generators = None if crease_generators is None else \
+            np.searchsorted(kept, np.asarray(crease_generators, np.int64), side="right") - 1
+    m = len(a)
     # Torsal generators cut the generators into segments: where the twist changes
-    # sign the two segments share the generator (hops across it would reverse the
-    # rows); a coplanar pair, or a crease inside a strip, leaves that strip to be
-    # closed by strip quads (planar for a coplanar pair) or triangles (§4.3).
+    # sign (hops across would reverse the rows), at a coplanar pair, or at a crease
+    # inside a strip, that strip is left to be closed by strip quads (planar for a
+    # coplanar pair) or triangles (§4.3).  The segments do not share the generator:
+    # each takes its own division, and two divisions on one line would leave
+    # zero-width slivers between them.
     flat, change, crease = _torsal_cuts(a, d, scale, tol, creases, m)
     if ptol > tol.planarity:
         flat = flat | _nearly_flat(a, d, rows, ptol)
     torsal = _say_cuts(flat, change, crease, warnings)
     cg = _crease_generators(crease_generators, m)
-    segs = _segments(m, np.union1d(np.flatnonzero(change & ~flat & ~crease), cg),
-                     np.flatnonzero(flat | crease))
+    # A sign change across a strip much narrower than a row step (the generators
+    # nearly coincide) is shared instead: a zipper there would be all slivers.
+    narrow = change & ~flat & ~crease & _narrow_strips(a, d, rows)
+    segs = _segments(m, np.union1d(np.flatnonzero(narrow), cg),
+                     np.flatnonzero(flat | crease | (change & ~narrow)))
     plan = _Plan(a, d, tol, scale, warnings, frozenset(cg.tolist()))
-    parts = _build_all(plan, segs, args.primary, args.middle,
+    primary = int(np.searchsorted(kept, args.primary, side="right") - 1)
+    parts = _build_all(plan, segs, primary, args.middle,
                        Division(rows, args.option, args.extend, args.max_extend), m)
     restarts = max(len([r for r in parts if len(r.left)]) - len([s for s in segs if s.hi - s.lo >= 2]), 0)
     even = _even_ranges(parts, segs, warnings)
     meet = np.r_[flat, False] | np.r_[False, flat]      # generators of a coplanar pair
     mesh = assemble(parts, a, d, args.trim, tol, ptol, warnings, scale, meet, rows=rows)
+    mesh, flips = flip_triangles(mesh)
     mesh, paired = _paired(mesh, ptol, tol)
+    if paired:
+        mesh, more = flip_triangles(mesh)
+        flips += more
     _warn_share(mesh, warnings, torsal.size, even, restarts, m, rows)
     _warn_splinters(mesh, warnings, torsal)
-    return mesh.with_info(runs=len(parts), restarts=restarts, planarity_tolerance=ptol, paired=paired)
+    if kept.size < m_given:
+        mesh = _renumbered(mesh, kept)
+    return mesh.with_info(runs=len(parts), restarts=restarts, planarity_tolerance=ptol, paired=paired,
+                          flips=flips)
 
 
 @dataclass(frozen=True)
@@ -492,7 +577,7 @@ def _build_all(plan: _Plan, segs: list[_Segment], p: int, middle: bool, div: Div
     built: dict[int, list[Run]] = {}
     s = segs[home]
     pr = (p - s.lo) if not middle else _well_twisted(plan, s.lo, s.hi)
-    built[home] = _build_segment(plan, s.lo, s.hi, pr, div, budget)
+    built[home] = _build_segment(plan, s.lo, s.hi, pr, div, budget, home=True)
     for step in (1, -1):
         k = home + step
         while 0 <= k < len(segs):

@@ -27,16 +27,6 @@ _MIN_CROSSING = 0.05
 _ROUNDS = 6
 
 
-def _angles(P: np.ndarray) -> np.ndarray:
-    """(F, k) interior angles, degrees, of polygons ``P`` (F, k, 3)."""
-    u = np.roll(P, 1, axis=1) - P
-    w = np.roll(P, -1, axis=1) - P
-    nu = np.linalg.norm(u, axis=2)
-    nw = np.linalg.norm(w, axis=2)
-    cos = np.einsum("fkc,fkc->fk", u, w) / np.maximum(nu * nw, 1e-300)
-    return np.degrees(np.arccos(np.clip(cos, -1.0, 1.0)))
-
-
 def _candidates(V: np.ndarray, tri: np.ndarray):
     """Every pair of triangles sharing an edge, as quads (t1, t2, corners)."""
     e_from = tri.reshape(-1)
@@ -85,7 +75,7 @@ def pair_triangles(mesh: Mesh, ptol: float, kinds: tuple[int, ...] | None = None
     int
         Number of quads made.
     """
-    from ..analysis.faces import quad_diagonal_crossing, quad_planarity
+    from ..analysis.faces import polygon_angles, quad_diagonal_crossing, quad_planarity
 
     if kinds is None:
         kinds = (FaceKind.FILL, FaceKind.BORDER, FaceKind.SPLIT)
@@ -100,8 +90,8 @@ def pair_triangles(mesh: Mesh, ptol: float, kinds: tuple[int, ...] | None = None
         return mesh, 0
     P = V[quad]
     sq, tq, _ = quad_diagonal_crossing(P)
-    ang = _angles(P).min(axis=1)
-    tri_min = _angles(V[tri]).min(axis=1)
+    ang = polygon_angles(P).min(axis=1)
+    tri_min = polygon_angles(V[tri]).min(axis=1)
     ok = (quad_planarity(P) <= ptol) & (sq > _MIN_CROSSING) & (sq < 1 - _MIN_CROSSING) \
         & (tq > _MIN_CROSSING) & (tq < 1 - _MIN_CROSSING) \
         & (ang >= np.minimum(tri_min[t1], tri_min[t2]))

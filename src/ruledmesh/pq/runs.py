@@ -23,7 +23,7 @@ import numpy as np
 from ..budget import MAX_BUILD_BYTES, PQ_BYTES_PER_GRID_POINT
 from ..errors import GeometryError
 from ..hop import crossing_maps
-from ..tolerances import Tolerances
+from ..tolerances import RESTART_ANGLE_DEG, TINY, Tolerances
 from .maps import (
     ChainMaps,
     apply,
@@ -80,7 +80,7 @@ class Run:
     right: np.ndarray         # (F, 3) right halves
     pole: np.ndarray          # (F,) a row passes through infinity inside the face
     centre_gen: np.ndarray    # (F,) generator index of each centre (global)
-    failing: np.ndarray       # (m,) faces on the patch that are not convex, per generator
+    failing: np.ndarray       # (m,) faces on the patch not convex or too thin, per generator
     on_patch: np.ndarray      # (m,) faces on the patch, per generator
 
     def inside_t(self, g: int) -> np.ndarray:
@@ -274,7 +274,11 @@ def _grid(a: np.ndarray, d: np.ndarray, first: int, maps: ChainMaps, tau: np.nda
 
 
 def _failing_faces(a, d, t, far, ic, hl, hc, pole, m) -> tuple[np.ndarray, np.ndarray]:
-    """Per generator: faces centred on it on the patch whose crossing misses its diagonal, and all on the patch."""
+    """Per generator: faces centred on it on the patch that fail, and all on the patch.
+
+    A face fails when its crossing misses its generator diagonal (a bow-tie) or
+    when it is a sliver (:func:`_thin`).
+    """
     inner = (ic > 0) & (ic < m - 1)
     failing = np.zeros(m, np.int64)
     counted = np.zeros(m, np.int64)
@@ -292,9 +296,27 @@ def _failing_faces(a, d, t, far, ic, hl, hc, pole, m) -> tuple[np.ndarray, np.nd
     on_patch = np.isfinite(tc) & (tc > 0.0) & (tc < 1.0) & ~pole[inner] \
         & ~far[i, lo] & ~far[i, lo + 1] & ~far[i - 1, c] & ~far[i + 1, c]
     between = (tc - t0) * (tc - t1) < 0
-    np.add.at(failing, i[on_patch & ~between], 1)
+    np.add.at(failing, i[on_patch & (~between | _thin(a, d, t, i, lo, c))], 1)
     np.add.at(counted, i[on_patch], 1)
     return failing, counted
+
+
+def _thin(a, d, t, i, lo, c) -> np.ndarray:
+    """Faces centred on ``g_i`` whose smallest corner angle is below :data:`RESTART_ANGLE_DEG`.
+
+    Near a torsal generator the second asymptotic direction turns into the
+    generator: the rows run nearly along it and every face there is a sliver,
+    however the rows are rooted.  Such faces count as failing, so the run
+    ends before them and the band is closed by triangles of good shape.
+    """
+    P = np.stack([a[i - 1] + t[i - 1, c][:, None] * d[i - 1], a[i] + t[i, lo][:, None] * d[i],
+                  a[i + 1] + t[i + 1, c][:, None] * d[i + 1], a[i] + t[i, lo + 1][:, None] * d[i]],
+                 axis=1)
+    u = np.roll(P, 1, axis=1) - P
+    w = np.roll(P, -1, axis=1) - P
+    norms = np.linalg.norm(u, axis=2) * np.linalg.norm(w, axis=2)
+    cos = np.einsum("fkc,fkc->fk", u, w) / np.maximum(norms, TINY)
+    return np.degrees(np.arccos(np.clip(cos, -1.0, 1.0))).min(axis=1) < RESTART_ANGLE_DEG
 
 
 def carrier(a: np.ndarray, d: np.ndarray, first: int, t: np.ndarray) -> Run:

@@ -1,0 +1,196 @@
+"""Edge flips that fatten the triangles a PQ mesh has to keep.
+
+Triangles are planar whatever their corners, so the triangles the mesher
+leaves (zippers between runs, notch halves, the even bands next to torsal
+generators) may be re-cut freely as long as every corner stays a vertex on a
+generator.  Two triangles sharing an edge are re-cut along their other
+diagonal when that raises the smaller of their smallest angles: Lawson's flip
+with the max-min angle rule, in 3-D.  A flip is taken only where the two
+triangles are nearly coplanar and stay so (no fold, no ridge cut off), so the
+mesh keeps to the surface; quads and their edges are never touched.
+
+Flips are chosen by rounds of mutual best choice (each triangle names the
+flip that gains it most; flips that both triangles name are taken), whole
+arrays per round: no loop over faces.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from ..mesh import FaceKind, Mesh
+from ..tolerances import FLIP_ACTIVE_DEG, FLIP_MAX_BEND_DEG, FLIP_MAX_SAG, FLIP_MIN_GAIN_DEG
+
+__all__ = ["flip_triangles"]
+
+_ROUNDS = 40
+
+
+def _angles(P: np.ndarray) -> np.ndarray:
+    """(F,) smallest interior angle, degrees, of triangles ``P`` (F, 3, 3)."""
+    from ..analysis.faces import polygon_angles
+
+    return polygon_angles(P).min(axis=1)
+
+
+def _unit_normals(p, q, r) -> np.ndarray:
+    n = np.cross(q - p, r - p)
+    return n / np.maximum(np.linalg.norm(n, axis=1, keepdims=True), 1e-300)
+
+
+def _edge_keys(mesh_faces: list[np.ndarray], n: int) -> np.ndarray:
+    """Sorted undirected edge keys ``lo * n + hi`` of fixed-valence face arrays."""
+    keys = []
+    for F in mesh_faces:
+        if len(F):
+            a, b = F.reshape(-1), np.roll(F, -1, axis=1).reshape(-1)
+            keys.append(np.minimum(a, b) * n + np.maximum(a, b))
+    return np.unique(np.concatenate(keys)) if keys else np.zeros(0, np.int64)
+
+
+def _pairs(tri: np.ndarray, n: int):
+    """Triangles sharing a manifold edge: (t1, t2, a, b, c, d) with t1 = (b, c, a), t2 = (c, b, d)."""
+    e_from = tri.reshape(-1)
+    e_to = np.roll(tri, -1, axis=1).reshape(-1)
+    key = np.minimum(e_from, e_to) * n + np.maximum(e_from, e_to)
+    order = np.argsort(key, kind="stable")
+    ks = key[order]
+    pair = np.flatnonzero(ks[1:] == ks[:-1])
+    if len(pair) > 1:
+        single = np.r_[True, pair[1:] != pair[:-1] + 1] & np.r_[pair[:-1] + 1 != pair[1:], True]
+        pair = pair[single]
+    s1, s2 = order[pair], order[pair + 1]
+    ok = (s1 // 3 != s2 // 3) & (e_from[s1] == e_to[s2])
+    s1, s2 = s1[ok], s2[ok]
+    t1, j1, t2, j2 = s1 // 3, s1 % 3, s2 // 3, s2 % 3
+    return (t1, t2, tri[t1, (j1 + 2) % 3], tri[t1, j1], tri[t1, (j1 + 1) % 3],
+            tri[t2, (j2 + 2) % 3])
+
+
+def _round(V: np.ndarray, tri: np.ndarray, fixed: np.ndarray, scale: float) -> int:
+    """One round of mutual-best flips on ``tri`` (in place); the number made.
+
+    ``fixed`` holds the sorted edge keys of every other face (quads, triangles
+    left out of the rounds): a flip may not make one of those edges again.
+    """
+    n = len(V)
+    t1, t2, a, b, c, d = _pairs(tri, n)
+    if t1.size == 0:
+        return 0
+    A, B, C, D = V[a], V[b], V[c], V[d]
+    old = np.minimum(_angles(V[tri[t1]]), _angles(V[tri[t2]]))
+    new = np.minimum(_angles(np.stack([A, B, D], 1)), _angles(np.stack([A, D, C], 1)))
+    n1, n2 = _unit_normals(A, B, C), _unit_normals(B, D, C)
+    m1, m2 = _unit_normals(A, B, D), _unit_normals(A, D, C)
+    mean = n1 + n2
+    mean /= np.maximum(np.linalg.norm(mean, axis=1, keepdims=True), 1e-300)
+    bend = np.cos(np.radians(FLIP_MAX_BEND_DEG))
+    # The flipped pair's height over the old one: how far the surface moves.
+    sag = np.abs(np.einsum("ij,ij->i", 0.5 * (A + D) - 0.5 * (B + C), mean))
+    ok = (new > old + FLIP_MIN_GAIN_DEG) & (np.einsum("ij,ij->i", n1, n2) >= bend) \
+        & (np.einsum("ij,ij->i", m1, m2) >= bend) & (np.einsum("ij,ij->i", m1, mean) >= bend) \
+        & (np.einsum("ij,ij->i", m2, mean) >= bend) & (sag <= FLIP_MAX_SAG * scale) & (a != d)
+    if not ok.any():
+        return 0
+    # The new diagonal must not be an edge already (it would join three faces).
+    new_key = np.minimum(a, d) * n + np.maximum(a, d)
+    ok &= ~(_member(new_key, fixed) | _member(new_key, _edge_keys([tri], n)))
+    cand = np.flatnonzero(ok)
+    if cand.size == 0:
+        return 0
+    gain = new - old
+    best = np.full(len(tri), -np.inf)
+    np.maximum.at(best, t1[cand], gain[cand])
+    np.maximum.at(best, t2[cand], gain[cand])
+    top = cand[(gain[cand] >= best[t1[cand]]) & (gain[cand] >= best[t2[cand]])]
+    first = np.full(len(tri), len(t1))
+    np.minimum.at(first, t1[top], top)
+    np.minimum.at(first, t2[top], top)
+    take = top[(first[t1[top]] == top) & (first[t2[top]] == top)]
+    # Two flips of one round making the same diagonal: keep the first.
+    _, keep = np.unique(new_key[take], return_index=True)
+    take = take[keep]
+    tri[t1[take]] = np.stack([a[take], b[take], d[take]], axis=1)
+    tri[t2[take]] = np.stack([a[take], d[take], c[take]], axis=1)
+    return int(take.size)
+
+
+def _member(keys: np.ndarray, sorted_keys: np.ndarray) -> np.ndarray:
+    """(k,) bool: which ``keys`` are in ``sorted_keys``."""
+    if sorted_keys.size == 0:
+        return np.zeros(keys.shape, bool)
+    pos = np.clip(np.searchsorted(sorted_keys, keys), 0, sorted_keys.size - 1)
+    return sorted_keys[pos] == keys
+
+
+def _active(V: np.ndarray, tri: np.ndarray) -> np.ndarray:
+    """(T,) bool: triangles thinner than :data:`FLIP_ACTIVE_DEG` and their edge neighbours.
+
+    Only these take part in the rounds: a flip between two fat triangles gains
+    little, and most of a large mesh's triangles are fat.
+    """
+    thin = _angles(V[tri]) < FLIP_ACTIVE_DEG
+    if not thin.any():
+        return thin
+    t1, t2, *_ = _pairs(tri, len(V))
+    near = thin.copy()
+    near[t2[thin[t1]]] = True
+    near[t1[thin[t2]]] = True
+    # Two rings: a thin triangle's best partner may sit beside its neighbour.
+    out = near.copy()
+    out[t2[near[t1]]] = True
+    out[t1[near[t2]]] = True
+    return out
+
+
+def flip_triangles(mesh: Mesh) -> tuple[Mesh, int]:
+    """Re-cut pairs of adjacent triangles for a larger smallest angle.
+
+    Parameters
+    ----------
+    mesh : Mesh
+        Any polygon mesh; only its triangles are changed.
+
+    Returns
+    -------
+    Mesh
+        The same vertices, members and quads; flipped triangles are of kind
+        :attr:`FaceKind.FILL` (they are no longer halves of a quad).
+    int
+        Number of flips made.
+    """
+    val = mesh.valences
+    is_tri = val == 3
+    if is_tri.sum() < 2:
+        return mesh, 0
+    V = mesh.vertices
+    n = len(V)
+    scale = float(np.linalg.norm(V.max(axis=0) - V.min(axis=0))) or 1.0
+    ids = np.flatnonzero(is_tri)
+    tri_all = mesh.face_indices[mesh.face_offsets[ids][:, None] + np.arange(3)].astype(np.int64)
+    live = _active(V, tri_all)
+    if not live.any():
+        return mesh, 0
+    others = [tri_all[~live]]
+    for k in np.unique(val[~is_tri]).tolist():
+        f = np.flatnonzero(val == k)
+        others.append(mesh.face_indices[mesh.face_offsets[f][:, None] + np.arange(k)])
+    fixed = _edge_keys(others, n)
+    tri = tri_all[live]
+    before = tri.copy()
+    flips = 0
+    for _ in range(_ROUNDS):
+        made = _round(V, tri, fixed, scale)
+        flips += made
+        if made == 0:
+            break
+    if flips == 0:
+        return mesh, 0
+    changed = (tri != before).any(axis=1)
+    sel = ids[live]
+    kind = mesh.face_kind.copy()
+    kind[sel[changed]] = FaceKind.FILL
+    idx = mesh.face_indices.copy()
+    idx[mesh.face_offsets[sel][:, None] + np.arange(3)] = tri
+    return Mesh(V, mesh.face_offsets, idx, kind, mesh.members, mesh.member_id, mesh.vertex_data,
+                mesh.info), flips
