@@ -468,3 +468,31 @@ def test_cli_refuses_bad_input(tmp_path, capsys):
     bad.write_text(SMALL.replace("count = 9", "count = 1"))
     assert main(["design", str(bad), "--no-browser"]) == 2
     assert "rulings.count" in capsys.readouterr().err
+
+
+@pytest.mark.parametrize("ext", io.formats())
+def test_export_writes_the_files_the_command_line_writes(tmp_path, ext, monkeypatch):
+    """Regression: PLY export wrote NAME.ply only, without the NAME.ruledmesh.ply companion."""
+    (tmp_path / "designer").mkdir()
+    (tmp_path / "cli").mkdir()
+    design = tmp_path / "designer" / "small.toml"
+    design.write_text(SMALL)
+    s = Session(SMALL, design)
+    try:
+        s.export(ext)
+    except ExportError as exc:
+        pytest.skip(f"{ext}: {exc}")
+    from ruledmesh.cli import main
+
+    monkeypatch.chdir(tmp_path / "designer")  # the design named as the designer names it
+    assert main(["build", "small.toml", "-o", str(tmp_path / "cli" / f"small{ext}"), "-q"]) == 0
+    ours = sorted(p.name for p in (tmp_path / "designer").iterdir() if p.name != "small.toml")
+    theirs = sorted(p.name for p in (tmp_path / "cli").iterdir())
+    assert ours == theirs
+    if ext in (".ply", ".obj", ".stl", ".json"):  # no time stamps or ids: the same bytes
+        for name in ours:
+            assert (tmp_path / "designer" / name).read_bytes() == (tmp_path / "cli" / name).read_bytes()
+    if ext == ".ply":
+        back = io.load(tmp_path / "designer" / "small.ply")  # reads the companion too
+        assert back.face_kind.tolist() == s.built.mesh.face_kind.tolist()
+        assert len(back.members) == len(s.built.mesh.members) > 0

@@ -686,26 +686,49 @@ class Session:
             self.path = target
         return target
 
-    def export_bytes(self, ext: str) -> bytes:
-        """The current mesh in the format of extension ``ext`` (see ``ruledmesh.io.WRITERS``)."""
+    def _writer(self, ext: str) -> tuple[str, Any]:
+        """The normalised extension and the :mod:`ruledmesh.io` module writing it."""
         from .. import io
 
         ext = ext.lower() if ext.startswith(".") else f".{ext.lower()}"
         if ext not in io.WRITERS:
             raise ParameterError(f'cannot write "{ext}" files; known: '
                                  f'{", ".join(io.formats())}', "format")
+        try:
+            return ext, importlib.import_module(f"ruledmesh.io.{io.WRITERS[ext]}")
+        except ImportError as exc:
+            raise ExportError(f"{ext} export needs an optional package that is not installed "
+                              f"({exc.name or exc}); see the install extras") from None
+
+    def export_files(self, ext: str, target: Path) -> dict[Path, bytes]:
+        """Every file ``ruledmesh build -o target`` writes for the current mesh, with its bytes.
+
+        The main file first, then the format's companions (PLY: ``NAME.ruledmesh.ply``
+        with the face kinds and generators), exactly as :func:`ruledmesh.io.save`
+        writes them.
+        """
+        from .. import io
+
+        ext, module = self._writer(ext)
         mesh = self._current.built.mesh
         io.check_finite(mesh)
         try:
-            module = importlib.import_module(f"ruledmesh.io.{io.WRITERS[ext]}")
+            files = {Path(target): module.dumpb(mesh)}
+            if hasattr(module, "companions"):
+                files.update({Path(p): b for p, b in module.companions(target, mesh).items()})
         except ImportError as exc:
             raise ExportError(f"{ext} export needs an optional package that is not installed "
                               f"({exc.name or exc}); see the install extras") from None
-        try:
-            return module.dumpb(mesh)
-        except ImportError as exc:
-            raise ExportError(f"{ext} export needs an optional package that is not installed "
-                              f"({exc.name or exc}); see the install extras") from None
+        return files
+
+    def export_bytes(self, ext: str) -> bytes:
+        """The current mesh in the format of extension ``ext`` (see ``ruledmesh.io.WRITERS``).
+
+        Only the main file (a download is one file): :meth:`export` also writes
+        the format's companion files.
+        """
+        ext, _ = self._writer(ext)
+        return self.export_files(ext, Path(f"design{ext}"))[Path(f"design{ext}")]
 
     def export(self, ext: str, path: str | None = None, overwrite: bool = False) -> Path:
         """Write the current mesh as ``ext`` (atomically) inside the design's folder.
@@ -721,9 +744,13 @@ class Session:
             raise ParameterError(f'expected a file name ending in "{ext}", got '
                                  f'"{Path(name).name}"', "path")
         target = self._writable(name, overwrite)
-        data = self.export_bytes(ext)
-        write_atomic(target, data)
-        self._owned.add(target)
+        files = self.export_files(ext, target)
+        for file in files:  # every file is checked before any is written
+            self._writable(str(file.relative_to(self.base_dir)), overwrite)
+        # Companions first, the main file last: as ruledmesh.io.save does.
+        for file, data in reversed(list(files.items())):
+            write_atomic(file, data)
+            self._owned.add(file)
         return target
 
     # ------------------------------------------------------------- page
