@@ -141,8 +141,10 @@ class InProcessBuilder:
     def cached(self, data: dict, source: str, base_dir: str | Path) -> tuple[str | None, Any]:
         """``(key, (built, frame))``: the cached build of this design, or ``(key, None)``."""
         key = _cache_key(data, source, base_dir)
+        if key is None:
+            return None, None
         with self._state:
-            built = self._cache.get(key) if key is not None else None
+            built = self._cache.get(key)
             if built is not None:
                 self._cache.move_to_end(key)
             return key, built

@@ -1070,6 +1070,18 @@ def _handles(design: Mapping, mesh: Mesh) -> list[dict[str, Any]]:
                 points(["surface", key, "point"], value["point"], f"{key}.point")
                 _direction_handle(handles, ["surface", key, "direction"], value.get("direction"),
                                   np.asarray(value["point"], float), mesh, f"{key}.direction")
+            elif isinstance(value, Mapping) and isinstance(value.get("type"), str):
+                # a curve of the surface (a pipe's spine, a meridian, a translational p or q):
+                # its control points and its centre or vertex
+                for sub in ("points", "center", "vertex"):
+                    points(["surface", key, sub], value.get(sub), f"{key}.{sub}")
+        if _is_point(surface.get("direction")) and mesh.n_vertices:
+            # a prism's direction, from the centre of its polygon (else of the mesh)
+            base = surface.get("polygon")
+            anchor = (np.asarray(base, float).mean(axis=0) if _is_points(base)
+                      else mesh.bounding_box().mean(axis=0))
+            _direction_handle(handles, ["surface", "direction"], surface["direction"], anchor,
+                              mesh, "direction")
         _size_handles(handles, surface, mesh)
     return handles
 
@@ -1113,3 +1125,11 @@ def _size_handles(handles: list, surface: Mapping, mesh: Mesh) -> None:
         handles.append({"path": ["surface", key], "kind": "size", "anchor": anchor.tolist(),
                         "axis": unit.tolist(), "scale": scale,
                         "position": (anchor + value * scale * unit).tolist(), "label": key})
+    axes = surface.get("axes")
+    if isinstance(axes, list) and _is_point(axes) and all(v > 0 for v in axes):
+        # an ellipsoid's semi-axes a, b, c: one handle along X, Y and Z each
+        for i, value in enumerate(axes):
+            unit = np.eye(3)[i]
+            handles.append({"path": ["surface", "axes", i], "kind": "size",
+                            "anchor": centre.tolist(), "axis": unit.tolist(), "scale": 1.0,
+                            "position": (centre + value * unit).tolist(), "label": f"axes[{i}]"})
