@@ -20,6 +20,7 @@ import numpy as np
 import pytest
 
 from ruledmesh import io
+from ruledmesh.analysis.report import analyze
 from ruledmesh.design import build_design, parse_design
 from ruledmesh.web.server import make_server
 from ruledmesh.web.session import Session
@@ -132,11 +133,24 @@ def test_page_loads_and_draws(page, designer):
     assert 0.05 < drawn.mean() < 0.95                      # something drawn, not everything
     assert len({tuple(c) for c in pic.reshape(-1, 3)}) > 50  # shaded faces, lines, handles
     assert page.inner_text("[data-fig=faces]") == str(designer.session.built.mesh.n_faces)
-    # the slow figures are computed on request, in the worker process
+    # the slow figures and the full report are computed on request, in the worker process
     assert page.inner_text("[data-fig=panels]") == "-"
+    assert page.evaluate("window.designer.figuresVersion") is None
     page.click("#slow-figures")
     page.wait_for_function("document.querySelector('[data-fig=panels]').textContent.match(/^\\d+$/)",
                            timeout=60_000)
+    # the report is ruledmesh analyze's, of the mesh drawn
+    report = page.evaluate("window.designer.report")
+    built = designer.session.built
+    expected = analyze(built.mesh, reference=build_design(parse_design(
+        designer.session.toml(), "browser.toml", Path(designer.session.base_dir))).reference,
+        extras=built.extras)
+    assert report["faces"] == expected["faces"] and report["kinds"] == expected["kinds"]
+    assert report["planarity"]["max"] == pytest.approx(expected["planarity"]["max"], rel=1e-9)
+    assert report["closeness"]["centroids_max"] == pytest.approx(
+        expected["closeness"]["centroids_max"], rel=1e-6)
+    page.click("#report-box summary")
+    assert '"faces"' in page.inner_text("#report")
 
 
 def server_reaches(predicate, timeout=10.0) -> bool:

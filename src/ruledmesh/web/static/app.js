@@ -966,6 +966,9 @@ function showFigures(fig) {
   // Coverage, closeness and the panel count are computed on request (a button, or a
   // colouring that needs them): during edits they would compete with the builds.
   for (const k of ['coverage', 'closeness', 'panels']) setFig(k, '-', true);
+  if (window.designer.figuresVersion !== current?.header.version) {
+    $('report').textContent = 'not computed for this version';
+  }
   $('warnings').innerHTML = '';
   for (const w of fig.warnings) {
     const li = document.createElement('li');
@@ -997,6 +1000,9 @@ async function fetchSlowFigures() {
   setFig('coverage', fig.coverage !== undefined ? fmt(fig.coverage, 5) : 'n/a');
   setFig('closeness', fig.closeness ? fmt(fig.closeness.centroids_max) : 'n/a');
   setFig('panels', fig.panels !== undefined ? fig.panels : 'n/a');
+  // The full report, as `ruledmesh analyze --json` prints it.
+  $('report').textContent = fig.report ? JSON.stringify(fig.report, null, 1) : 'n/a';
+  window.designer.report = fig.report || null;
   if (msg.header.error) {
     for (const k of ['coverage', 'closeness', 'panels']) setFig(k, 'error');
     status('figures: ' + msg.header.error);
