@@ -28,7 +28,12 @@ def main() -> None:
             page = browser.new_page(viewport={"width": 1400, "height": 860})
             page.goto(server.url)
             page.wait_for_selector("body[data-version]", timeout=20_000)
-            time.sleep(3)          # let the figures process report closeness and coverage
+            # closeness, coverage and the panel count are computed on request
+            page.click("#slow-figures")
+            page.wait_for_function(
+                "document.querySelector('[data-fig=panels]').textContent.match(/^\\d+$/)",
+                timeout=120_000)
+            time.sleep(0.5)
             page.screenshot(path=str(ROOT / "docs" / "img" / "designer.png"))
             browser.close()
     finally:

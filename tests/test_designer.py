@@ -468,3 +468,61 @@ def test_cli_refuses_bad_input(tmp_path, capsys):
     bad.write_text(SMALL.replace("count = 9", "count = 1"))
     assert main(["design", str(bad), "--no-browser"]) == 2
     assert "rulings.count" in capsys.readouterr().err
+
+
+@pytest.mark.parametrize("ext", io.formats())
+def test_export_writes_the_files_the_command_line_writes(tmp_path, ext, monkeypatch):
+    """Regression: PLY export wrote NAME.ply only, without the NAME.ruledmesh.ply companion."""
+    (tmp_path / "designer").mkdir()
+    (tmp_path / "cli").mkdir()
+    design = tmp_path / "designer" / "small.toml"
+    design.write_text(SMALL)
+    s = Session(SMALL, design)
+    try:
+        s.export(ext)
+    except ExportError as exc:
+        pytest.skip(f"{ext}: {exc}")
+    from ruledmesh.cli import main
+
+    monkeypatch.chdir(tmp_path / "designer")  # the design named as the designer names it
+    assert main(["build", "small.toml", "-o", str(tmp_path / "cli" / f"small{ext}"), "-q"]) == 0
+    ours = sorted(p.name for p in (tmp_path / "designer").iterdir() if p.name != "small.toml")
+    theirs = sorted(p.name for p in (tmp_path / "cli").iterdir())
+    assert ours == theirs
+    if ext in (".ply", ".obj", ".stl", ".json"):  # no time stamps or ids: the same bytes
+        for name in ours:
+            assert (tmp_path / "designer" / name).read_bytes() == (tmp_path / "cli" / name).read_bytes()
+    if ext == ".ply":
+        back = io.load(tmp_path / "designer" / "small.ply")  # reads the companion too
+        assert back.face_kind.tolist() == s.built.mesh.face_kind.tolist()
+        assert len(back.members) == len(s.built.mesh.members) > 0
+
+
+def test_one_build_per_design_undo_and_redo_from_the_cache(tmp_path):
+    from ruledmesh.web.builder import BUILD_CACHE, InProcessBuilder
+
+    builder = InProcessBuilder()
+    s = Session(SMALL, tmp_path / "small.toml", builder=builder)
+    s.edit([(["mesh", "rows"], 7)])
+    s.edit([(["mesh", "rows"], 8)])
+    assert builder.builds == 2
+    s.undo()
+    s.undo()  # back to the opening design: built once by the session itself, not cached
+    s.redo()
+    s.redo()
+    assert builder.builds == 3 and s.design["mesh"]["rows"] == 8
+    s.edit([(["mesh", "rows"], 7)])  # a design built before: not built again
+    assert builder.builds == 3
+    # the cached build is the mesh of that design
+    assert same_mesh(s.built.mesh, build_design(parse_design(s.toml(), "small.toml", tmp_path)).mesh)
+    for rows in range(9, 9 + BUILD_CACHE + 1):  # bounded: the oldest builds go
+        s.edit([(["mesh", "rows"], rows)])
+    s.edit([(["mesh", "rows"], 7)])
+    assert builder.builds == 3 + BUILD_CACHE + 2
+
+
+def test_designs_reading_a_file_are_built_again(tmp_path):
+    from ruledmesh.web.builder import _cache_key
+
+    assert _cache_key({"rulings": {"file": "lines.csv"}}, "x.toml", tmp_path) is None
+    assert _cache_key({"mesh": {"rows": 3}}, "x.toml", tmp_path) is not None

@@ -22,6 +22,12 @@ import pytest
 from ruledmesh.web.server import MAX_BODY, Limits, make_server
 from ruledmesh.web.session import MAX_CONTROL_POINTS, Session
 
+
+def decode(data: bytes) -> tuple[dict, bytes]:
+    """The JSON header of a designer state message (and the array bytes after it)."""
+    n = int.from_bytes(data[:4], "little")
+    return json.loads(data[4:4 + n].decode("utf-8")), data[4 + n:]
+
 SMALL = """\
 name = "small"
 
@@ -176,27 +182,46 @@ def test_live_socket_needs_token_origin_and_host(designer, query, origin, host):
     designer.untouched()
 
 
-def read_versions(s: socket.socket, buf: bytes, last: int, wait: float = 20.0) -> list[int]:
-    """Versions in the server's text frames until ``last`` arrives, the socket ends or ``wait``."""
+def frames(buf: bytes):
+    """Complete server frames at the start of ``buf``: ``([(opcode, payload)], rest)``."""
+    out = []
+    while len(buf) >= 2:
+        n, head = buf[1] & 0x7F, 2
+        if n == 126:
+            if len(buf) < 4:
+                break
+            n, head = int.from_bytes(buf[2:4], "big"), 4
+        elif n == 127:
+            if len(buf) < 10:
+                break
+            n, head = int.from_bytes(buf[2:10], "big"), 10
+        if len(buf) < head + n:
+            break
+        out.append((buf[0] & 0x0F, buf[head:head + n]))
+        buf = buf[head + n:]
+    return out, buf
+
+
+def read_versions(s: socket.socket, buf: bytes, last: int, wait: float = 20.0) -> list[dict]:
+    """Headers of the states in the server's binary frames until version ``last`` arrives."""
     s.settimeout(1.0)
     deadline = time.monotonic() + wait
-    versions: list[int] = []
-    while time.monotonic() < deadline and last not in versions:
-        while len(buf) >= 2 and (buf[1] & 0x7F) < 126 and len(buf) >= 2 + (buf[1] & 0x7F):
-            n = buf[1] & 0x7F
-            if buf[0] & 0x0F == 1:  # a text frame (pings and the like are skipped)
-                versions.append(json.loads(buf[2:2 + n])["version"])
-            buf = buf[2 + n:]
-        if last in versions:
+    states: list[dict] = []
+    while time.monotonic() < deadline and last not in [h["version"] for h in states]:
+        got, buf = frames(buf)
+        for opcode, payload in got:
+            if opcode == 2:  # a binary frame: the state message (pings and the like skipped)
+                states.append(decode(payload)[0])
+        if last in [h["version"] for h in states]:
             break
         try:
-            chunk = s.recv(4096)
+            chunk = s.recv(65536)
         except TimeoutError:
             continue
         if not chunk:  # closed by the server
             break
         buf += chunk
-    return versions
+    return states
 
 
 def test_live_socket_with_token_tells_every_change(designer):
@@ -207,11 +232,17 @@ def test_live_socket_with_token_tells_every_change(designer):
     assert status == 200
     status, _ = designer.request("POST", "/api/undo", {})
     assert status == 200
-    versions = read_versions(s, rest, last=2)
+    states = read_versions(s, rest, last=2)
     s.close()
-    # the version on connecting first, then the newer ones in order, ending with the undo's
+    versions = [h["version"] for h in states]
+    # the state on connecting first, then the newer ones in order, ending with the undo's
     # (versions announced while the socket was busy may be merged into the newest)
     assert versions[0] == 0 and versions[-1] == 2 and versions == sorted(set(versions)), versions
+    # each frame is the whole state of its version: the design with the edit, then undone
+    assert states[0]["design"]["mesh"]["rows"] == 6 and states[-1]["design"]["mesh"]["rows"] == 6
+    assert all(h["figures"]["faces"] > 0 for h in states)
+    if 1 in versions:
+        assert states[versions.index(1)]["design"]["mesh"]["rows"] == 7
 
 
 def test_live_sockets_are_bounded(designer):

@@ -21,9 +21,11 @@ from __future__ import annotations
 
 import contextlib
 import dataclasses
+import json
 import multiprocessing as mp
 import threading
 import time
+from collections import OrderedDict
 from pathlib import Path
 from typing import Any
 
@@ -38,6 +40,20 @@ MAX_BUILD_SECONDS = 20.0
 SUPERSEDE_GRACE = 0.3
 # Seconds a fresh worker process may take to import its modules.
 STARTUP_SECONDS = 120.0
+# Builds kept by design: undo, redo, a slider moved back and forth, the same design sent by
+# two tabs are answered without building again. A 100 x 100 mesh is about 1 MB.
+BUILD_CACHE = 8
+
+
+def _cache_key(data: dict, source: str, base_dir: str | Path) -> str | None:
+    """The key of a design's build, or None when it reads a file (which may change on disk)."""
+    try:
+        text = json.dumps(data, sort_keys=True, allow_nan=True)
+    except (TypeError, ValueError):
+        return None
+    if '"file"' in text:
+        return None
+    return f"{source}\0{base_dir}\0{text}"
 
 
 class Superseded(RuledMeshError):
@@ -51,7 +67,7 @@ class BuildTimeout(RuledMeshError):
 def _worker_main(conn) -> None:  # pragma: no cover - runs in the child process
     from ..design import Design, build_design, parse_design
     from ..registry import load_plugins
-    from .session import DEFAULT_DESIGN
+    from .session import DEFAULT_DESIGN, frame_data
 
     load_plugins()
     build_design(parse_design(DEFAULT_DESIGN))  # imports the mesher's modules (lazy elsewhere)
@@ -66,10 +82,13 @@ def _worker_main(conn) -> None:  # pragma: no cover - runs in the child process
         data, source, base_dir = job
         try:
             built = build_design(Design(data, source, Path(base_dir)))
+            # The page's arrays and figures are made here, while the server waits anyway: it
+            # then only encodes them (and stays free for other requests meanwhile).
+            frame = frame_data(data, built)
             # The smooth reference surface stays here: the server never measures with it (the
             # figures process builds its own), and the catalogue's references are closures,
             # which cannot be pickled.
-            reply: tuple[str, Any] = ("ok", dataclasses.replace(built, reference=None))
+            reply: tuple[str, Any] = ("ok", (dataclasses.replace(built, reference=None), frame))
         except RuledMeshError as exc:
             reply = ("error", exc)
         except MemoryError:
@@ -79,9 +98,9 @@ def _worker_main(conn) -> None:  # pragma: no cover - runs in the child process
         try:
             conn.send(reply)
         except Exception:  # noqa: BLE001 - an unpicklable error: say so instead of hanging
-            if reply[0] == "ok" and reply[1].extras:
+            if reply[0] == "ok" and reply[1][0].extras:
                 with contextlib.suppress(Exception):  # the extras are for reports only
-                    conn.send(("ok", dataclasses.replace(reply[1], extras={})))
+                    conn.send(("ok", (dataclasses.replace(reply[1][0], extras={}), reply[1][1])))
                     continue
             try:
                 conn.send(("bug", f"cannot return the result: {reply[0]}"))
@@ -116,6 +135,30 @@ class InProcessBuilder:
     def __init__(self) -> None:
         self._state = threading.Lock()
         self._issued = 0
+        self._cache: OrderedDict[str, Any] = OrderedDict()
+        self.builds = 0  # designs built (not answered from the cache), for the tests
+
+    def cached(self, data: dict, source: str, base_dir: str | Path) -> tuple[str | None, Any]:
+        """``(key, (built, frame))``: the cached build of this design, or ``(key, None)``."""
+        key = _cache_key(data, source, base_dir)
+        if key is None:
+            return None, None
+        with self._state:
+            built = self._cache.get(key)
+            if built is not None:
+                self._cache.move_to_end(key)
+            return key, built
+
+    def remember(self, key: str | None, built: Any) -> Any:
+        """Keep ``built`` (a ``(built, frame)`` pair) as the build of ``key``; the oldest of
+        :data:`BUILD_CACHE` goes."""
+        with self._state:
+            self.builds += 1
+            if key is not None:
+                self._cache[key] = built
+                while len(self._cache) > BUILD_CACHE:
+                    self._cache.popitem(last=False)
+        return built
 
     def generation(self) -> int:
         """A new generation number, newer than every one before (one per edit)."""
@@ -129,10 +172,22 @@ class InProcessBuilder:
             return self._issued > generation
 
     def build(self, generation: int, data: dict, source: str, base_dir: str | Path) -> Any:
-        """Build design ``data`` here and now; returns the :class:`~ruledmesh.registry.Built`."""
+        """Build design ``data``; returns the :class:`~ruledmesh.registry.Built`."""
+        return self.build_frame(generation, data, source, base_dir)[0]
+
+    def build_frame(self, generation: int, data: dict, source: str,
+                    base_dir: str | Path) -> tuple[Any, dict | None]:
+        """Build design ``data`` here and now: ``(built, None)``.
+
+        The page's message of it (:func:`~ruledmesh.web.session.frame_data`)
+        is made by the session when asked for.
+        """
         from ..design import Design, build_design
 
-        return build_design(Design(data, source, Path(base_dir)))
+        key, hit = self.cached(data, source, base_dir)
+        if hit is not None:
+            return hit
+        return self.remember(key, (build_design(Design(data, source, Path(base_dir))), None))
 
     def close(self) -> None:
         """Nothing to stop."""
@@ -186,8 +241,13 @@ class BuildWorker(InProcessBuilder):
                     pass  # the first build tries again and reports it
 
     # ---------------------------------------------------------------- builds
-    def build(self, generation: int, data: dict, source: str, base_dir: str | Path) -> Any:
-        """Build design ``data`` in the worker; returns the :class:`~ruledmesh.registry.Built`.
+    def build_frame(self, generation: int, data: dict, source: str,
+                    base_dir: str | Path) -> tuple[Any, dict | None]:
+        """Build design ``data`` in the worker: ``(built, frame_data)``.
+
+        ``built`` is the :class:`~ruledmesh.registry.Built` (without its smooth
+        reference), ``frame_data`` the page's message parts made in the worker
+        (:func:`~ruledmesh.web.session.frame_data`).
 
         Raises
         ------
@@ -200,6 +260,9 @@ class BuildWorker(InProcessBuilder):
         """
         if self.superseded(generation):
             raise Superseded("superseded by a newer edit")
+        key, hit = self.cached(data, source, base_dir)
+        if hit is not None:
+            return hit
         with self._run_lock:
             if self._closed:
                 raise Superseded("the designer is stopping")
@@ -208,7 +271,7 @@ class BuildWorker(InProcessBuilder):
             if self._proc is None or not self._proc.is_alive():
                 self._stop()
                 self._start()
-            return self._wait(generation, (data, source, str(base_dir)))
+            return self.remember(key, self._wait(generation, (data, source, str(base_dir))))
 
     def _wait(self, generation: int, job: tuple) -> Any:
         started = time.monotonic()

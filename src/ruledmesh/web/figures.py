@@ -1,4 +1,4 @@
-"""Slow figures (closeness, coverage, panel count) in a separate process.
+"""Slow figures (closeness, coverage, panel count, the full report) in a separate process.
 
 The distance of a mesh from its smooth reference surface can take seconds on
 some designs (an arc-length parametrised B-spline), and the congruence classes
@@ -40,6 +40,7 @@ def _worker_main(conn) -> None:  # pragma: no cover - runs in the child process
         try:
             built = build_design(Design(data, source, Path(base_dir)))
             figures, per_face = slow_figures(built)
+            figures["report"] = _report(built)
             reply: tuple[int, dict[str, Any], dict[str, Any] | None, str | None] = (
                 version, figures, per_face, None)
         except RuledMeshError as exc:
@@ -50,6 +51,17 @@ def _worker_main(conn) -> None:  # pragma: no cover - runs in the child process
             conn.send(reply)
         except OSError:  # the server went away: nobody to answer
             return
+
+
+def _report(built) -> dict[str, Any]:  # pragma: no cover - runs in the child process
+    """The report of ``ruledmesh analyze`` (what ``--json`` prints), or ``{"error": ...}``."""
+    from ..analysis.report import analyze
+    from ..errors import RuledMeshError
+
+    try:
+        return analyze(built.mesh, reference=built.reference, extras=built.extras)
+    except RuledMeshError as exc:
+        return {"error": str(exc)}
 
 
 class FigureWorker:

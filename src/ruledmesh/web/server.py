@@ -14,7 +14,7 @@ one's body; this module adds the designer's own rules.  The API:
 ``GET /api/download?format=.glb``  the exported bytes as a download
 ``GET /api/figures?version=N``     binary message: closeness, coverage, panels, classes
 ``GET /api/panel?face=F``   JSON: the face's unrolled outline and ``panels.csv`` row
-``WS /api/live?token=T``    pushes ``{"version": N}`` after every change of the design
+``WS /api/live?token=T``    pushes the state (binary, as ``/api/state``) after every change
 ==========================  ==================================================
 
 Edits answer like ``GET /api/state`` (one round trip per change).  Errors
@@ -48,6 +48,7 @@ connections are kept.
 from __future__ import annotations
 
 import asyncio
+import dataclasses
 import errno
 import hmac
 import ipaddress
@@ -308,6 +309,9 @@ class _Call:
 
     started: float
     topology: str | None = None
+    # "version": answer a change with {"version": N} only; the page has the live socket,
+    # which brings the new state to it (and to every other tab) as a binary frame.
+    answer: str | None = None
 
 
 class _Api:
@@ -365,9 +369,13 @@ class _Api:
         return body
 
     def state(self, call: _Call) -> Response:
+        # Server-Timing lets the page tell server time (build + encode) from its own.
+        if call.answer == "version":
+            ms = (time.perf_counter() - call.started) * 1000
+            return JSONResponse({"version": self.session.version},
+                                headers={"Server-Timing": f"app;dur={ms:.1f}"})
         body = self.session.payload(call.topology)
         ms = (time.perf_counter() - call.started) * 1000
-        # Server-Timing lets the page tell server time (build + encode) from its own.
         return Response(body, media_type="application/octet-stream",
                         headers={"Server-Timing": f"app;dur={ms:.1f}"})
 
@@ -380,7 +388,8 @@ class _Api:
             if fn is None:
                 raise _HttpError(404, f"no API {request.method} /api/{name}")
             arg = await self.body(request) if method == "post" else dict(request.query_params)
-            call = _Call(started, request.headers.get("x-ruledmesh-topology"))
+            call = _Call(started, request.headers.get("x-ruledmesh-topology"),
+                         request.headers.get("x-ruledmesh-answer"))
             return await run_in_threadpool(fn, arg, call)
         except _HttpError as exc:
             return exc.response()
@@ -397,7 +406,7 @@ class _Api:
 
     # ------------------------------------------------------------ endpoints (worker threads)
     def get_state(self, query: dict, call: _Call) -> Response:
-        return self.state(call)
+        return self.state(dataclasses.replace(call, answer=None))
 
     def post_edit(self, body: dict, call: _Call) -> Response:
         changes = body.get("changes")
@@ -492,7 +501,14 @@ class _Api:
 
 
 class _Live:
-    """The open live-update WebSockets: each gets the new version after every change."""
+    """The open live-update WebSockets: each gets the new state after every change.
+
+    The state travels as the binary message of ``GET /api/state``
+    (:meth:`Session.frame`), one WebSocket binary frame.  Each socket remembers
+    the faces it sent last, so while they stay the same a frame holds only
+    the vertices, planarity and the rest (``same_topology``).  A socket that
+    is still sending when newer versions arrive sends only the newest.
+    """
 
     def __init__(self, session: Session, limit: int = MAX_LIVE):
         self.session = session
@@ -513,6 +529,19 @@ class _Live:
             except RuntimeError:  # the loop closed: the server is stopping
                 return
 
+    async def _pump(self, websocket: WebSocket, queue: asyncio.Queue) -> None:
+        sent: str | None = None  # the faces this socket's page has
+        while True:
+            await queue.get()
+            while not queue.empty():  # only the newest matters
+                queue.get_nowait()
+            # The frame is of the design current when it is encoded: never an older one.
+            data, sent = await anyio.to_thread.run_sync(self.session.frame, sent)
+            try:
+                await websocket.send_bytes(data)
+            except (WebSocketDisconnect, RuntimeError, OSError):
+                return  # the page went away; the receiving side notices and ends
+
     async def endpoint(self, websocket: WebSocket) -> None:
         with self.lock:
             full = len(self.queues) >= self.limit
@@ -524,18 +553,10 @@ class _Live:
         with self.lock:
             self.loop = asyncio.get_running_loop()
             self.queues.add(queue)
+        queue.put_nowait(self.session.version)  # the state on connecting
         try:
-            await websocket.send_json({"version": self.session.version})
-
-            async def pump() -> None:
-                while True:
-                    version = await queue.get()
-                    while not queue.empty():  # only the newest matters
-                        version = queue.get_nowait()
-                    await websocket.send_json({"version": version})
-
             async with anyio.create_task_group() as tasks:
-                tasks.start_soon(pump)
+                tasks.start_soon(self._pump, websocket, queue)
                 try:
                     while True:  # the page sends nothing; this notices when it goes away
                         message = await websocket.receive()

@@ -393,6 +393,67 @@ class _Snapshot:
     built: Built
     version: int
     toml: str
+    frame: dict[str, Any] | None = None  # frame_data, when the build worker made it
+
+
+# The sampled curves of the last design: they change only when the curves do (not with the
+# rows, counts, ...). One entry per process; guarded for the server's threads.
+_CURVES: dict[str, Any] = {}
+_CURVES_LOCK = threading.Lock()
+
+
+def frame_data(design: Mapping[str, Any], built: Built) -> dict[str, Any]:
+    """What the page's message of a design holds besides the session's state.
+
+    Computed where the design is built (the build worker process, right after
+    the build), so the server only encodes it.  Only the cheap figures are
+    here (planarity, convexity, counts); closeness, coverage and the panel
+    count come from the figures process on request.
+
+    Returns
+    -------
+    dict
+        ``key`` (:func:`topology_key`), ``header`` (figures, construction,
+        curves, handles, bbox), and lists of ``(name, array)``: ``live``
+        (vertices, planarity), ``faces`` (triangles, edges, corners, kinds:
+        sent when the page has other faces) and ``rest`` (generators, torsal
+        generators, sampled curves).
+    """
+    mesh = built.mesh
+    figures, plan = fast_figures(mesh)
+    rulings = built.rulings
+    if rulings is not None and getattr(rulings, "a", None) is not None:
+        gens = np.stack([rulings.a, rulings.b], axis=1)
+    elif len(mesh.members):
+        gens = mesh.vertices[mesh.members]
+    else:
+        gens = np.zeros((0, 2, 3))
+    spec = json.dumps(design.get("curves", {}), sort_keys=True, default=str)
+    with _CURVES_LOCK:
+        if _CURVES.get("spec") != spec:
+            _CURVES.clear()
+            _CURVES.update(spec=spec, value=_curve_polylines(design))
+        names, counts, points = _CURVES["value"]
+    bbox = mesh.bounding_box() if mesh.n_vertices else np.zeros((2, 3))
+    tris, tri_face = fan_triangles(mesh)
+    return {
+        "key": topology_key(mesh),
+        "header": {"figures": figures, "construction": _construction(design, len(gens)),
+                   "curves": [{"name": n, "count": c} for n, c in zip(names, counts)],
+                   "handles": _handles(design, mesh), "bbox": bbox.tolist()},
+        "live": [("vertices", mesh.vertices.astype(np.float32)),
+                 ("planarity", plan.astype(np.float32))],
+        "faces": [("triangles", tris.astype(np.uint32)),
+                  ("triangle_face", tri_face.astype(np.uint32)),
+                  ("kind", mesh.face_kind.astype(np.uint8)),
+                  ("edges", mesh.edges().astype(np.uint32)),
+                  # The faces themselves (the page's read-out measures areas and angles).
+                  ("face_offsets", mesh.face_offsets.astype(np.uint32)),
+                  ("face_indices", mesh.face_indices.astype(np.uint32))],
+        "rest": [("generators", gens.astype(np.float32)),
+                 ("torsal", _torsal(np.asarray(gens, dtype=np.float64), mesh)),
+                 ("curve_points", points.astype(np.float32))],
+    }
 
 
 class Session:
@@ -452,6 +513,8 @@ class Session:
         # every open page, so two tabs never show different designs.
         self._listeners: list[Callable[[int], None]] = []
         self._panels: tuple[int, dict[str, np.ndarray], Any] | None = None
+        self._frame: tuple[int, dict[str, Any]] | None = None  # (version, frame_data)
+        self._frame_lock = threading.Lock()
 
     def add_listener(self, listener: Callable[[int], None]) -> None:
         """Call ``listener(version)`` after every change of the current design."""
@@ -506,7 +569,7 @@ class Session:
 
     def _commit(self, generation: int, push: bool, data: dict, built: Built,
                 text: str | None = None, coalesce: str | None = None,
-                label: str | None = None) -> int:
+                label: str | None = None, frame: dict | None = None) -> int:
         """Make ``data`` current unless a newer edit arrived while it built (under the lock)."""
         if self._builder.superseded(generation):
             raise Superseded("superseded by a newer edit")
@@ -520,7 +583,7 @@ class Session:
             self._redo_labels.clear()
             self._label = label or "edit"
         self._coalesce = coalesce
-        self._make_current(data, built, text)
+        self._make_current(data, built, text, frame)
         return self.version
 
     def _notify(self, version: int) -> None:
@@ -528,9 +591,10 @@ class Session:
             with contextlib.suppress(Exception):  # a closed page must not refuse an edit
                 listener(version)
 
-    def _make_current(self, data: dict, built: Built, text: str | None = None) -> None:
+    def _make_current(self, data: dict, built: Built, text: str | None = None,
+                      frame: dict | None = None) -> None:
         self._current = _Snapshot(data, built, self._current.version + 1,
-                                  dumps(data) if text is None else text)
+                                  dumps(data) if text is None else text, frame)
 
     # ------------------------------------------------------------- edits
     def replace(self, data: Mapping[str, Any], coalesce: str | None = None,
@@ -566,9 +630,11 @@ class Session:
         text = dumps(candidate)
         parse_design(text, self.source, self.base_dir)
         # Built outside the lock: state requests (and newer edits) never wait for a build.
-        built = self._builder.build(generation, candidate, self.source, self.base_dir)
+        built, frame = self._builder.build_frame(generation, candidate, self.source,
+                                                 self.base_dir)
         with self._lock:
-            version = self._commit(generation, True, candidate, built, text, coalesce, label)
+            version = self._commit(generation, True, candidate, built, text, coalesce, label,
+                                   frame)
         self._notify(version)
         return version
 
@@ -601,7 +667,7 @@ class Session:
                 raise ParameterError(f"nothing to {name}", name)
             generation = self._builder.generation()
             data = stack[-1]
-        built = self._builder.build(generation, data, self.source, self.base_dir)
+        built, frame = self._builder.build_frame(generation, data, self.source, self.base_dir)
         with self._lock:
             if self._builder.superseded(generation):
                 raise Superseded("superseded by a newer edit")
@@ -611,7 +677,7 @@ class Session:
             (self._redo if back else self._undo).append(self._current.design)
             (self._redo_labels if back else self._undo_labels).append(self._label)
             self._label = label
-            version = self._commit(generation, False, data, built)
+            version = self._commit(generation, False, data, built, frame=frame)
         self._notify(version)
         return version
 
@@ -686,26 +752,49 @@ class Session:
             self.path = target
         return target
 
-    def export_bytes(self, ext: str) -> bytes:
-        """The current mesh in the format of extension ``ext`` (see ``ruledmesh.io.WRITERS``)."""
+    def _writer(self, ext: str) -> tuple[str, Any]:
+        """The normalised extension and the :mod:`ruledmesh.io` module writing it."""
         from .. import io
 
         ext = ext.lower() if ext.startswith(".") else f".{ext.lower()}"
         if ext not in io.WRITERS:
             raise ParameterError(f'cannot write "{ext}" files; known: '
                                  f'{", ".join(io.formats())}', "format")
+        try:
+            return ext, importlib.import_module(f"ruledmesh.io.{io.WRITERS[ext]}")
+        except ImportError as exc:
+            raise ExportError(f"{ext} export needs an optional package that is not installed "
+                              f"({exc.name or exc}); see the install extras") from None
+
+    def export_files(self, ext: str, target: Path) -> dict[Path, bytes]:
+        """Every file ``ruledmesh build -o target`` writes for the current mesh, with its bytes.
+
+        The main file first, then the format's companions (PLY: ``NAME.ruledmesh.ply``
+        with the face kinds and generators), exactly as :func:`ruledmesh.io.save`
+        writes them.
+        """
+        from .. import io
+
+        ext, module = self._writer(ext)
         mesh = self._current.built.mesh
         io.check_finite(mesh)
         try:
-            module = importlib.import_module(f"ruledmesh.io.{io.WRITERS[ext]}")
+            files = {Path(target): module.dumpb(mesh)}
+            if hasattr(module, "companions"):
+                files.update({Path(p): b for p, b in module.companions(target, mesh).items()})
         except ImportError as exc:
             raise ExportError(f"{ext} export needs an optional package that is not installed "
                               f"({exc.name or exc}); see the install extras") from None
-        try:
-            return module.dumpb(mesh)
-        except ImportError as exc:
-            raise ExportError(f"{ext} export needs an optional package that is not installed "
-                              f"({exc.name or exc}); see the install extras") from None
+        return files
+
+    def export_bytes(self, ext: str) -> bytes:
+        """The current mesh in the format of extension ``ext`` (see ``ruledmesh.io.WRITERS``).
+
+        Only the main file (a download is one file): :meth:`export` also writes
+        the format's companion files.
+        """
+        ext, _ = self._writer(ext)
+        return self.export_files(ext, Path(f"design{ext}"))[Path(f"design{ext}")]
 
     def export(self, ext: str, path: str | None = None, overwrite: bool = False) -> Path:
         """Write the current mesh as ``ext`` (atomically) inside the design's folder.
@@ -721,9 +810,13 @@ class Session:
             raise ParameterError(f'expected a file name ending in "{ext}", got '
                                  f'"{Path(name).name}"', "path")
         target = self._writable(name, overwrite)
-        data = self.export_bytes(ext)
-        write_atomic(target, data)
-        self._owned.add(target)
+        files = self.export_files(ext, target)
+        for file in files:  # every file is checked before any is written
+            self._writable(str(file.relative_to(self.base_dir)), overwrite)
+        # Companions first, the main file last: as ruledmesh.io.save does.
+        for file, data in reversed(list(files.items())):
+            write_atomic(file, data)
+            self._owned.add(file)
         return target
 
     # ------------------------------------------------------------- page
@@ -766,49 +859,33 @@ class Session:
             edges, faces, kinds) are left out and ``header["same_topology"]`` is
             true; the vertices, planarity and the rest are always sent.
         """
+        return self.frame(topology)[0]
+
+    def frame(self, topology: str | None = None) -> tuple[bytes, str]:
+        """:meth:`payload` and the fingerprint of the faces it describes.
+
+        What a message holds (:func:`frame_data`) is computed once per version,
+        in the build worker when it built the design, and shared by every answer
+        and every open tab; only the header (history, undo flags) and the choice
+        of arrays are made per call.
+        """
         with self._lock:
             snap = self._current
             header = self.describe()
-        built = snap.built
-        mesh = built.mesh
-        figures, plan = fast_figures(mesh)
-        key = topology_key(mesh)
-        header["topology"] = key
-        header["same_topology"] = same = topology == key
-        arrays: list[tuple[str, np.ndarray]] = [
-            ("vertices", mesh.vertices.astype(np.float32)),
-            ("planarity", plan.astype(np.float32)),
-        ]
-        if not same:
-            tris, tri_face = fan_triangles(mesh)
-            arrays += [
-                ("triangles", tris.astype(np.uint32)),
-                ("triangle_face", tri_face.astype(np.uint32)),
-                ("kind", mesh.face_kind.astype(np.uint8)),
-                ("edges", mesh.edges().astype(np.uint32)),
-                # The faces themselves (the page's read-out measures areas and angles).
-                ("face_offsets", mesh.face_offsets.astype(np.uint32)),
-                ("face_indices", mesh.face_indices.astype(np.uint32)),
-            ]
-        rulings = built.rulings
-        if rulings is not None and getattr(rulings, "a", None) is not None:
-            gens = np.stack([rulings.a, rulings.b], axis=1)
-        elif len(mesh.members):
-            gens = mesh.vertices[mesh.members]
-        else:
-            gens = np.zeros((0, 2, 3))
-        arrays.append(("generators", gens.astype(np.float32)))
-        arrays.append(("torsal", _torsal(np.asarray(gens, dtype=np.float64), mesh)))
-        header["figures"] = figures
-        header["construction"] = _construction(snap.design, len(gens))
-        names, counts, points = _curve_polylines(snap.design)
-        header["curves"] = [{"name": n, "count": c} for n, c in zip(names, counts)]
-        arrays.append(("curve_points", points.astype(np.float32)))
-        header["handles"] = _handles(snap.design, mesh)
-        bbox = mesh.bounding_box() if mesh.n_vertices else np.zeros((2, 3))
-        header["bbox"] = bbox.tolist()
-        return encode_message(header, arrays)
+        parts = self._frame_parts(snap)
+        same = topology == parts["key"]
+        header.update(parts["header"], topology=parts["key"], same_topology=same)
+        arrays = parts["live"] + ([] if same else parts["faces"]) + parts["rest"]
+        return encode_message(header, arrays), parts["key"]
 
+    def _frame_parts(self, snap: _Snapshot) -> dict[str, Any]:
+        if snap.frame is not None:
+            return snap.frame
+        with self._frame_lock:  # two tabs asking at once compute it once
+            cached = self._frame
+            if cached is None or cached[0] != snap.version:
+                cached = self._frame = (snap.version, frame_data(snap.design, snap.built))
+            return cached[1]
 
     def panel(self, face: int) -> dict[str, Any]:
         """The unrolled outline and the ``panels.csv`` row of one face of the current mesh.
@@ -993,6 +1070,18 @@ def _handles(design: Mapping, mesh: Mesh) -> list[dict[str, Any]]:
                 points(["surface", key, "point"], value["point"], f"{key}.point")
                 _direction_handle(handles, ["surface", key, "direction"], value.get("direction"),
                                   np.asarray(value["point"], float), mesh, f"{key}.direction")
+            elif isinstance(value, Mapping) and isinstance(value.get("type"), str):
+                # a curve of the surface (a pipe's spine, a meridian, a translational p or q):
+                # its control points and its centre or vertex
+                for sub in ("points", "center", "vertex"):
+                    points(["surface", key, sub], value.get(sub), f"{key}.{sub}")
+        if _is_point(surface.get("direction")) and mesh.n_vertices:
+            # a prism's direction, from the centre of its polygon (else of the mesh)
+            base = surface.get("polygon")
+            anchor = (np.asarray(base, float).mean(axis=0) if _is_points(base)
+                      else mesh.bounding_box().mean(axis=0))
+            _direction_handle(handles, ["surface", "direction"], surface["direction"], anchor,
+                              mesh, "direction")
         _size_handles(handles, surface, mesh)
     return handles
 
@@ -1036,3 +1125,11 @@ def _size_handles(handles: list, surface: Mapping, mesh: Mesh) -> None:
         handles.append({"path": ["surface", key], "kind": "size", "anchor": anchor.tolist(),
                         "axis": unit.tolist(), "scale": scale,
                         "position": (anchor + value * scale * unit).tolist(), "label": key})
+    axes = surface.get("axes")
+    if isinstance(axes, list) and _is_point(axes) and all(v > 0 for v in axes):
+        # an ellipsoid's semi-axes a, b, c: one handle along X, Y and Z each
+        for i, value in enumerate(axes):
+            unit = np.eye(3)[i]
+            handles.append({"path": ["surface", "axes", i], "kind": "size",
+                            "anchor": centre.tolist(), "axis": unit.tolist(), "scale": 1.0,
+                            "position": (centre + value * unit).tolist(), "label": f"axes[{i}]"})

@@ -30,6 +30,9 @@ async function request(method, name, body) {
   const init = { method, headers: { Authorization: `Bearer ${TOKEN}` } };
   // The faces this page has: an answer with the same ones leaves them out (see applyState).
   if (current?.header.topology) init.headers['X-Ruledmesh-Topology'] = current.header.topology;
+  // With the live socket open, a change is answered {version} and its state comes on the
+  // socket (to this tab and every other), so it is never sent twice.
+  if (body !== undefined && liveOpen()) init.headers['X-Ruledmesh-Answer'] = 'version';
   if (body !== undefined) {
     init.headers['Content-Type'] = 'application/json';
     init.body = JSON.stringify(body);
@@ -54,13 +57,15 @@ async function request(method, name, body) {
 
 async function api(method, name, body) {
   const response = await request(method, name, body);
+  const timing = /dur=([0-9.]+)/.exec(response.headers.get('Server-Timing') || '');
   if ((response.headers.get('Content-Type') || '').startsWith('application/json')) {
-    return response.json();
+    const data = await response.json();
+    data.serverMs = timing ? parseFloat(timing[1]) : null;
+    return data;
   }
   const raw = await response.arrayBuffer();
   const msg = decode(raw);
   msg.raw = raw;
-  const timing = /dur=([0-9.]+)/.exec(response.headers.get('Server-Timing') || '');
   msg.serverMs = timing ? parseFloat(timing[1]) : null;
   return msg;
 }
@@ -389,20 +394,35 @@ function fitBuffer(geom, name, data, itemSize) {
 }
 const setAttribute = fitBuffer;
 
-// Triangles for display, each with its face's colour, written into the buffers drawn until
-// now where they fit (the draw range then hides what is left of the old picture).
-function drawFaces() {
-  const { vertices: V, triangles: T, triangle_face: TF } = current.arrays;
-  const nt = TF.length;
-  const pos = new Float32Array(nt * 9);
-  const col = new Float32Array(nt * 9);
+// The faces drawn as one indexed mesh with a vertex per face corner (so each face has its
+// own colour and flat normal), written into the buffers drawn until now where they fit (the
+// draw range hides what is left of the old picture). The triangles, in corner numbers, are
+// the same while the faces are: then only positions, normals and colours are written.
+function drawFaces(sameFaces = false) {
+  const { vertices: V, face_offsets: off, face_indices: idx } = current.arrays;
+  const nf = off.length - 1, nc = idx.length;
+  const pos = new Float32Array(3 * nc), nor = new Float32Array(3 * nc), col = new Float32Array(3 * nc);
   const fc = faceColours($('colour').value);
-  for (let t = 0; t < nt; t++) {
-    const f = TF[t];
-    for (let k = 0; k < 3; k++) {
-      const v = T[3 * t + k], o = 9 * t + 3 * k;
-      pos[o] = V[3 * v]; pos[o + 1] = V[3 * v + 1]; pos[o + 2] = V[3 * v + 2];
-      col[o] = fc[3 * f]; col[o + 1] = fc[3 * f + 1]; col[o + 2] = fc[3 * f + 2];
+  for (let c = 0; c < nc; c++) {
+    const v = 3 * idx[c];
+    pos[3 * c] = V[v]; pos[3 * c + 1] = V[v + 1]; pos[3 * c + 2] = V[v + 2];
+  }
+  for (let f = 0; f < nf; f++) {
+    // Newell's normal of the face (planar faces: its plane's normal), for every corner.
+    let x = 0, y = 0, z = 0;
+    const s = off[f], e = off[f + 1];
+    for (let c = s; c < e; c++) {
+      const p = 3 * c, q = 3 * (c + 1 < e ? c + 1 : s);
+      x += (pos[p + 1] - pos[q + 1]) * (pos[p + 2] + pos[q + 2]);
+      y += (pos[p + 2] - pos[q + 2]) * (pos[p] + pos[q]);
+      z += (pos[p] - pos[q]) * (pos[p + 1] + pos[q + 1]);
+    }
+    const l = Math.hypot(x, y, z) || 1;
+    x /= l; y /= l; z /= l;
+    const r = fc[3 * f], g = fc[3 * f + 1], b = fc[3 * f + 2];
+    for (let c = 3 * s; c < 3 * e; c += 3) {
+      nor[c] = x; nor[c + 1] = y; nor[c + 2] = z;
+      col[c] = r; col[c + 1] = g; col[c + 2] = b;
     }
   }
   let mesh = layers.faces.children[0];
@@ -415,28 +435,26 @@ function drawFaces() {
   }
   const geom = mesh.geometry;
   const reused = fitBuffer(geom, 'position', pos, 3);
+  fitBuffer(geom, 'normal', nor, 3);
   fitBuffer(geom, 'color', col, 3);
+  const nt = current.arrays.triangle_face.length;
+  if (!sameFaces || !geom.index || geom.userData.faces !== current.arrays.face_offsets) {
+    // Fan triangles of each face in corner numbers, in the server's order (so a picked
+    // triangle's face is triangle_face[triangle]).
+    const tri = new Uint32Array(3 * nt);
+    let t = 0;
+    for (let f = 0; f < nf; f++) {
+      for (let c = off[f] + 1; c < off[f + 1] - 1; c++, t += 3) {
+        tri[t] = off[f]; tri[t + 1] = c; tri[t + 2] = c + 1;
+      }
+    }
+    fitBuffer(geom, 'index', tri, 1);
+    geom.userData.faces = current.arrays.face_offsets;
+  }
   geom.setDrawRange(0, 3 * nt);
-  computeNormals(geom, pos);
   geom.computeBoundingSphere();
   window.designer.reused = reused;
   window.designer.legend = drawLegend($('colour').value);
-}
-
-// Flat normals of the triangles drawn (each triangle's own: the faces are planar).
-function computeNormals(geom, pos) {
-  const nt = pos.length / 9;
-  const nor = new Float32Array(pos.length);
-  for (let t = 0; t < nt; t++) {
-    const o = 9 * t;
-    const ux = pos[o + 3] - pos[o], uy = pos[o + 4] - pos[o + 1], uz = pos[o + 5] - pos[o + 2];
-    const vx = pos[o + 6] - pos[o], vy = pos[o + 7] - pos[o + 1], vz = pos[o + 8] - pos[o + 2];
-    let x = uy * vz - uz * vy, y = uz * vx - ux * vz, z = ux * vy - uy * vx;
-    const l = Math.hypot(x, y, z) || 1;
-    x /= l; y /= l; z /= l;
-    for (let k = 0; k < 3; k++) { nor[o + 3 * k] = x; nor[o + 3 * k + 1] = y; nor[o + 3 * k + 2] = z; }
-  }
-  fitBuffer(geom, 'normal', nor, 3);
 }
 
 function recolour() {
@@ -459,7 +477,7 @@ function lines(positions, index, colour, opacity = 1, dashed = false) {
 }
 
 // Face edges (the quads as quads), in the buffers drawn until now where they fit.
-function drawEdges() {
+function drawEdges(sameFaces = false) {
   const { vertices: V, edges: E } = current.arrays;
   let seg = layers.edges.children[0];
   if (!seg) {
@@ -468,7 +486,7 @@ function drawEdges() {
     layers.edges.add(seg);
   }
   fitBuffer(seg.geometry, 'position', V, 3);
-  fitBuffer(seg.geometry, 'index', E, 1);
+  if (!sameFaces || !seg.geometry.index) fitBuffer(seg.geometry, 'index', E, 1);  // the same edges
   seg.geometry.setDrawRange(0, E.length);
   seg.geometry.computeBoundingSphere();
   // The faces' median width (area / longest edge, of up to 2,000 faces): the spacing of the
@@ -627,11 +645,29 @@ function drawScene() {
   let t = performance.now();
   const lap = (name) => { const now = performance.now(); times[name] = now - t; t = now; };
   faceGeometry(); lap('areas');
-  drawFaces(); lap('faces');
-  drawEdges(); drawGenerators(true); lap('lines');
-  drawCurves(); drawConstruction(); drawGrid(); drawHandles(); lap('construction');
+  drawFaces(header.same_topology); lap('faces');
+  drawEdges(header.same_topology); drawGenerators(true); lap('lines');
+  // The layers of the construction are made again only when what they show changed (a
+  // slider of the rows or a moved point leaves most of them as they are).
+  const G = arrays.generators, p = header.construction?.primary;
+  const gen = p !== undefined && 6 * p + 6 <= G.length ? Array.from(G.subarray(6 * p, 6 * p + 6)) : null;
+  redrawIf('curves', [header.curves, header.design.curves], drawCurves);
+  redrawIf('construction', [header.design.curves, header.design.rulings, header.construction, gen,
+    Array.from(arrays.torsal || []), header.handles.filter((h) => h.kind === 'normal'), size,
+    Array.from(arrays.torsal || []).map((i) => Array.from(G.subarray(6 * i, 6 * i + 6)))], drawConstruction);
+  redrawIf('grid', [header.bbox], drawGrid);
+  redrawIf('handles', [header.handles, size, [...selection], primaryLabel], drawHandles);
+  lap('construction');
   render(); lap('render');
   window.designer.drawTimes = times;
+}
+
+const drawnKeys = {};  // layer -> what it was last drawn from (JSON)
+function redrawIf(layer, inputs, draw) {
+  const key = JSON.stringify(inputs);
+  if (drawnKeys[layer] === key) { window.designer.kept[layer] = (window.designer.kept[layer] || 0) + 1; return; }
+  drawnKeys[layer] = key;
+  draw();
 }
 
 // ------------------------------------------------------------------ handles and selection
@@ -927,7 +963,12 @@ function showFigures(fig) {
   setFig('kinds', fig.kinds_text || '-');
   setFig('planarity', fmt(fig.planarity_max));
   setFig('non_convex', fig.non_convex);
-  for (const k of ['coverage', 'closeness', 'panels']) setFig(k, '...', true);
+  // Coverage, closeness and the panel count are computed on request (a button, or a
+  // colouring that needs them): during edits they would compete with the builds.
+  for (const k of ['coverage', 'closeness', 'panels']) setFig(k, '-', true);
+  if (window.designer.figuresVersion !== current?.header.version) {
+    $('report').textContent = 'not computed for this version';
+  }
   $('warnings').innerHTML = '';
   for (const w of fig.warnings) {
     const li = document.createElement('li');
@@ -937,13 +978,16 @@ function showFigures(fig) {
 }
 
 let figureTimer = null;
+const needsSlowFigures = () => ['closeness', 'class'].includes($('colour').value);
 function scheduleSlowFigures() {
   clearTimeout(figureTimer);
+  if (!needsSlowFigures()) return;
   // Wait until the edits settle: the slow figures are recomputed from scratch each time.
   figureTimer = setTimeout(fetchSlowFigures, 350);
 }
 async function fetchSlowFigures() {
   const version = current.header.version;
+  for (const k of ['coverage', 'closeness', 'panels']) setFig(k, '...', true);
   let msg;
   try {
     msg = await api('GET', `figures?version=${version}`);
@@ -956,6 +1000,9 @@ async function fetchSlowFigures() {
   setFig('coverage', fig.coverage !== undefined ? fmt(fig.coverage, 5) : 'n/a');
   setFig('closeness', fig.closeness ? fmt(fig.closeness.centroids_max) : 'n/a');
   setFig('panels', fig.panels !== undefined ? fig.panels : 'n/a');
+  // The full report, as `ruledmesh analyze --json` prints it.
+  $('report').textContent = fig.report ? JSON.stringify(fig.report, null, 1) : 'n/a';
+  window.designer.report = fig.report || null;
   if (msg.header.error) {
     for (const k of ['coverage', 'closeness', 'panels']) setFig(k, 'error');
     status('figures: ' + msg.header.error);
@@ -1273,21 +1320,29 @@ $('kind').addEventListener('change', async () => {
 
 // ------------------------------------------------------------------ edits
 let inFlight = false;
-const jobs = [];      // edits waiting to be sent: {changes: Map key -> [path, value], coalesce}
+const jobs = [];      // edits waiting to be sent: {changes: Map key -> [path, value], coalesce, t}
 let sentAt = 0;
 const timings = [];
-const breakdown = [];  // {total, server, page} ms per edit
-const frameTimes = []; // ms from sending an edit to the next frame after its answer was drawn
+const breakdown = [];  // {total, server, page} ms per edit (see settleMarks)
+const frameTimes = []; // ms from the input event to the next frame after its state was drawn
+const frameLog = [];   // {ms, version, changes}: what each of frameTimes measured
+const marks = [];      // input events waiting for the frame that shows them: {t, version, ...}
+let shown = { version: -1, at: 0, received: 0 };  // the last state drawn and its frame
 
-// Edits go one at a time; while one is on its way, later moves of the same gesture merge
-// (only the newest position matters), so a fast drag never builds a backlog.
+// Edits go one at a time. While one is on its way, later values of the same fields replace
+// the waiting ones (the newest wins: a slider moved on, a point dragged further), so fast
+// input never builds a backlog of designs nobody will see.
 function queueEdit(changes, coalesce = null) {
+  const keys = changes.map(([path]) => keyOf(path));
   let job = jobs[jobs.length - 1];
-  if (!job || coalesce === null || job.coalesce !== coalesce) {
-    job = { changes: new Map(), coalesce };
+  const sameFields = job && job.changes.size === keys.length && keys.every((k) => job.changes.has(k));
+  if (!job || !(sameFields || (coalesce !== null && job.coalesce === coalesce))) {
+    job = { changes: new Map(), coalesce, t: 0 };
     jobs.push(job);
   }
+  if (coalesce !== null) job.coalesce = coalesce;
   for (const [path, value] of changes) job.changes.set(keyOf(path), [path, value]);
+  job.t = performance.now();  // the input whose value the frame will show
   if (!inFlight) flush();
 }
 
@@ -1295,29 +1350,63 @@ async function flush() {
   inFlight = true;
   while (jobs.length) {
     const job = jobs.shift();
-    await send('edit', { changes: [...job.changes.values()], coalesce: job.coalesce });
+    await send('edit', { changes: [...job.changes.values()], coalesce: job.coalesce }, job.t);
   }
   inFlight = false;
   catchUp();
 }
 
-// POST an action that answers with the state; returns false (and shows why) on error.
-async function send(name, body) {
+// Slider to frame: from the input event to the animation frame after the state it asked
+// for was written into the buffers (performance marks, also in the browser's timeline).
+function settleMarks() {
+  for (let i = marks.length - 1; i >= 0; i--) {
+    const m = marks[i];
+    if (m.version === null || m.version > shown.version) continue;
+    marks.splice(i, 1);
+    const ms = shown.at - m.t;
+    performance.measure('ruledmesh slider-to-frame', { start: m.t, end: shown.at });
+    frameTimes.push(ms);
+    frameLog.push({ ms, version: shown.version, changes: m.changes });
+    // server: the edit's build and commit; answered, arrived: when the answer to the edit
+    // and the state's frame reached the page; page: from then to the frame.
+    breakdown.push({ total: ms, server: m.serverMs, answered: m.answered - m.t,
+                     arrived: shown.received - m.t, page: shown.at - shown.received });
+    for (const list of [frameTimes, frameLog, breakdown]) if (list.length > 200) list.shift();
+  }
+}
+
+function frameDrawn(version, received) {
+  requestAnimationFrame(() => {
+    if (version < shown.version) return;
+    shown = { version, at: performance.now(), received };
+    performance.mark('ruledmesh frame');
+    settleMarks();
+  });
+}
+
+// POST an action that changes the state; returns false (and shows why) on error. With the
+// live socket the answer is {version} and the state arrives on the socket (applyState).
+async function send(name, body, inputAt = null) {
   sentAt = performance.now();
-  const started = sentAt;
+  const started = inputAt ?? sentAt;
   try {
     const msg = await api('POST', name, body || {});
     const received = performance.now();
     showError('');
-    applyState(msg);
-    requestAnimationFrame(() => {
-      frameTimes.push(performance.now() - started);
-      if (frameTimes.length > 200) frameTimes.shift();
-    });
-    const ms = performance.now() - sentAt;
+    const mark = { t: started, version: null, changes: body?.changes || name, serverMs: msg.serverMs,
+                   answered: received };
+    marks.push(mark);
+    if (msg.header) {         // the state itself (no live socket)
+      applyState(msg);
+      frameDrawn(msg.header.version, received);
+      mark.version = msg.header.version;
+    } else {
+      mark.version = msg.version;
+      settleMarks();          // the socket may have brought it already
+    }
+    const ms = received - sentAt;
     timings.push(ms);
-    breakdown.push({ total: ms, server: msg.serverMs, page: performance.now() - received });
-    if (timings.length > 50) { timings.shift(); breakdown.shift(); }
+    if (timings.length > 50) timings.shift();
     status(`updated in ${ms.toFixed(0)} ms (server ${msg.serverMs?.toFixed(0)} ms)`);
     return true;
   } catch (err) {
@@ -1351,18 +1440,28 @@ async function refresh() {
 }
 
 // ------------------------------------------------------------------ live updates
-// The server announces every new version on a WebSocket; a tab that did not make the change
-// (another tab's edit, undo) fetches the state, so all tabs show the same design.
+// The server pushes every new state on a WebSocket as a binary frame (the message of
+// /api/state; without the faces while they stay the same), to every open tab: an edit,
+// undo or redo in any tab shows in all of them, and this tab's own edits come this way too.
 let live = null;
 let liveVersion = null;
+const liveOpen = () => live !== null && live.readyState === WebSocket.OPEN && window.designer.live;
 function connectLive(delay = 500) {
   const url = `${location.protocol === 'https:' ? 'wss' : 'ws'}://${location.host}/api/live?token=${
     encodeURIComponent(TOKEN)}`;
   live = new WebSocket(url);
+  live.binaryType = 'arraybuffer';
   live.addEventListener('open', () => { window.designer.live = true; delay = 500; });
   live.addEventListener('message', (event) => {
-    liveVersion = JSON.parse(event.data).version;
-    catchUp();
+    if (typeof event.data === 'string') return;
+    const received = performance.now();
+    const msg = decode(event.data);
+    msg.raw = event.data;
+    liveVersion = msg.header.version;
+    window.designer.liveFrames += 1;
+    if (current && msg.header.version < current.header.version) return;
+    applyState(msg);
+    frameDrawn(msg.header.version, received);
   });
   live.addEventListener('close', () => {
     window.designer.live = false;
@@ -1370,8 +1469,8 @@ function connectLive(delay = 500) {
   });
 }
 function catchUp() {
-  // While this tab's own edits are on their way, their answers bring the state.
-  if (inFlight || jobs.length || liveVersion === null || !current) return;
+  // Without the socket's frames (it reconnects), a newer version is fetched.
+  if (inFlight || jobs.length || liveVersion === null || !current || liveOpen()) return;
   if (liveVersion !== current.header.version) refresh();
 }
 
@@ -1698,7 +1797,11 @@ function finishDrawing() {
 $('undo').addEventListener('click', () => send('undo'));
 $('redo').addEventListener('click', () => send('redo'));
 $('fit').addEventListener('click', () => fitView());
-$('colour').addEventListener('change', () => recolour());
+$('colour').addEventListener('change', () => {
+  recolour();
+  if (needsSlowFigures() && window.designer.figuresVersion !== current?.header.version) fetchSlowFigures();
+});
+$('slow-figures').addEventListener('click', () => { if (current) fetchSlowFigures(); });
 for (const b of document.querySelectorAll('[data-view]')) {
   b.addEventListener('click', () => setView(b.dataset.view));
 }
@@ -1769,7 +1872,7 @@ window.addEventListener('keydown', (event) => {
 // ------------------------------------------------------------------ test and debugging hooks
 window.designer = {
   version: null, renders: 0, frames: 0, figuresVersion: null, lastExport: null, timings,
-  breakdown, frameTimes, sameTopology: 0, legend: null, hover: null, panel: null, reused: false, view: null,
+  breakdown, frameTimes, frameLog, liveFrames: 0, kept: {}, sameTopology: 0, legend: null, hover: null, panel: null, reused: false, view: null,
   busy: () => inFlight || jobs.length > 0,
   softwareGL: SOFTWARE_GL,
   // The page's own part of an update, without the server: decode the last state message
@@ -1781,10 +1884,23 @@ window.designer = {
     for (const name of FACE_ARRAYS) msg.arrays[name] ||= current.arrays[name];
     msg.header.same_topology = false;
     current = null;
+    for (const k of Object.keys(drawnKeys)) delete drawnKeys[k];  // everything drawn again
     applyState(msg);
     requestAnimationFrame(() => resolve(performance.now() - t0));
   }),
   selection: () => [...selection],
+  design: () => current?.header.design,
+  // What the GPU buffers hold now: faces and triangles drawn, and the vertices written into
+  // the face edges' position buffer (their count and sum), to check a frame against a build.
+  drawn: () => {
+    const faces = layers.faces.children[0]?.geometry, edges = layers.edges.children[0]?.geometry;
+    const n = current.arrays.vertices.length;
+    const buf = edges.getAttribute('position').array;
+    let sum = 0;
+    for (let i = 0; i < n; i++) sum += buf[i];
+    return { faces: current.arrays.face_offsets.length - 1, triangles: faces.drawRange.count / 3,
+             vertices: n / 3, vertexSum: sum };
+  },
   camera: () => ({ ortho: camera === orthographic, direction:
     camera.getWorldDirection(new THREE.Vector3()).toArray() }),
   layer: (name) => layers[name].visible,
