@@ -42,7 +42,7 @@ from typing import Any
 import numpy as np
 
 from ._validation import check_int, check_points, describe
-from .budget import HYBRID_BYTES_PER_NODE, check_budget
+from .budget import HYBRID_BYTES_PER_NODE, MAX_COUNT, check_budget
 from .errors import GeometryError, ParameterError
 from .mesh import FaceKind, Mesh
 
@@ -295,7 +295,7 @@ def compound_mesh(P: Any, midpoints: int = 1, divisions: int = 8, border: str = 
     if P.ndim != 3 or P.shape[2] != 3 or P.shape[0] < 2 or P.shape[1] < 2:
         raise ParameterError(f"expected an (I + 1, J + 1, 3) net, got {describe(P)}", "P")
     nu = check_int(midpoints, "midpoints", lo=0, hi=10_000) + 1
-    nv = check_int(divisions, "divisions", lo=1, hi=100_000)
+    nv = check_int(divisions, "divisions", lo=1, hi=MAX_COUNT)
     if border not in ("notched", "triangles"):
         raise ParameterError(f'expected "notched" or "triangles", got {describe(border)}', "border")
     I, J = P.shape[0] - 1, P.shape[1] - 1

@@ -50,7 +50,7 @@ from ._validation import (
     describe,
 )
 from .errors import GeometryError, ParameterError
-from .tolerances import DEFAULT, Tolerances
+from .tolerances import CONVERGED, DEFAULT, PARAMETER_SLACK, ROOT_RTOL, ROOT_XTOL, ROUNDING, TINY, ULPS, Tolerances
 
 __all__ = [
     "CubicHermite",
@@ -70,7 +70,7 @@ _NEWTON_ITERATIONS = 60
 # Arc-length pieces per B-spline knot span (each with _GL_NODES speed samples).
 _LENGTH_PIECES_PER_SPAN = 8
 # A Newton step this small (in u) ends the iteration.
-_NEWTON_FINAL_STEP = 1e-15
+_NEWTON_FINAL_STEP = ULPS
 
 
 # --------------------------------------------------------------------------
@@ -113,7 +113,7 @@ def _params(u: Any, name: str = "u") -> np.ndarray:
 def _unit_params(u: Any, name: str = "u") -> np.ndarray:
     """Parameters that must lie in [0, 1] (rounding slack allowed, then clipped)."""
     arr = _params(u, name)
-    if arr.size and (arr.min() < -1e-12 or arr.max() > 1.0 + 1e-12):
+    if arr.size and (arr.min() < -ROUNDING or arr.max() > 1.0 + ROUNDING):
         raise ParameterError(
             f"expected values in [0, 1], got values in [{arr.min():g}, {arr.max():g}]", name)
     return np.clip(arr, 0.0, 1.0)
@@ -240,7 +240,7 @@ class LevelSet:
         a, b = grid[:-1], grid[1:]
         # one-sided derivatives just inside each interval, so kinks at nodes
         # never fake a critical point inside an interval
-        delta = 1e-9 * (b - a)
+        delta = PARAMETER_SLACK * (b - a)
         dl, dr = dg(a + delta), dg(b - delta)
         def slope(x):
             return float(dg(np.float64(x)))
@@ -254,7 +254,7 @@ class LevelSet:
             # Evaluated one by one, a derivative at rounding level (a curve
             # lying almost in a level plane) may lose its sign change: no root.
             if slope(lo) * slope(hi) < 0:
-                crit.append(brentq(slope, lo, hi, xtol=1e-16, rtol=8.9e-16))
+                crit.append(brentq(slope, lo, hi, xtol=ROOT_XTOL, rtol=ROOT_RTOL))
         self.g, self.dg = g, dg
         self.tol = float(tol)
         self.nodes = np.unique(np.concatenate([grid, crit]))
@@ -293,7 +293,7 @@ class LevelSet:
                     new = x - fx / d
                 bad = ~np.isfinite(new) | (new <= np.minimum(a, b)) | (new >= np.maximum(a, b))
                 new = np.where(bad, 0.5 * (a + b), new)
-                done = (fx == 0) | (np.abs(new - x) <= 4e-16 * np.maximum(np.abs(x), 1e-300))
+                done = (fx == 0) | (np.abs(new - x) <= CONVERGED * np.maximum(np.abs(x), TINY))
                 x = np.where(live & ~done, new, x)
                 live = live & ~done
                 if not np.any(live):
@@ -322,7 +322,7 @@ class LevelSet:
         keep = [0]
         for j in range(1, len(cand)):
             i = keep[-1]
-            same = cand[j] - cand[i] <= 1e-15 or (
+            same = cand[j] - cand[i] <= ULPS or (
                 err[i] <= self.tol and err[j] <= self.tol and mids[j - 1] <= self.tol)
             if same:
                 if err[j] < err[i]:
@@ -562,7 +562,7 @@ class Curve:
         speed, length = values @ fit.T, values @ integ
         # Drop the trailing coefficients that are below rounding on every piece: smooth
         # pieces need far fewer than the nodes, and each one costs a Clenshaw step.
-        keep = np.abs(length).max(axis=0) > 1e-15 * max(float(np.abs(length).max()), 1e-300)
+        keep = np.abs(length).max(axis=0) > ULPS * max(float(np.abs(length).max()), TINY)
         n = max(int(np.flatnonzero(keep)[-1]) + 1 if keep.any() else 1, 2)
         return pieces, cum, speed[:, :max(n - 1, 1)], length[:, :n]
 
@@ -622,7 +622,7 @@ class Curve:
                                   + (t * t - t) * t * m1)
         good = np.isfinite(guess) & (guess >= lo) & (guess <= hi) & (v0 > 0) & (v1 > 0)
         u = np.where(good, guess, u)
-        scale = max(total, 1e-300)
+        scale = max(total, TINY)
         todo = np.arange(flat.size)
         for _ in range(_NEWTON_ITERATIONS):
             uu, kk = u[todo], k[todo]
@@ -634,7 +634,7 @@ class Curve:
                 new = uu - f / _clenshaw(speed_c[kk], xi)
             bad = ~np.isfinite(new) | (new < lo[todo]) | (new > hi[todo])
             new = np.where(bad, 0.5 * (lo[todo] + hi[todo]), new)
-            exact = np.abs(f) <= 4e-16 * scale
+            exact = np.abs(f) <= CONVERGED * scale
             u[todo] = np.where(exact, uu, new)
             done = exact | (np.abs(new - uu) <= _NEWTON_FINAL_STEP)
             todo = todo[~done]
@@ -656,7 +656,7 @@ class Curve:
         """
         arr = _params(s, "s")
         total = self.length()
-        slack = 1e-12 * max(total, 1.0)
+        slack = ROUNDING * max(total, 1.0)
         if arr.size and (arr.min() < -slack or arr.max() > total + slack):
             raise ParameterError(
                 f"expected lengths in [0, {total:g}], got values in [{arr.min():g}, {arr.max():g}]",
@@ -779,7 +779,7 @@ def _plane_text(n: np.ndarray, offset: float) -> str:
 def _check_distinct(points: np.ndarray, name: str) -> None:
     seg = np.linalg.norm(np.diff(points, axis=0), axis=1)
     size = float(np.linalg.norm(points.max(axis=0) - points.min(axis=0)))
-    bad = np.nonzero(seg <= DEFAULT.degenerate * max(size, 1e-300))[0]
+    bad = np.nonzero(seg <= DEFAULT.degenerate * max(size, TINY))[0]
     if len(bad):
         i = int(bad[0])
         raise ParameterError(f"points {i} and {i + 1} coincide; consecutive points must differ",
@@ -809,7 +809,7 @@ class Line(Curve):
     def __post_init__(self) -> None:
         p0 = check_vector(self.p0, "p0")
         p1 = check_vector(self.p1, "p1")
-        if np.linalg.norm(p1 - p0) <= DEFAULT.degenerate * max(np.abs(p0).max(), np.abs(p1).max(), 1e-300):
+        if np.linalg.norm(p1 - p0) <= DEFAULT.degenerate * max(np.abs(p0).max(), np.abs(p1).max(), TINY):
             raise ParameterError("p0 and p1 coincide; a line needs two distinct points", "p1")
         object.__setattr__(self, "p0", _frozen(p0))
         object.__setattr__(self, "p1", _frozen(p1))
@@ -1068,7 +1068,7 @@ class BSpline(Curve):
         # A repeated point gives a piece of zero length (degree 1) or zero speed
         # at an end (higher degrees): arc length and tangents divide by zero.
         _check_distinct(cp, "control_points")
-        if np.ptp(cp, axis=0).max() <= DEFAULT.degenerate * max(float(np.abs(cp).max()), 1e-300):
+        if np.ptp(cp, axis=0).max() <= DEFAULT.degenerate * max(float(np.abs(cp).max()), TINY):
             # a point, not a curve: arc length and tangents would divide by zero
             raise ParameterError("all control points coincide; a curve needs two distinct points",
                                  "control_points")

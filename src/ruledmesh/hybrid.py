@@ -44,17 +44,14 @@ from typing import Any
 import numpy as np
 
 from ._validation import check_bool, check_int, check_points
-from .budget import HYBRID_BYTES_PER_NODE, MAX_BUILD_BYTES, gib
+from .budget import HYBRID_BYTES_PER_NODE, MAX_BUILD_BYTES, MAX_DIVISIONS, MAX_GRID_NODES, gib
 from .errors import GeometryError, ParameterError
 from .mesh import FaceKind, Mesh
 from .normalise import normalised
-from .tolerances import DEFAULT, Tolerances
+from .tolerances import DEFAULT, TINY, Tolerances
 
 __all__ = ["hybrid_mesh", "hybrid_grid", "orient_generators", "checkerboard_faces"]
 
-# Grid nodes above which a build is refused up front (memory): the measured
-# peak per node against the one build budget (ruledmesh.budget).
-MAX_GRID_NODES = MAX_BUILD_BYTES // HYBRID_BYTES_PER_NODE
 
 
 # --------------------------------------------------------------------------- geometry
@@ -192,7 +189,7 @@ def _flat(V: np.ndarray, f: np.ndarray, tol: Tolerances) -> np.ndarray:
     cr = np.cross(P, np.roll(P, -1, axis=1)).sum(axis=1)
     area = 0.5 * np.linalg.norm(cr, axis=1)
     edge = np.linalg.norm(P - np.roll(P, -1, axis=1), axis=2).max(axis=1)
-    return area <= tol.degenerate * np.maximum(edge, 1e-300) ** 2
+    return area <= tol.degenerate * np.maximum(edge, TINY) ** 2
 
 
 def _edge_keys(f: np.ndarray, n: int) -> np.ndarray:
@@ -558,11 +555,11 @@ def hybrid_mesh(a: Any, b: Any, *, midpoints: int = 1, divisions: int = 8, flip:
     if a.shape != b.shape:
         raise ParameterError(f"expected as many points as a ({len(a)}), got {len(b)}", "b")
     midpoints = check_int(midpoints, "midpoints", lo=0, hi=10_000)
-    divisions = check_int(divisions, "divisions", lo=1, hi=1_000_000)
+    divisions = check_int(divisions, "divisions", lo=1, hi=MAX_DIVISIONS)
     flip = check_bool(flip, "flip")
     orient = check_bool(orient, "orient")
     pts = np.concatenate([a, b])
-    scale = max(float(np.linalg.norm(pts.max(axis=0) - pts.min(axis=0))), 1e-300)
+    scale = max(float(np.linalg.norm(pts.max(axis=0) - pts.min(axis=0))), TINY)
     short = np.nonzero(np.linalg.norm(b - a, axis=1) <= tol.degenerate * scale)[0]
     if short.size:
         raise GeometryError(f"generator {int(short[0])} has zero length: a line needs two "

@@ -27,6 +27,7 @@ from typing import Any, TypeVar
 import numpy as np
 
 from .errors import GeometryError
+from .tolerances import MIN_EXTENT, MIN_RELATIVE_EXTENT
 
 __all__ = ["MAX_COORDINATE", "MIN_EXTENT", "check_range", "normalised", "unit_frame"]
 
@@ -35,10 +36,7 @@ __all__ = ["MAX_COORDINATE", "MIN_EXTENT", "check_range", "normalised", "unit_fr
 # design's own scale, with products of four lengths (Gauss-Newton determinants),
 # measured exact to 1e+-70; 1e+-60 leaves a margin.
 MAX_COORDINATE = 1e60
-# Extent (bounding-box diagonal) of the input below which it is refused.
-MIN_EXTENT = 1e-60
-# Extent relative to the largest coordinate below which float64 cannot hold the shape.
-MIN_RELATIVE_EXTENT = 1e-12
+# MIN_EXTENT and MIN_RELATIVE_EXTENT (the smallest extents accepted) live in tolerances.
 
 F = TypeVar("F", bound=Callable[..., Any])
 

@@ -52,9 +52,10 @@ from ._validation import (
 
 # scipy is imported where it is used (lines through points, PCHIP at tangencies, root
 # brackets), so building from director curves starts without it.
+from .budget import MAX_GENERATORS, PQ_BYTES_PER_GRID_POINT
 from .curves import BSpline, CubicHermite, Curve, LevelSet, perpendicular
 from .errors import GeometryError, ParameterError
-from .tolerances import DEFAULT, Tolerances
+from .tolerances import DEFAULT, PARAMETER_SLACK, ROOT_RTOL, ROOT_XTOL, ROUNDING, SAME_ROOT, TINY, ULPS, Tolerances
 
 __all__ = [
     "Distribution",
@@ -120,7 +121,7 @@ def _arc_sigma(curve: Curve, count: int) -> Any:
     grid, _ = dense_grid(count)
     values = exact.value(grid)
     speed = curve._speed(values)
-    if np.all(speed > 1e-12 * curve.length()):
+    if np.all(speed > ROUNDING * curve.length()):
         return _Pchip.of(grid, values, curve.length() / speed)
     # A cusp (zero speed, e.g. a spline doubling back) has an infinite slope
     # there: use the monotone interpolant of the samples instead.
@@ -315,7 +316,7 @@ class Rulings:
 
 def _check_generators(a: np.ndarray, b: np.ndarray, what: str, tol: Tolerances) -> None:
     pts = np.concatenate([a, b])
-    size = max(float(np.linalg.norm(pts.max(axis=0) - pts.min(axis=0))), 1e-300)
+    size = max(float(np.linalg.norm(pts.max(axis=0) - pts.min(axis=0))), TINY)
     short = np.nonzero(np.linalg.norm(b - a, axis=1) <= tol.degenerate * size)[0]
     if len(short):
         i = int(short[0])
@@ -422,7 +423,7 @@ def check_line(value: Any, name: str, err: type = ParameterError) -> np.ndarray:
     d = check_points(value, name, err=err)
     if len(d) != 2:
         raise err(f"expected 2 points of the line, got {len(d)}", name)
-    if np.linalg.norm(d[1] - d[0]) <= DEFAULT.degenerate * max(np.abs(d).max(), 1e-300):
+    if np.linalg.norm(d[1] - d[0]) <= DEFAULT.degenerate * max(np.abs(d).max(), TINY):
         raise err("the two points coincide; a line needs two distinct points", name)
     return d
 
@@ -521,7 +522,7 @@ class _PencilAngle:
         if approach(lo) < 0 < approach(hi):
             from .roots import brentq
 
-            xm = brentq(approach, lo, hi, xtol=1e-16, rtol=8.9e-16)
+            xm = brentq(approach, lo, hi, xtol=ROOT_XTOL, rtol=ROOT_RTOL)
         rmin = float(self.radius(curve._eval(np.asarray(xm, dtype=np.float64))))
         if rmin <= tol.degenerate * curve._size:
             raise GeometryError(
@@ -579,8 +580,8 @@ def _linear_directrix(c1: Curve, c2: Curve, count: int, d: np.ndarray, info: dic
             "and the points of c1 meet it everywhere or nowhere")
     # the plane through d and a_0 has angle theta1[0] modulo pi
     starts = []
-    for j in range(math.ceil((lo - theta1[0]) / np.pi - 1e-12),
-                   math.floor((hi - theta1[0]) / np.pi + 1e-12) + 1):
+    for j in range(math.ceil((lo - theta1[0]) / np.pi - ROUNDING),
+                   math.floor((hi - theta1[0]) / np.pi + ROUNDING) + 1):
         for r in lev2.roots(float(theta1[0] + j * np.pi)):
             starts.append((float(r), j))
     if not starts:
@@ -626,11 +627,11 @@ def _newton_3(c2: Curve, c3: Curve, p: np.ndarray, x: np.ndarray, size: float,
         x = x + dx
         if abs(x[0] - 0.5) > 1.5 or abs(x[1] - 0.5) > 1.5:
             return x, False
-        if np.linalg.norm(dx[:2]) <= 1e-15 and np.linalg.norm(f) <= 1e-12 * size:
+        if np.linalg.norm(dx[:2]) <= ULPS and np.linalg.norm(f) <= ROUNDING * size:
             return x, True
     v, w, lam = x
     f = c3._eval(np.array(w)) - p - lam * (c2._eval(np.array(v)) - p)
-    return x, bool(np.linalg.norm(f) <= 1e-12 * size)
+    return x, bool(np.linalg.norm(f) <= ROUNDING * size)
 
 
 def _first_transversal(c2: Curve, c3: Curve, p: np.ndarray, size: float,
@@ -641,8 +642,8 @@ def _first_transversal(c2: Curve, c3: Curve, p: np.ndarray, size: float,
     v = np.linspace(0.0, 1.0, samples)
     q = c2._eval(v) - p
     r = c3._eval(v) - p
-    qn = q / np.maximum(np.linalg.norm(q, axis=1), 1e-300)[:, None]
-    rn = r / np.maximum(np.linalg.norm(r, axis=1), 1e-300)[:, None]
+    qn = q / np.maximum(np.linalg.norm(q, axis=1), TINY)[:, None]
+    rn = r / np.maximum(np.linalg.norm(r, axis=1), TINY)[:, None]
     sine = np.linalg.norm(np.cross(qn[:, None, :], rn[None, :, :]), axis=-1)
     minima = (sine == minimum_filter(sine, size=3, mode="nearest")) & (sine < 0.3)
     order = np.argsort(sine[minima])
@@ -650,11 +651,11 @@ def _first_transversal(c2: Curve, c3: Curve, p: np.ndarray, size: float,
     found: list[np.ndarray] = []
     for idx in order[:200]:
         i, j = iv[idx], iw[idx]
-        lam = float(r[j] @ q[i] / max(q[i] @ q[i], 1e-300))
+        lam = float(r[j] @ q[i] / max(q[i] @ q[i], TINY))
         x, ok = _newton_3(c2, c3, p, np.array([v[i], v[j], lam]), size)
-        if ok and -1e-12 <= x[0] <= 1 + 1e-12 and -1e-12 <= x[1] <= 1 + 1e-12:
+        if ok and -ROUNDING <= x[0] <= 1 + ROUNDING and -ROUNDING <= x[1] <= 1 + ROUNDING:
             x[:2] = np.clip(x[:2], 0.0, 1.0)
-            if not any(np.linalg.norm(x[:2] - y[:2]) < 1e-8 for y in found):
+            if not any(np.linalg.norm(x[:2] - y[:2]) < SAME_ROOT for y in found):
                 found.append(x)
     return sorted(found, key=lambda y: (y[0], y[1]))
 
@@ -715,14 +716,15 @@ def three_directrices(c1: Curve, c2: Curve, c3: Curve, count: int, *,
         h = g1 - g0
         while g < g1:
             h = min(h, g1 - g)
-            gn = g1 if g + h >= g1 - 1e-15 else g + h
+            gn = g1 if g + h >= g1 - ULPS else g + h
             p = c1._eval(np.array(a_param(gn)))
             pred = cur + prev_step * ((gn - g) / h_prev)
             x, ok = _newton_3(c2, c3, p, pred, size)
             jump = np.linalg.norm(x[:2] - cur[:2]) if ok else np.inf
             if ok and jump <= 0.05 + 4 * np.linalg.norm(prev_step[:2]) * (gn - g) / h_prev:
-                if not (-1e-9 <= x[0] <= 1 + 1e-9 and -1e-9 <= x[1] <= 1 + 1e-9):
-                    which = "c2" if not -1e-9 <= x[0] <= 1 + 1e-9 else "c3"
+                inside = (x[:2] >= -PARAMETER_SLACK) & (x[:2] <= 1 + PARAMETER_SLACK)
+                if not inside.all():
+                    which = "c2" if not inside[0] else "c3"
                     raise _family_end(f"the line runs off the end of {which}", gn, sig1, grid,
                                       k, count)
                 prev_step, h_prev = x - cur, gn - g
@@ -730,7 +732,7 @@ def three_directrices(c1: Curve, c2: Curve, c3: Curve, count: int, *,
                 h = 2 * h
             else:
                 h = h / 2
-                if h < 1e-9:
+                if h < DEFAULT.degenerate:
                     raise _family_end("the solution turns back (the line becomes tangent to "
                                       "the surface's director curves)", g, sig1, grid, k, count)
         cur[:2] = np.clip(cur[:2], 0.0, 1.0)
@@ -867,10 +869,5 @@ def from_lines(lines: Any, *, tol: Tolerances = DEFAULT) -> Rulings:
 # limits
 # --------------------------------------------------------------------------
 
-# Most generators a design may ask for.  Measured peak memory of ``ruledmesh
-# build`` (mesh, analysis against the smooth surface, export) is about 1 KiB per
-# grid point, i.e. per generator and row: 10^5 generators at the default 20 rows
-# already need ~2 GiB, a million ~20 GiB.  Refusing up front beats an
-# out-of-memory kill halfway through.
-MAX_GENERATORS = 100_000
-BUILD_BYTES_PER_GRID_POINT = 1024
+# The limit on generators and the measured memory per generator and row live in ruledmesh.budget.
+BUILD_BYTES_PER_GRID_POINT = PQ_BYTES_PER_GRID_POINT
