@@ -61,6 +61,7 @@ __all__ = [
     "BSpline",
     "Helix",
     "CurveType",
+    "LevelSet",
 ]
 
 # Gauss-Legendre nodes per arc-length piece; with pieces no longer than half a
@@ -497,6 +498,83 @@ class Curve:
         """``count`` points at equal parameter steps, ends included: (count, 3)."""
         count = check_int(count, "count", lo=2)
         return self._eval(np.linspace(0.0, 1.0, count))
+
+    # --- kernels: for callers that already hold float64 parameter arrays -----
+    # The checked methods above validate their input; these skip the checks
+    # (the generators evaluate curves inside Newton and root-finding loops, where
+    # a non-finite iterate must give NaN, not an error) and compute the same values.
+    def point_at(self, u: np.ndarray) -> np.ndarray:
+        """Points ``c(u)`` at float64 parameters, unchecked: what :meth:`evaluate` computes.
+
+        Parameters
+        ----------
+        u : (...) float64
+
+        Returns
+        -------
+        points : (..., 3) float64
+        """
+        return self._eval(u)
+
+    def tangent_at(self, u: np.ndarray) -> np.ndarray:
+        """First derivatives ``c'(u)`` at float64 parameters, unchecked.
+
+        Parameters
+        ----------
+        u : (...) float64
+
+        Returns
+        -------
+        vectors : (..., 3) float64
+            At a kink the derivative of the piece after it.
+        """
+        return self._deriv(u, 1)
+
+    def speed_at(self, u: np.ndarray) -> np.ndarray:
+        """Speeds ``|c'(u)|`` (arc length per unit of ``u``) at float64 parameters: (...) float64."""
+        return self._speed(u)
+
+    def param_at_fraction(self, f: np.ndarray) -> np.ndarray:
+        """Parameters at arc-length fractions ``f`` of the whole length, clipped to [0, 1].
+
+        Parameters
+        ----------
+        f : (...) float64
+            Fractions of :meth:`length`; outside [0, 1] they clip to the ends.
+
+        Returns
+        -------
+        u : (...) float64 in [0, 1]
+        """
+        return self._param_at_length(f * self.length())
+
+    @property
+    def size(self) -> float:
+        """Characteristic size (diagonal of a sampled bounding box) that relative tolerances scale by."""
+        return self._size
+
+    def breaks(self) -> np.ndarray:
+        """Parameters of the kinks and smooth-piece ends, 0 and 1 included: (k,) float64 sorted."""
+        return self._breaks()
+
+    def level_grid(self) -> np.ndarray:
+        """Parameters between which a plane's height function has at most one critical point: (k,) float64."""
+        return self._level_grid()
+
+    def height_function(self, unit_normal: np.ndarray, tol: Tolerances = DEFAULT) -> LevelSet:
+        """The height ``u -> unit_normal . c(u)`` cut into monotone pieces, for plane intersections.
+
+        Parameters
+        ----------
+        unit_normal : (3,) float64, unit length
+        tol : Tolerances
+            ``tol.degenerate`` times :attr:`size` is the absolute tolerance of touches.
+
+        Returns
+        -------
+        LevelSet
+        """
+        return self._plane_level(unit_normal, tol)
 
     @cached_property
     def _size(self) -> float:

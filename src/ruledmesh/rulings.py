@@ -101,10 +101,10 @@ class _ArcLength:
     curve: Curve
 
     def value(self, u):
-        return self.curve._param_at_length(u * self.curve.length())
+        return self.curve.param_at_fraction(u)
 
     def deriv(self, u):
-        return self.curve.length() / self.curve._speed(self.value(u))
+        return self.curve.length() / self.curve.speed_at(self.value(u))
 
 
 def _arc_sigma(curve: Curve, count: int) -> Any:
@@ -120,7 +120,7 @@ def _arc_sigma(curve: Curve, count: int) -> Any:
         return exact
     grid, _ = dense_grid(count)
     values = exact.value(grid)
-    speed = curve._speed(values)
+    speed = curve.speed_at(values)
     if np.all(speed > ROUNDING * curve.length()):
         return _Pchip.of(grid, values, curve.length() / speed)
     # A cusp (zero speed, e.g. a spline doubling back) has an infinite slope
@@ -161,10 +161,10 @@ class _CurveTrack:
     sigma: Any
 
     def value(self, u):
-        return self.curve._eval(self.sigma.value(u))
+        return self.curve.point_at(self.sigma.value(u))
 
     def deriv(self, u):
-        return self.curve._deriv(self.sigma.value(u), 1) * self.sigma.deriv(u)[..., None]
+        return self.curve.tangent_at(self.sigma.value(u)) * self.sigma.deriv(u)[..., None]
 
 
 @dataclass(frozen=True, eq=False)
@@ -343,7 +343,7 @@ def _curve_rulings(c1: Curve, s1: Any, c2: Curve, s2: Any, count: int, info: dic
     u = np.linspace(0.0, 1.0, count)
     sig1 = s1.value(u) if sig1 is None else sig1
     sig2 = s2.value(u) if sig2 is None else sig2
-    a, b = c1._eval(sig1), c2._eval(sig2)
+    a, b = c1.point_at(sig1), c2.point_at(sig2)
     _check_generators(a, b, info["distribution"], tol)
     info = {**info, "c1_params": sig1, "c2_params": sig2}
     surface = RuledSurface(_CurveTrack(c1, s1), _CurveTrack(c2, s2), u)
@@ -441,7 +441,7 @@ def _ended(what: str, curve_name: str, end: tuple, k: int, count: int, extra: st
 def _director_plane(c1: Curve, c2: Curve, count: int, normal: np.ndarray, info: dict,
                     tol: Tolerances) -> Rulings:
     n = normal / np.linalg.norm(normal)
-    levels = [c._plane_level(n, tol) for c in (c1, c2)]
+    levels = [c.height_function(n, tol) for c in (c1, c2)]
     for name, lev in zip(("c1", "c2"), levels):
         lo, hi = lev.range
         if hi - lo <= lev.tol:
@@ -472,7 +472,7 @@ def _director_plane(c1: Curve, c2: Curve, count: int, normal: np.ndarray, info: 
         sig.append(u)
     ds = (s[-1] - s[0])
     with np.errstate(divide="ignore", invalid="ignore"):  # n . c' = 0 at a range end: PCHIP
-        slopes = [ds / (c._deriv(u, 1) @ n) for c, u in zip((c1, c2), sig)]
+        slopes = [ds / (c.tangent_at(u) @ n) for c, u in zip((c1, c2), sig)]
     s1, s2 = _Pchip.of(grid, sig[0], slopes[0]), _Pchip.of(grid, sig[1], slopes[1])
     info = {**info, "levels": s[::k].copy(), "director_plane": n}
     return _curve_rulings(c1, s1, c2, s2, count, info, tol, sig[0][::k].copy(), sig[1][::k].copy())
@@ -507,15 +507,15 @@ class _PencilAngle:
         return np.hypot(x, y)
 
     def level(self, curve: Curve, name: str, tol: Tolerances) -> LevelSet:
-        grid = np.unique(np.concatenate([curve._level_grid(), curve._breaks()]))
+        grid = np.unique(np.concatenate([curve.level_grid(), curve.breaks()]))
         # the closest approach to d, polished between the neighbours of the
         # nearest sample (there the pencil angle jumps by pi)
-        i = int(np.argmin(self.radius(curve._eval(grid))))
+        i = int(np.argmin(self.radius(curve.point_at(grid))))
         lo, hi = grid[max(i - 1, 0)], grid[min(i + 1, len(grid) - 1)]
         def approach(x):  # d/dx of radius^2 / 2: smooth, zero at the closest approach
             x = np.float64(x)
-            px, py = self.xy(curve._eval(x))
-            dx, dy = self.xy(curve._deriv(x, 1) + self.d0)
+            px, py = self.xy(curve.point_at(x))
+            dx, dy = self.xy(curve.tangent_at(x) + self.d0)
             return float(px * dx + py * dy)
 
         xm = grid[i]
@@ -523,13 +523,13 @@ class _PencilAngle:
             from .roots import brentq
 
             xm = brentq(approach, lo, hi, xtol=ROOT_XTOL, rtol=ROOT_RTOL)
-        rmin = float(self.radius(curve._eval(np.asarray(xm, dtype=np.float64))))
-        if rmin <= tol.degenerate * curve._size:
+        rmin = float(self.radius(curve.point_at(np.asarray(xm, dtype=np.float64))))
+        if rmin <= tol.degenerate * curve.size:
             raise GeometryError(
                 f"linear-directrix: {name} meets the directrix d at u = {xm:.6g}: "
                 "every plane through d contains that point")
         for _ in range(6):
-            pts = curve._eval(grid)
+            pts = curve.point_at(grid)
             ref = np.unwrap(self.raw(pts))
             if np.max(np.abs(np.diff(ref))) < 0.5:
                 break
@@ -541,12 +541,12 @@ class _PencilAngle:
         def g(u):
             u = np.asarray(u, dtype=np.float64)
             lin = np.interp(u, grid, ref)
-            return lin + (np.mod(self.raw(curve._eval(u)) - lin + np.pi, 2 * np.pi) - np.pi)
+            return lin + (np.mod(self.raw(curve.point_at(u)) - lin + np.pi, 2 * np.pi) - np.pi)
 
         def dg(u):
             u = np.asarray(u, dtype=np.float64)
-            x, y = self.xy(curve._eval(u))
-            dx, dy = self.xy(curve._deriv(u, 1) + self.d0)
+            x, y = self.xy(curve.point_at(u))
+            dx, dy = self.xy(curve.tangent_at(u) + self.d0)
             return (x * dy - y * dx) / (x * x + y * y)
 
         return LevelSet(g, dg, grid, tol.degenerate)
@@ -558,10 +558,10 @@ def _linear_directrix(c1: Curve, c2: Curve, count: int, d: np.ndarray, info: dic
     grid, k = dense_grid(count)
     arc1 = _arc_sigma(c1, count)
     sig1 = arc1.value(grid)
-    pts1 = c1._eval(sig1)
+    pts1 = c1.point_at(sig1)
     r1 = pencil.radius(pts1)
     near = int(np.argmin(r1))
-    if r1[near] <= tol.degenerate * c1._size:
+    if r1[near] <= tol.degenerate * c1.size:
         gen = near / k
         where = f"a_{int(gen)} (generator {int(gen)})" if gen == int(gen) else (
             f"c1 between generators {int(gen)} and {int(gen) + 1}")
@@ -596,7 +596,7 @@ def _linear_directrix(c1: Curve, c2: Curve, count: int, d: np.ndarray, info: dic
                      "branch; move d or shorten c1")
     # d sigma2 / du = theta1'(u) / g2'(sigma2), theta1' through the arc length of c1
     x1, y1 = pencil.xy(pts1)
-    dx1, dy1 = pencil.xy(c1._deriv(sig1, 1) * arc1.deriv(grid)[:, None] + pencil.d0)
+    dx1, dy1 = pencil.xy(c1.tangent_at(sig1) * arc1.deriv(grid)[:, None] + pencil.d0)
     with np.errstate(divide="ignore", invalid="ignore"):
         slope2 = (x1 * dy1 - y1 * dx1) / (x1 * x1 + y1 * y1) / lev2.dg(sig2)
     info = {**info, "directrix": d}
@@ -614,10 +614,10 @@ def _newton_3(c2: Curve, c3: Curve, p: np.ndarray, x: np.ndarray, size: float,
     x = x.copy()
     for _ in range(iterations):
         v, w, lam = x
-        q = c2._eval(np.array(v))
-        r = c3._eval(np.array(w))
+        q = c2.point_at(np.array(v))
+        r = c3.point_at(np.array(w))
         f = r - p - lam * (q - p)
-        jac = np.column_stack([-lam * c2._deriv(np.array(v), 1), c3._deriv(np.array(w), 1), p - q])
+        jac = np.column_stack([-lam * c2.tangent_at(np.array(v)), c3.tangent_at(np.array(w)), p - q])
         try:
             dx = np.linalg.solve(jac, -f)
         except np.linalg.LinAlgError:
@@ -630,7 +630,7 @@ def _newton_3(c2: Curve, c3: Curve, p: np.ndarray, x: np.ndarray, size: float,
         if np.linalg.norm(dx[:2]) <= ULPS and np.linalg.norm(f) <= ROUNDING * size:
             return x, True
     v, w, lam = x
-    f = c3._eval(np.array(w)) - p - lam * (c2._eval(np.array(v)) - p)
+    f = c3.point_at(np.array(w)) - p - lam * (c2.point_at(np.array(v)) - p)
     return x, bool(np.linalg.norm(f) <= ROUNDING * size)
 
 
@@ -640,8 +640,8 @@ def _first_transversal(c2: Curve, c3: Curve, p: np.ndarray, size: float,
     from scipy.ndimage import minimum_filter
 
     v = np.linspace(0.0, 1.0, samples)
-    q = c2._eval(v) - p
-    r = c3._eval(v) - p
+    q = c2.point_at(v) - p
+    r = c3.point_at(v) - p
     qn = q / np.maximum(np.linalg.norm(q, axis=1), TINY)[:, None]
     rn = r / np.maximum(np.linalg.norm(r, axis=1), TINY)[:, None]
     sine = np.linalg.norm(np.cross(qn[:, None, :], rn[None, :, :]), axis=-1)
@@ -691,11 +691,11 @@ def three_directrices(c1: Curve, c2: Curve, c3: Curve, count: int, *,
     c2 = _check_curve(c2, "c2")
     c3 = _check_curve(c3, "c3")
     count = check_int(count, "count", lo=2)
-    size = max(c1._size, c2._size, c3._size)
+    size = max(c1.size, c2.size, c3.size)
     grid, k = dense_grid(count)
     arc1 = _arc_sigma(c1, count)
     sig1 = arc1.value(grid)
-    pts1 = c1._eval(sig1)
+    pts1 = c1.point_at(sig1)
     candidates = _first_transversal(c2, c3, pts1[0], size)
     if not candidates:
         raise GeometryError("three directrices: no line through c1(0) meets both c2 and c3")
@@ -717,7 +717,7 @@ def three_directrices(c1: Curve, c2: Curve, c3: Curve, count: int, *,
         while g < g1:
             h = min(h, g1 - g)
             gn = g1 if g + h >= g1 - ULPS else g + h
-            p = c1._eval(np.array(a_param(gn)))
+            p = c1.point_at(np.array(a_param(gn)))
             pred = cur + prev_step * ((gn - g) / h_prev)
             x, ok = _newton_3(c2, c3, p, pred, size)
             jump = np.linalg.norm(x[:2] - cur[:2]) if ok else np.inf
@@ -740,8 +740,8 @@ def three_directrices(c1: Curve, c2: Curve, c3: Curve, count: int, *,
     # implicit differentiation of c3(w) - p - lam (c2(v) - p) = 0 in p = c1(sigma1(u)):
     # J dx/du = (1 - lam) dp/du
     v, w, lam = sol.T
-    jac = np.stack([-lam[:, None] * c2._deriv(v, 1), c3._deriv(w, 1), pts1 - c2._eval(v)], axis=-1)
-    dp = c1._deriv(sig1, 1) * arc1.deriv(grid)[:, None]
+    jac = np.stack([-lam[:, None] * c2.tangent_at(v), c3.tangent_at(w), pts1 - c2.point_at(v)], axis=-1)
+    dp = c1.tangent_at(sig1) * arc1.deriv(grid)[:, None]
     try:
         dx = np.linalg.solve(jac, ((1 - lam)[:, None] * dp)[..., None])[..., 0]
     except np.linalg.LinAlgError:
@@ -803,7 +803,7 @@ def conoid(curve: Curve, directrix: Any, director_plane: Any, count: int, *,
     sig = arc.value(u)
     rail_a = _CurveTrack(curve, arc)
     rail_b = _ConoidTrack(rail_a, d[0], e, n)
-    a = curve._eval(sig)
+    a = curve.point_at(sig)
     b = rail_b.value(u)
     _check_generators(a, b, "conoid", tol)
     info = {"distribution": "conoid", "warnings": [], "c1_params": sig,

@@ -336,7 +336,7 @@ def curve_kinks(curve) -> np.ndarray:
     from ..curves import BSpline, Polyline
 
     if isinstance(curve, Polyline):
-        return np.asarray(curve._knots[1:-1], dtype=float)
+        return np.asarray(curve.breaks()[1:-1], dtype=float)
     if isinstance(curve, BSpline):
         k = np.asarray(curve.knots if curve.knots is not None else [], dtype=float)
         p = curve.degree
