@@ -6,7 +6,7 @@ make most of them independent of the scale, but products of lengths (areas,
 determinants, squared norms) overflow above about 1e77 and underflow below
 1e-77, and absolute floors such as ``1e-300`` decide differently at different
 scales.  So the entry points (:func:`ruledmesh.pq.pq_mesh`,
-:func:`ruledmesh.hybrid.hybrid_mesh`, :func:`ruledmesh.compound.compound_mesh`)
+:func:`ruledmesh.skew.hybrid_mesh`, :func:`ruledmesh.skew.compound_mesh`)
 mesh a copy of their input moved to the origin and scaled by a **power of two**
 to a box whose longest side is in [1, 2), then map the vertices back.  Scaling by a power of two
 is exact in binary floating point, so a design scaled by ``2**k`` gives the same

@@ -1,8 +1,8 @@
 """The design-file builders of the §4 meshers besides §4.3: hybrid (§4.1) and compound HP (§4.2).
 
 ``[mesh] method = "hybrid"`` meshes the generators of ``[rulings]`` with
-:func:`ruledmesh.hybrid.hybrid_mesh`; ``[surface] kind = "compound-hp"`` builds the
-C1 net of :func:`ruledmesh.compound.compound_net` and meshes it.  Each value is
+:func:`ruledmesh.skew.hybrid_mesh`; ``[surface] kind = "compound-hp"`` builds the
+C1 net of :func:`ruledmesh.skew.compound_net` and meshes it.  Each value is
 checked here once, with messages naming the field.
 """
 
@@ -15,11 +15,11 @@ import numpy as np
 
 from .._validation import check_bool, check_int, check_keys, check_points, describe
 from ..budget import MAX_COUNT, MAX_DIVISIONS
-from ..compound import CompoundReference, c1_residual, check_steps, compound_mesh, compound_net
 from ..errors import DesignError
-from ..hybrid import hybrid_mesh
 from ..mesh import FaceKind
 from ..registry import BuildContext, Built, mesh_method, surface_kind
+from ..skew.compound import CompoundReference, c1_residual, check_steps, compound_mesh, compound_net
+from ..skew.hybrid import hybrid_mesh
 from ..surfaces import RuledReference
 from ..tolerances import DEFAULT, Tolerances
 
