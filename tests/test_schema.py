@@ -107,6 +107,20 @@ def test_curve_with_a_key_of_another_type_is_refused(validator):
         build_design(design_from_tables(data, "skew.toml", base_dir=ROOT / "examples"))
 
 
+@pytest.mark.parametrize("curve,key,value", [
+    ("c1", "degree", 7),            # a B-spline of degree 1..5
+    ("c1", "points", "abc"),        # points are lists of numbers
+    ("c2", "type", "bsplin"),       # an unknown curve type
+])
+def test_bad_curves_are_refused_by_schema_and_loader(validator, curve, key, value):
+    data = _example("skew")
+    data["curves"][curve][key] = value
+    assert list(validator.iter_errors(data)), f"the schema accepts curves.{curve}.{key} = {value!r}"
+    with pytest.raises(DesignError) as err:
+        build_design(design_from_tables(data, "skew.toml", base_dir=ROOT / "examples"))
+    assert err.value.field == f"curves.{curve}.{key}"
+
+
 def test_cli_writes_the_schema(tmp_path, capsys):
     out = tmp_path / "design.schema.json"
     assert main(["schema", "-o", str(out)]) == 0

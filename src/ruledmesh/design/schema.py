@@ -294,14 +294,55 @@ def _conditional(selector: str, name: str, table: _Table, *, default: bool = Fal
     return {"if": cond, "then": then}
 
 
+def _curve_values(reader: Any, table: _Table) -> None:
+    """Value schemas of one ``[curves.NAME]`` reader (``_line(t)``, ``_helix(t)``, ...).
+
+    Its table ``t`` reads ``t.points(key)``, ``t.vector(key)``, ``t.number(key, default=...)``
+    (all required unless given a default or read on one branch only) and
+    ``check_int(t.spec.get(key, ...), t.field(key), ...)``.
+    """
+    module = inspect.getmodule(reader)
+    fn = ast.parse(inspect.getsource(reader)).body[0]
+    assert isinstance(fn, ast.FunctionDef)
+    t = fn.args.args[0].arg
+    parents = {child: node for node in ast.walk(fn) for child in ast.iter_child_nodes(node)}
+    for node in ast.walk(fn):
+        if not (isinstance(node, ast.Call) and node.args):
+            continue
+        func = node.func
+        if (isinstance(func, ast.Attribute) and isinstance(func.value, ast.Name)
+                and func.value.id == t and func.attr in ("points", "vector", "number")):
+            key = _constant(node.args[0], module)
+            if isinstance(key, str):
+                table.value(key, _value_schema(func.attr, node, module))
+                if not (_branched(node, parents) or _after_early_return(node, fn, parents)
+                        or any(k.arg == "default" for k in node.keywords)):
+                    table.required.add(key)
+        elif (isinstance(func, ast.Name) and func.id.startswith("check_") and len(node.args) >= 2
+              and isinstance(node.args[1], ast.Call) and node.args[1].args):
+            key = _constant(node.args[1].args[0], module)
+            if isinstance(key, str):
+                table.value(key, _value_schema(func.id, node, module))
+
+
+def _after_early_return(node: ast.AST, fn: ast.FunctionDef, parents: dict) -> bool:
+    """Whether ``node`` runs only when an earlier ``if ...: return`` of ``fn`` did not return."""
+    while parents.get(node) is not fn:
+        node = parents[node]
+    earlier = fn.body[:fn.body.index(node)]
+    return any(isinstance(st, ast.If) and any(isinstance(n, ast.Return) for n in ast.walk(st))
+               for st in earlier)
+
+
 def _curve_schema() -> dict:
     from ..curves import CurveType
-    from .curves import _KEYS
+    from .curves import _KEYS, _READERS
 
     branches = []
     for kind, keys in _KEYS.items():
         table = _Table()
         table.allow(keys)
+        _curve_values(_READERS[kind], table)
         branches.append(_conditional("type", kind.value, table))
     return {"type": "object", "required": ["type"],
             "properties": {"type": {"enum": [t.value for t in CurveType]}}, "allOf": branches}
