@@ -15,7 +15,10 @@ tests scale theirs with :data:`FUZZ_SCALE` (read from the same variable).
 
 from __future__ import annotations
 
+import importlib.abc
+import importlib.util
 import os
+import sys
 from pathlib import Path
 
 import pytest
@@ -42,32 +45,34 @@ settings.register_profile(
 settings.load_profile(PROFILE if PROFILE in ("ci", "local") else "ci")
 
 
-# ------------------------------------------------------------------ shared designs
+# ------------------------------------------------------------------ shared helpers
 ROOT = Path(__file__).resolve().parents[1]
+TESTS = Path(__file__).resolve().parent
 
-#: A small ruled design (nine generators between a B-spline and a polyline, six rows): quick to
-#: build, with every part of the pipeline (curves, rulings, the §4.3 mesher) in it.
-SMALL_DESIGN = """\
-name = "small"
+#: Helper modules of tests/ that test files import by name (``import export_meshes``).
+HELPERS = ("_shared", "export_meshes", "_catalogue_checks")
 
-[curves.c1]
-type = "bspline"
-degree = 3
-points = [[0, 0, 0], [3, 1, 0], [6, -1, 0], [10, 0, 0]]
 
-[curves.c2]
-type = "polyline"
-points = [[0, 2, 4], [3, 4, 5], [6, 3, 3], [10, 3, 4]]
+class _HelperFinder(importlib.abc.MetaPathFinder):
+    """Finds the :data:`HELPERS` in tests/, and nothing else.
 
-[rulings]
-between = ["c1", "c2"]
-distribution = "parameter"
-count = 9
+    With ``--import-mode=importlib`` the tests folder is not on ``sys.path``, so a test file
+    cannot import a sibling module; this finder lets it import exactly the shared helpers
+    (loaded once, on first import), instead of every file loading its own copy by path.
+    """
 
-[mesh]
-method = "pq"
-rows = 6
-"""
+    def find_spec(self, name, path=None, target=None):
+        if name not in HELPERS:
+            return None
+        return importlib.util.spec_from_file_location(name, TESTS / f"{name}.py")
+
+
+if not any(isinstance(f, _HelperFinder) for f in sys.meta_path):
+    sys.meta_path.append(_HelperFinder())
+
+import _shared  # noqa: E402 - importable only once the finder is in place
+
+SMALL_DESIGN = _shared.SMALL_DESIGN
 
 
 @pytest.fixture(scope="session")
@@ -84,5 +89,5 @@ def skew_path(examples_dir: Path) -> Path:
 
 @pytest.fixture
 def small_design() -> str:
-    """The text of :data:`SMALL_DESIGN`."""
+    """The text of :data:`_shared.SMALL_DESIGN`."""
     return SMALL_DESIGN

@@ -1,7 +1,8 @@
 """Test meshes for the export and triangulation tests (built here, not by the PQ mesher).
 
-Loaded by the test files with ``load_helpers()`` below, since the tests run
-with ``--import-mode=importlib`` (the tests folder is not on sys.path).
+Test files import it as ``import export_meshes as E``: ``conftest.py`` makes the helper
+modules of tests/ importable, since the tests run with ``--import-mode=importlib`` (the tests
+folder is not on sys.path).
 """
 
 from __future__ import annotations

@@ -9,9 +9,9 @@ from hypothesis import strategies as st
 
 from ruledmesh.analysis.faces import planarity
 from ruledmesh.cli import main
-from ruledmesh.compound import CompoundSurface, c1_residual, c1_step, compound_mesh, compound_net
 from ruledmesh.errors import ParameterError
 from ruledmesh.mesh import FaceKind
+from ruledmesh.skew.compound import CompoundSurface, c1_residual, c1_step, compound_mesh, compound_net
 
 SEED = np.array([[[0.0, 0.0, 0.0], [0.0, 1.0, 0.3]], [[1.0, 0.0, 0.0], [1.0, 1.0, -0.2]]])
 

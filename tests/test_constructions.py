@@ -9,9 +9,7 @@ translational kinds parallelograms.  The predicates come from
 
 from __future__ import annotations
 
-import importlib.util
-import pathlib
-
+import _catalogue_checks as chk  # a helper module of tests/ (see conftest.py)
 import numpy as np
 import pytest
 from hypothesis import given, settings
@@ -19,11 +17,6 @@ from hypothesis import strategies as st
 
 from ruledmesh import constructions as C
 from ruledmesh.errors import GeometryError, ParameterError
-
-_spec = importlib.util.spec_from_file_location(
-    "_catalogue_checks", pathlib.Path(__file__).with_name("_catalogue_checks.py"))
-chk = importlib.util.module_from_spec(_spec)
-_spec.loader.exec_module(chk)
 
 PLANAR = 1e-12
 ON_SURFACE = 1e-10

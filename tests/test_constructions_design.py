@@ -9,10 +9,10 @@ inversion) are built exactly as written there, with Hypothesis over the values.
 
 from __future__ import annotations
 
-import importlib.util
 import json
 import pathlib
 
+import _catalogue_checks as chk  # a helper module of tests/ (see conftest.py)
 import numpy as np
 import pytest
 from hypothesis import HealthCheck, given, settings
@@ -23,11 +23,6 @@ meshio = pytest.importorskip("meshio")
 from ruledmesh.cli import main  # noqa: E402
 from ruledmesh.design import build_design, parse_design  # noqa: E402
 from ruledmesh.errors import DesignError  # noqa: E402
-
-_spec = importlib.util.spec_from_file_location(
-    "_catalogue_checks", pathlib.Path(__file__).with_name("_catalogue_checks.py"))
-chk = importlib.util.module_from_spec(_spec)
-_spec.loader.exec_module(chk)
 
 EXAMPLES = pathlib.Path(__file__).resolve().parents[1] / "examples"
 FAST = settings(max_examples=10, deadline=None,

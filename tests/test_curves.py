@@ -31,7 +31,7 @@ IDS = ["line", "polyline", "arc3", "arc-center", "bspline", "interp", "bspline-k
 
 
 def _numeric_length(c, a=0.0, b=1.0):
-    breaks = np.unique(np.concatenate([c._breaks(), [a, b]]))
+    breaks = np.unique(np.concatenate([c.breaks(), [a, b]]))
     breaks = breaks[(breaks >= a) & (breaks <= b)]
     return sum(quad(lambda x: np.linalg.norm(c.derivative(x)), lo, hi, epsabs=0, epsrel=1e-13,
                     limit=200)[0] for lo, hi in itertools.pairwise(breaks))
@@ -100,6 +100,26 @@ def test_vectorised_shapes(curve):
     assert curve.arclength(u).shape == (3, 4)
     assert curve.evaluate(0.5).shape == (3,)
     assert np.allclose(curve.evaluate(u)[1, 2], curve.evaluate(u[1, 2]))
+
+
+@pytest.mark.parametrize("curve", CURVES, ids=IDS)
+def test_unchecked_kernels_compute_what_the_checked_methods_do(curve):
+    u = np.linspace(0.0, 1.0, 37)
+    assert np.array_equal(curve.point_at(u), curve.evaluate(u))
+    assert np.array_equal(curve.tangent_at(u), curve.derivative(u))
+    assert np.array_equal(curve.speed_at(u), np.linalg.norm(curve.derivative(u), axis=-1))
+    assert np.array_equal(curve.param_at_fraction(u), curve.param_at_length(u * curve.length()))
+    b = curve.breaks()
+    assert b[0] == 0.0 and b[-1] == 1.0 and np.all(np.diff(b) > 0)
+    assert curve.size > 0
+    # the height function's roots are the plane intersections
+    n = np.array([0.0, 0.0, 1.0])
+    level = curve.height_function(n)
+    mid = float(curve.evaluate(0.5)[2])
+    if curve.bounding_box()[1, 2] - curve.bounding_box()[0, 2] > 1e-6:
+        np.testing.assert_array_equal(level.roots(mid), curve.intersect_plane(n, mid))
+    # a NaN iterate gives NaN, not an error: the kernels are for Newton loops
+    assert np.isnan(curve.point_at(np.array([np.nan]))).all()
 
 
 @pytest.mark.parametrize("curve", CURVES, ids=IDS)
@@ -242,7 +262,7 @@ def test_plane_roots_satisfy_the_plane_equation(c, frac, normal):
 def test_spline_derivative_matches_finite_differences(c, u):
     h = 1e-6
     if c.degree == 1:  # the derivative jumps at the knots (a polyline)
-        assume(np.all(np.abs(c._breaks() - u) > 2 * h))
+        assume(np.all(np.abs(c.breaks() - u) > 2 * h))
     fd = (c.evaluate(u + h) - c.evaluate(u - h)) / (2 * h)
     d = c.derivative(u)
     assert np.allclose(d, fd, atol=1e-6 * max(np.abs(d).max(), 1.0))
@@ -347,7 +367,7 @@ def test_de_boor_matches_scipy_bspline(degree):
         u = np.r_[np.linspace(0, 1, 301), -0.01, 1.01]
         np.testing.assert_allclose(curve.evaluate(u[:-2]), ref(u[:-2]), rtol=0, atol=5e-14)
         want = ref(u)  # with the end polynomials continued
-        np.testing.assert_allclose(curve._eval(u), want, rtol=0, atol=5e-14 * np.abs(want).max())
+        np.testing.assert_allclose(curve.point_at(u), want, rtol=0, atol=5e-14 * np.abs(want).max())
         for order in range(1, degree + 1):
             got, want = curve.derivative(u[:-2], order), ref(u[:-2], nu=order)
             np.testing.assert_allclose(got, want, rtol=0, atol=1e-13 * max(np.abs(want).max(), 1))
@@ -412,3 +432,25 @@ def test_brentq_is_scipys():
     assert checked > 100
     with pytest.raises(ValueError, match="sign change"):
         brentq(lambda x: x * x + 1.0, -1.0, 1.0)
+
+
+def test_no_module_outside_curves_calls_private_curve_methods():
+    # The generators and meshers use Curve's public kernels (point_at, tangent_at, ...); the
+    # private ones are the subclasses' protocol and may change with them.
+    import ast
+    from pathlib import Path
+
+    from ruledmesh.curves import Curve
+
+    src = Path(__file__).resolve().parents[1] / "src" / "ruledmesh"
+    private = {name for cls in Curve.__subclasses__() + [Curve] for name in vars(cls)
+               if name.startswith("_") and not name.startswith("__")}
+    used = []
+    for path in sorted(src.rglob("*.py")):
+        if path.name == "curves.py":
+            continue
+        for node in ast.walk(ast.parse(path.read_text(encoding="utf-8"))):
+            if (isinstance(node, ast.Attribute) and node.attr in private
+                    and not (isinstance(node.value, ast.Name) and node.value.id in ("self", "cls"))):
+                used.append(f"{path.relative_to(src)}:{node.lineno} .{node.attr}")
+    assert not used, used

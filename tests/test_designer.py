@@ -13,6 +13,7 @@ import tomllib
 import tracemalloc
 from pathlib import Path
 
+import _shared  # a helper module of tests/ (see conftest.py)
 import numpy as np
 import pytest
 from hypothesis import given, settings
@@ -27,27 +28,7 @@ from ruledmesh.web.toml_writer import dumps
 
 ROOT = Path(__file__).resolve().parents[1]
 
-SMALL = """\
-name = "small"
-
-[curves.c1]
-type = "bspline"
-degree = 3
-points = [[0, 0, 0], [3, 1, 0], [6, -1, 0], [10, 0, 0]]
-
-[curves.c2]
-type = "polyline"
-points = [[0, 2, 4], [3, 4, 5], [6, 3, 3], [10, 3, 4]]
-
-[rulings]
-between = ["c1", "c2"]
-distribution = "parameter"
-count = 9
-
-[mesh]
-method = "pq"
-rows = 6
-"""
+SMALL = _shared.SMALL_DESIGN
 
 
 def decode(data: bytes) -> tuple[dict, dict[str, np.ndarray]]:

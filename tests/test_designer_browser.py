@@ -16,6 +16,7 @@ import sys
 import threading
 from pathlib import Path
 
+import _shared  # a helper module of tests/ (see conftest.py)
 import numpy as np
 import pytest
 
@@ -36,27 +37,7 @@ sync_api = pytest.importorskip("playwright.sync_api",
 ARGS = ["--headless", "--no-sandbox", "--disable-gpu", "--disable-background-networking",
         "--disable-component-update", "--disable-sync", "--no-first-run"]
 
-DESIGN = """\
-name = "browser"
-
-[curves.c1]
-type = "bspline"
-degree = 3
-points = [[0, 0, 0], [3, 1, 0], [6, -1, 0], [10, 0, 0]]
-
-[curves.c2]
-type = "polyline"
-points = [[0, 2, 4], [3, 4, 5], [6, 3, 3], [10, 3, 4]]
-
-[rulings]
-between = ["c1", "c2"]
-distribution = "parameter"
-count = 15
-
-[mesh]
-method = "pq"
-rows = 12
-"""
+DESIGN = _shared.small_design(name="browser", count=15, rows=12)
 
 # Reads the WebGL canvas back through a 2-D canvas: a (h, w, 3) picture, downsampled.
 PIXELS_JS = """([w, h]) => {

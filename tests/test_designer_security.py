@@ -17,6 +17,7 @@ import threading
 import time
 from pathlib import Path
 
+import _shared  # a helper module of tests/ (see conftest.py)
 import pytest
 
 from ruledmesh.web.server import MAX_BODY, Limits, make_server
@@ -28,27 +29,8 @@ def decode(data: bytes) -> tuple[dict, bytes]:
     n = int.from_bytes(data[:4], "little")
     return json.loads(data[4:4 + n].decode("utf-8")), data[4 + n:]
 
-SMALL = """\
-name = "small"
 
-[curves.c1]
-type = "bspline"
-degree = 3
-points = [[0, 0, 0], [3, 1, 0], [6, -1, 0], [10, 0, 0]]
-
-[curves.c2]
-type = "polyline"
-points = [[0, 2, 4], [3, 4, 5], [6, 3, 3], [10, 3, 4]]
-
-[rulings]
-between = ["c1", "c2"]
-distribution = "parameter"
-count = 9
-
-[mesh]
-method = "pq"
-rows = 6
-"""
+SMALL = _shared.SMALL_DESIGN
 
 
 def tree(folder: Path) -> dict[str, bytes]:

@@ -28,8 +28,8 @@ from hypothesis import strategies as st
 from ruledmesh.analysis import planarity
 from ruledmesh.design import build_design, parse_design
 from ruledmesh.errors import RuledMeshError
-from ruledmesh.hybrid import hybrid_mesh
 from ruledmesh.pq import pq_mesh
+from ruledmesh.skew.hybrid import hybrid_mesh
 from ruledmesh.web.toml_writer import dumps
 
 SCALE = 10 if os.environ.get("HYPOTHESIS_PROFILE") == "local" else 1

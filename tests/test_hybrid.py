@@ -10,8 +10,8 @@ from hypothesis import strategies as st
 from ruledmesh.analysis.faces import face_areas, planarity
 from ruledmesh.cli import main
 from ruledmesh.errors import GeometryError, ParameterError
-from ruledmesh.hybrid import hybrid_mesh
 from ruledmesh.mesh import FaceKind
+from ruledmesh.skew.hybrid import hybrid_mesh
 
 
 # ----------------------------------------------------------------- invariants

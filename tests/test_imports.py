@@ -31,7 +31,7 @@ LAYERS: list[tuple[str, list[str]]] = [
     ("core", ["mesh", "notebook", "registry", "curves", "triangulate", "hop", "surfaces", "labels",
               "analysis.faces", "analysis.circularity", "analysis.surface", "analysis.__init__"]),
     ("generators", ["rulings"]),
-    ("meshers", ["constructions", "transforms", "pq", "hybrid", "compound"]),
+    ("meshers", ["constructions", "transforms", "pq", "skew", "hybrid", "compound"]),
     ("analysis", ["analysis"]),
     ("outputs", ["io", "fabricate", "structure", "render"]),
     ("design", ["design", "bundled", "api", ""]),
@@ -232,3 +232,16 @@ def test_design_errors_only_in_the_design_layer():
                 wrong.append(f"ruledmesh.{module}:{node.lineno}")
     assert not wrong, ("DesignError outside the design layer (maths raises ParameterError):\n"
                        + "\n".join(sorted(set(wrong))))
+
+
+def test_earlier_import_paths_of_the_section_4_meshers_still_work():
+    # ruledmesh.hybrid and ruledmesh.compound are named in earlier releases' docs: they re-export
+    # the same objects from ruledmesh.skew.
+    import ruledmesh
+    from ruledmesh import compound, hybrid, skew
+
+    assert hybrid.hybrid_mesh is skew.hybrid_mesh is ruledmesh.hybrid_mesh
+    for name in compound.__all__:
+        assert getattr(compound, name) is getattr(skew, name)
+    for name in hybrid.__all__:
+        assert getattr(hybrid, name) is getattr(skew, name)

@@ -3,10 +3,9 @@ and vertex positions match the source within the format's precision."""
 
 from __future__ import annotations
 
-import importlib.util
 import json
-from pathlib import Path
 
+import export_meshes as E  # a helper module of tests/ (see conftest.py)
 import numpy as np
 import pytest
 
@@ -16,16 +15,6 @@ from ruledmesh.io import READERS, WRITERS, formats, load, save
 from ruledmesh.mesh import FaceKind
 from ruledmesh.triangulate import recover_polygons, triangulate
 
-
-def _helpers():
-    spec = importlib.util.spec_from_file_location(
-        "export_meshes", Path(__file__).with_name("export_meshes.py"))
-    mod = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(mod)
-    return mod
-
-
-E = _helpers()
 MESHES = E.all_meshes()
 NAMES = list(MESHES)
 

@@ -3,13 +3,13 @@ and the polygons come back from _FACE_ID as documented."""
 
 from __future__ import annotations
 
-import importlib.util
 import json
 import shutil
 import struct
 import subprocess
 from pathlib import Path
 
+import export_meshes as E  # a helper module of tests/ (see conftest.py)
 import numpy as np
 import pytest
 
@@ -18,17 +18,6 @@ from ruledmesh.io.gltf import dumpb, gltf_positions
 from ruledmesh.triangulate import triangulate
 
 JS = Path(__file__).with_name("js")
-
-
-def _helpers():
-    spec = importlib.util.spec_from_file_location(
-        "export_meshes", Path(__file__).with_name("export_meshes.py"))
-    mod = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(mod)
-    return mod
-
-
-E = _helpers()
 
 
 def validate(paths: list[Path]) -> list[dict]:

@@ -5,11 +5,11 @@ numpy-stl, Open3D, pymeshlab, meshio)."""
 from __future__ import annotations
 
 import csv
-import importlib.util
 import io
 import warnings
 from pathlib import Path
 
+import export_meshes as E  # a helper module of tests/ (see conftest.py)
 import numpy as np
 import pytest
 
@@ -22,16 +22,6 @@ from ruledmesh.mesh import FaceKind
 from ruledmesh.triangulate import triangulate
 from ruledmesh.units import Unit, conversion_factor
 
-
-def _helpers():
-    spec = importlib.util.spec_from_file_location(
-        "export_meshes", Path(__file__).with_name("export_meshes.py"))
-    mod = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(mod)
-    return mod
-
-
-E = _helpers()
 UNITS = ["m", "mm", "cm", "in", "ft"]
 SITE = np.array([2.6e6, 1.2e6, 35.0])
 

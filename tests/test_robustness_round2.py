@@ -180,8 +180,8 @@ def test_pq_mesh_refuses_a_huge_grid_with_its_own_error(kwargs):
 
 
 def test_hybrid_and_compound_refuse_huge_grids():
-    from ruledmesh.compound import compound_mesh
-    from ruledmesh.hybrid import hybrid_mesh
+    from ruledmesh.skew.compound import compound_mesh
+    from ruledmesh.skew.hybrid import hybrid_mesh
 
     a, b = hyperboloid_lines(200)
     with pytest.raises(ParameterError, match="GiB"):
@@ -219,7 +219,7 @@ def test_far_axis_rotational_is_refused_not_silent(tmp_path, capsys):
 
 
 def test_tiny_generators_are_refused_with_the_range():
-    from ruledmesh.hybrid import hybrid_mesh
+    from ruledmesh.skew.hybrid import hybrid_mesh
 
     a, b = hyperboloid_lines()
     with pytest.raises(GeometryError, match="at least 1e-60 across"):
@@ -259,8 +259,8 @@ def test_notched_compound_coverage_is_warned(tmp_path, capsys):
 # ------------------------------------------------------------ scale and strict JSON
 @pytest.mark.parametrize("mesher", ["pq", "hybrid"])
 def test_meshes_are_the_same_at_every_scale(mesher):
-    from ruledmesh.hybrid import hybrid_mesh
     from ruledmesh.pq import pq_mesh
+    from ruledmesh.skew.hybrid import hybrid_mesh
 
     fn = pq_mesh if mesher == "pq" else hybrid_mesh
     a, b = hyperboloid_lines()

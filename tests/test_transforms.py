@@ -3,9 +3,7 @@ circularity and is refused for non-circular meshes; the reference follows."""
 
 from __future__ import annotations
 
-import importlib.util
-import pathlib
-
+import _catalogue_checks as chk  # a helper module of tests/ (see conftest.py)
 import numpy as np
 import pytest
 from hypothesis import given, settings
@@ -17,11 +15,6 @@ from ruledmesh.analysis.faces import face_normals
 from ruledmesh.design import build_design, parse_design
 from ruledmesh.errors import DesignError, GeometryError, ParameterError
 from ruledmesh.registry import Built
-
-_spec = importlib.util.spec_from_file_location(
-    "_catalogue_checks", pathlib.Path(__file__).with_name("_catalogue_checks.py"))
-chk = importlib.util.module_from_spec(_spec)
-_spec.loader.exec_module(chk)
 
 FAST = settings(max_examples=25, deadline=None)
 

@@ -2,10 +2,9 @@
 
 from __future__ import annotations
 
-import importlib.util
 import math
-from pathlib import Path
 
+import export_meshes as E  # a helper module of tests/ (see conftest.py)
 import numpy as np
 import pytest
 from hypothesis import given, settings
@@ -23,17 +22,6 @@ from ruledmesh.triangulate import (
     triangle_angles,
     triangulate,
 )
-
-
-def _helpers():
-    spec = importlib.util.spec_from_file_location(
-        "export_meshes", Path(__file__).with_name("export_meshes.py"))
-    mod = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(mod)
-    return mod
-
-
-E = _helpers()
 
 
 def _tri_normals(vertices, triangles):

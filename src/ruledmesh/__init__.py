@@ -24,7 +24,7 @@ Mesh(vertices=..., faces=... [quad=..., ...], members=...)
 >>> ruledmesh.analyze(mesh)["planarity"]["max"] < 1e-12
 True
 
-The maths modules (:mod:`ruledmesh.pq`, :mod:`ruledmesh.hybrid`,
+The maths modules (:mod:`ruledmesh.pq`, :mod:`ruledmesh.skew`,
 :mod:`ruledmesh.analysis` ...) are imported when first used.
 """
 
@@ -54,7 +54,7 @@ from .tolerances import Tolerances
 # name -> module that defines it; imported on first access (PEP 562).
 _LAZY = {
     "pq_mesh": "ruledmesh.pq",
-    "hybrid_mesh": "ruledmesh.hybrid",
+    "hybrid_mesh": "ruledmesh.skew.hybrid",
     "planarity": "ruledmesh.analysis.faces",
 }
 

@@ -15,12 +15,8 @@ import stat
 __all__ = ["MAX_CSV_BYTES", "MAX_DESIGN_BYTES", "MAX_MESH_BYTES", "FileRefused",
            "not_a_regular_file", "read_capped"]
 
-# A design file is a page of TOML; the largest bundled one is 4 kB.
-MAX_DESIGN_BYTES = 16 * 2**20
-# 100,000 generators (rulings.MAX_GENERATORS) of six full-precision numbers are ~13 MB.
-MAX_CSV_BYTES = 64 * 2**20
-# A mesh of a few million faces; its reader needs several times this in memory.
-MAX_MESH_BYTES = 1 * 2**30
+# The size caps are work limits: they live with the others in ruledmesh.budget.
+from .budget import MAX_CSV_BYTES, MAX_DESIGN_BYTES, MAX_MESH_BYTES
 
 _KINDS = ((stat.S_ISDIR, "a folder"), (stat.S_ISCHR, "a character device"),
           (stat.S_ISBLK, "a block device"), (stat.S_ISFIFO, "a named pipe"),

@@ -8,11 +8,18 @@ measured (peak resident memory with ``resource.getrusage`` over builds of a few
 million points on the development machine); they cover the mesh, its analysis
 against the smooth surface and an export.  One limit, :data:`MAX_BUILD_BYTES`,
 applies to them all, and the refusal says how much the build would need.
+
+The other limits on work and memory live here too: the largest count a single
+field may ask for, the most generators, the largest input files read.  (The
+request limits of the two servers, ``ruledmesh.web`` and ``ruledmesh.hops``,
+stay with the servers: they bound a protocol, not a build.)
 """
 
 from __future__ import annotations
 
-__all__ = ["HYBRID_BYTES_PER_NODE", "MAX_BUILD_BYTES", "PQ_BYTES_PER_GRID_POINT",
+__all__ = ["HYBRID_BYTES_PER_NODE", "MAX_BUILD_BYTES", "MAX_COUNT", "MAX_CSV_BYTES",
+           "MAX_DESIGN_BYTES", "MAX_DIVISIONS", "MAX_GENERATORS", "MAX_GRID_NODES",
+           "MAX_GRID_POINTS", "MAX_MESH_BYTES", "MAX_SURFACE_FACES", "PQ_BYTES_PER_GRID_POINT",
            "check_budget", "gib"]
 
 # Peak memory a build may need; refused above it.
@@ -21,6 +28,34 @@ MAX_BUILD_BYTES = 8 * 2**30
 PQ_BYTES_PER_GRID_POINT = 1024
 # Hybrid and compound meshers, per grid node: ~320 measured.
 HYBRID_BYTES_PER_NODE = 384
+
+# Grid points (generators x rows) of the §4.3 mesher above which a build is
+# refused up front, with the memory it would need, instead of running out of
+# memory half-way.
+MAX_GRID_POINTS = MAX_BUILD_BYTES // PQ_BYTES_PER_GRID_POINT
+# Grid nodes of the hybrid mesher refused up front, for the same reason.
+MAX_GRID_NODES = MAX_BUILD_BYTES // HYBRID_BYTES_PER_NODE
+
+# Most generators a design may ask for: at ~1 KiB per generator and row,
+# 10^5 generators at the default 20 rows already need ~2 GiB, a million ~20 GiB.
+# Refusing up front beats an out-of-memory kill halfway through.
+MAX_GENERATORS = 100_000
+# Largest count one field may ask for (rows, u, v, the compound's divisions):
+# the budget above refuses large products; this keeps a single typo (1e9 rows)
+# from reaching the arithmetic at all.
+MAX_COUNT = 100_000
+# Divisions of a generator in the hybrid mesher: its rows are cheap (one node per
+# generator and division), so a finer bound than MAX_COUNT would refuse real work.
+MAX_DIVISIONS = 1_000_000
+# Faces (u x v) of a smooth analytic surface sampled for §2 constructions.
+MAX_SURFACE_FACES = 4_000_000
+
+# A design file is a page of TOML; the largest bundled one is 4 kB.
+MAX_DESIGN_BYTES = 16 * 2**20
+# MAX_GENERATORS generators of six full-precision numbers are ~13 MB.
+MAX_CSV_BYTES = 64 * 2**20
+# A mesh of a few million faces; its reader needs several times this in memory.
+MAX_MESH_BYTES = 1 * 2**30
 
 
 def gib(n_bytes: float) -> str:

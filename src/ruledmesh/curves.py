@@ -50,7 +50,7 @@ from ._validation import (
     describe,
 )
 from .errors import GeometryError, ParameterError
-from .tolerances import DEFAULT, Tolerances
+from .tolerances import CONVERGED, DEFAULT, PARAMETER_SLACK, ROOT_RTOL, ROOT_XTOL, ROUNDING, TINY, ULPS, Tolerances
 
 __all__ = [
     "CubicHermite",
@@ -61,6 +61,7 @@ __all__ = [
     "BSpline",
     "Helix",
     "CurveType",
+    "LevelSet",
 ]
 
 # Gauss-Legendre nodes per arc-length piece; with pieces no longer than half a
@@ -70,7 +71,7 @@ _NEWTON_ITERATIONS = 60
 # Arc-length pieces per B-spline knot span (each with _GL_NODES speed samples).
 _LENGTH_PIECES_PER_SPAN = 8
 # A Newton step this small (in u) ends the iteration.
-_NEWTON_FINAL_STEP = 1e-15
+_NEWTON_FINAL_STEP = ULPS
 
 
 # --------------------------------------------------------------------------
@@ -113,7 +114,7 @@ def _params(u: Any, name: str = "u") -> np.ndarray:
 def _unit_params(u: Any, name: str = "u") -> np.ndarray:
     """Parameters that must lie in [0, 1] (rounding slack allowed, then clipped)."""
     arr = _params(u, name)
-    if arr.size and (arr.min() < -1e-12 or arr.max() > 1.0 + 1e-12):
+    if arr.size and (arr.min() < -ROUNDING or arr.max() > 1.0 + ROUNDING):
         raise ParameterError(
             f"expected values in [0, 1], got values in [{arr.min():g}, {arr.max():g}]", name)
     return np.clip(arr, 0.0, 1.0)
@@ -240,7 +241,7 @@ class LevelSet:
         a, b = grid[:-1], grid[1:]
         # one-sided derivatives just inside each interval, so kinks at nodes
         # never fake a critical point inside an interval
-        delta = 1e-9 * (b - a)
+        delta = PARAMETER_SLACK * (b - a)
         dl, dr = dg(a + delta), dg(b - delta)
         def slope(x):
             return float(dg(np.float64(x)))
@@ -254,7 +255,7 @@ class LevelSet:
             # Evaluated one by one, a derivative at rounding level (a curve
             # lying almost in a level plane) may lose its sign change: no root.
             if slope(lo) * slope(hi) < 0:
-                crit.append(brentq(slope, lo, hi, xtol=1e-16, rtol=8.9e-16))
+                crit.append(brentq(slope, lo, hi, xtol=ROOT_XTOL, rtol=ROOT_RTOL))
         self.g, self.dg = g, dg
         self.tol = float(tol)
         self.nodes = np.unique(np.concatenate([grid, crit]))
@@ -293,7 +294,7 @@ class LevelSet:
                     new = x - fx / d
                 bad = ~np.isfinite(new) | (new <= np.minimum(a, b)) | (new >= np.maximum(a, b))
                 new = np.where(bad, 0.5 * (a + b), new)
-                done = (fx == 0) | (np.abs(new - x) <= 4e-16 * np.maximum(np.abs(x), 1e-300))
+                done = (fx == 0) | (np.abs(new - x) <= CONVERGED * np.maximum(np.abs(x), TINY))
                 x = np.where(live & ~done, new, x)
                 live = live & ~done
                 if not np.any(live):
@@ -322,7 +323,7 @@ class LevelSet:
         keep = [0]
         for j in range(1, len(cand)):
             i = keep[-1]
-            same = cand[j] - cand[i] <= 1e-15 or (
+            same = cand[j] - cand[i] <= ULPS or (
                 err[i] <= self.tol and err[j] <= self.tol and mids[j - 1] <= self.tol)
             if same:
                 if err[j] < err[i]:
@@ -498,6 +499,83 @@ class Curve:
         count = check_int(count, "count", lo=2)
         return self._eval(np.linspace(0.0, 1.0, count))
 
+    # --- kernels: for callers that already hold float64 parameter arrays -----
+    # The checked methods above validate their input; these skip the checks
+    # (the generators evaluate curves inside Newton and root-finding loops, where
+    # a non-finite iterate must give NaN, not an error) and compute the same values.
+    def point_at(self, u: np.ndarray) -> np.ndarray:
+        """Points ``c(u)`` at float64 parameters, unchecked: what :meth:`evaluate` computes.
+
+        Parameters
+        ----------
+        u : (...) float64
+
+        Returns
+        -------
+        points : (..., 3) float64
+        """
+        return self._eval(u)
+
+    def tangent_at(self, u: np.ndarray) -> np.ndarray:
+        """First derivatives ``c'(u)`` at float64 parameters, unchecked.
+
+        Parameters
+        ----------
+        u : (...) float64
+
+        Returns
+        -------
+        vectors : (..., 3) float64
+            At a kink the derivative of the piece after it.
+        """
+        return self._deriv(u, 1)
+
+    def speed_at(self, u: np.ndarray) -> np.ndarray:
+        """Speeds ``|c'(u)|`` (arc length per unit of ``u``) at float64 parameters: (...) float64."""
+        return self._speed(u)
+
+    def param_at_fraction(self, f: np.ndarray) -> np.ndarray:
+        """Parameters at arc-length fractions ``f`` of the whole length, clipped to [0, 1].
+
+        Parameters
+        ----------
+        f : (...) float64
+            Fractions of :meth:`length`; outside [0, 1] they clip to the ends.
+
+        Returns
+        -------
+        u : (...) float64 in [0, 1]
+        """
+        return self._param_at_length(f * self.length())
+
+    @property
+    def size(self) -> float:
+        """Characteristic size (diagonal of a sampled bounding box) that relative tolerances scale by."""
+        return self._size
+
+    def breaks(self) -> np.ndarray:
+        """Parameters of the kinks and smooth-piece ends, 0 and 1 included: (k,) float64 sorted."""
+        return self._breaks()
+
+    def level_grid(self) -> np.ndarray:
+        """Parameters between which a plane's height function has at most one critical point: (k,) float64."""
+        return self._level_grid()
+
+    def height_function(self, unit_normal: np.ndarray, tol: Tolerances = DEFAULT) -> LevelSet:
+        """The height ``u -> unit_normal . c(u)`` cut into monotone pieces, for plane intersections.
+
+        Parameters
+        ----------
+        unit_normal : (3,) float64, unit length
+        tol : Tolerances
+            ``tol.degenerate`` times :attr:`size` is the absolute tolerance of touches.
+
+        Returns
+        -------
+        LevelSet
+        """
+        return self._plane_level(unit_normal, tol)
+
     @cached_property
     def _size(self) -> float:
         """Characteristic size (diagonal of a sampled bounding box) for tolerances."""
@@ -562,7 +640,7 @@ class Curve:
         speed, length = values @ fit.T, values @ integ
         # Drop the trailing coefficients that are below rounding on every piece: smooth
         # pieces need far fewer than the nodes, and each one costs a Clenshaw step.
-        keep = np.abs(length).max(axis=0) > 1e-15 * max(float(np.abs(length).max()), 1e-300)
+        keep = np.abs(length).max(axis=0) > ULPS * max(float(np.abs(length).max()), TINY)
         n = max(int(np.flatnonzero(keep)[-1]) + 1 if keep.any() else 1, 2)
         return pieces, cum, speed[:, :max(n - 1, 1)], length[:, :n]
 
@@ -622,7 +700,7 @@ class Curve:
                                   + (t * t - t) * t * m1)
         good = np.isfinite(guess) & (guess >= lo) & (guess <= hi) & (v0 > 0) & (v1 > 0)
         u = np.where(good, guess, u)
-        scale = max(total, 1e-300)
+        scale = max(total, TINY)
         todo = np.arange(flat.size)
         for _ in range(_NEWTON_ITERATIONS):
             uu, kk = u[todo], k[todo]
@@ -634,7 +712,7 @@ class Curve:
                 new = uu - f / _clenshaw(speed_c[kk], xi)
             bad = ~np.isfinite(new) | (new < lo[todo]) | (new > hi[todo])
             new = np.where(bad, 0.5 * (lo[todo] + hi[todo]), new)
-            exact = np.abs(f) <= 4e-16 * scale
+            exact = np.abs(f) <= CONVERGED * scale
             u[todo] = np.where(exact, uu, new)
             done = exact | (np.abs(new - uu) <= _NEWTON_FINAL_STEP)
             todo = todo[~done]
@@ -656,7 +734,7 @@ class Curve:
         """
         arr = _params(s, "s")
         total = self.length()
-        slack = 1e-12 * max(total, 1.0)
+        slack = ROUNDING * max(total, 1.0)
         if arr.size and (arr.min() < -slack or arr.max() > total + slack):
             raise ParameterError(
                 f"expected lengths in [0, {total:g}], got values in [{arr.min():g}, {arr.max():g}]",
@@ -779,7 +857,7 @@ def _plane_text(n: np.ndarray, offset: float) -> str:
 def _check_distinct(points: np.ndarray, name: str) -> None:
     seg = np.linalg.norm(np.diff(points, axis=0), axis=1)
     size = float(np.linalg.norm(points.max(axis=0) - points.min(axis=0)))
-    bad = np.nonzero(seg <= DEFAULT.degenerate * max(size, 1e-300))[0]
+    bad = np.nonzero(seg <= DEFAULT.degenerate * max(size, TINY))[0]
     if len(bad):
         i = int(bad[0])
         raise ParameterError(f"points {i} and {i + 1} coincide; consecutive points must differ",
@@ -809,7 +887,7 @@ class Line(Curve):
     def __post_init__(self) -> None:
         p0 = check_vector(self.p0, "p0")
         p1 = check_vector(self.p1, "p1")
-        if np.linalg.norm(p1 - p0) <= DEFAULT.degenerate * max(np.abs(p0).max(), np.abs(p1).max(), 1e-300):
+        if np.linalg.norm(p1 - p0) <= DEFAULT.degenerate * max(np.abs(p0).max(), np.abs(p1).max(), TINY):
             raise ParameterError("p0 and p1 coincide; a line needs two distinct points", "p1")
         object.__setattr__(self, "p0", _frozen(p0))
         object.__setattr__(self, "p1", _frozen(p1))
@@ -1068,7 +1146,7 @@ class BSpline(Curve):
         # A repeated point gives a piece of zero length (degree 1) or zero speed
         # at an end (higher degrees): arc length and tangents divide by zero.
         _check_distinct(cp, "control_points")
-        if np.ptp(cp, axis=0).max() <= DEFAULT.degenerate * max(float(np.abs(cp).max()), 1e-300):
+        if np.ptp(cp, axis=0).max() <= DEFAULT.degenerate * max(float(np.abs(cp).max()), TINY):
             # a point, not a curve: arc length and tangents would divide by zero
             raise ParameterError("all control points coincide; a curve needs two distinct points",
                                  "control_points")

@@ -18,6 +18,8 @@ from __future__ import annotations
 
 import numpy as np
 
+from .tolerances import ROUNDING, TINY
+
 __all__ = ["hop", "landing_maps", "crossing_maps", "coplanarity", "apply_map"]
 
 
@@ -26,7 +28,7 @@ def _dot(x: np.ndarray, y: np.ndarray) -> np.ndarray:
 
 
 def hop(points: np.ndarray, a1: np.ndarray, d1: np.ndarray, a2: np.ndarray, d2: np.ndarray,
-        tol: float = 1e-12) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        tol: float = ROUNDING) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """The line through each point that meets two lines: where it meets them.
 
     Parameters
@@ -67,8 +69,8 @@ def hop(points: np.ndarray, a1: np.ndarray, d1: np.ndarray, a2: np.ndarray, d2: 
     nd2 = _dot(n, d2)
     scale_n = np.linalg.norm(d1, axis=-1) * np.linalg.norm(a1 - points, axis=-1)
     nn = np.linalg.norm(n, axis=-1)
-    ok_plane = nn > tol * np.maximum(scale_n, 1e-300)
-    ok_land = np.abs(nd2) > tol * np.maximum(nn * np.linalg.norm(d2, axis=-1), 1e-300)
+    ok_plane = nn > tol * np.maximum(scale_n, TINY)
+    ok_land = np.abs(nd2) > tol * np.maximum(nn * np.linalg.norm(d2, axis=-1), TINY)
     ok = ok_plane & ok_land
     t2 = np.where(ok, _dot(n, a1 - a2) / np.where(ok, nd2, 1.0), 0.0)
     q = a2 + t2[..., None] * d2
@@ -153,7 +155,7 @@ def coplanarity(a: np.ndarray, d: np.ndarray, scale: float) -> np.ndarray:
     """
     vol = _dot(np.cross(d[:-1], d[1:]), a[1:] - a[:-1])
     norms = np.linalg.norm(d, axis=1)
-    return vol / np.maximum(norms[:-1] * norms[1:] * scale, 1e-300)
+    return vol / np.maximum(norms[:-1] * norms[1:] * scale, TINY)
 
 
 def apply_map(M: np.ndarray, tau: np.ndarray) -> tuple[np.ndarray, np.ndarray]:

@@ -20,6 +20,7 @@ import numpy as np
 
 from ._validation import check_points
 from .errors import ParameterError
+from .tolerances import ROUNDING, TINY
 
 __all__ = ["FaceKind", "Mesh"]
 
@@ -356,7 +357,7 @@ class Mesh:
         return replace(self, vertices=self.vertices[used], face_indices=new[self.face_indices],
                        members=new[self.members], vertex_data=vdata)
 
-    def merge_vertices(self, tol: float = 1e-12) -> Mesh:
+    def merge_vertices(self, tol: float = ROUNDING) -> Mesh:
         """Merge vertices closer than ``tol`` times the diagonal (exact grid snap).
 
         Vertices are snapped to a grid of spacing ``tol * diagonal`` and merged
@@ -366,7 +367,7 @@ class Mesh:
         """
         if self.n_vertices == 0:
             return self
-        scale = max(self.diagonal(), 1e-300) * tol
+        scale = max(self.diagonal(), TINY) * tol
         key = np.round((self.vertices - self.vertices.min(axis=0)) / scale).astype(np.int64)
         _, first, inverse = np.unique(key, axis=0, return_index=True, return_inverse=True)
         inverse = inverse.reshape(-1)

@@ -6,7 +6,7 @@ make most of them independent of the scale, but products of lengths (areas,
 determinants, squared norms) overflow above about 1e77 and underflow below
 1e-77, and absolute floors such as ``1e-300`` decide differently at different
 scales.  So the entry points (:func:`ruledmesh.pq.pq_mesh`,
-:func:`ruledmesh.hybrid.hybrid_mesh`, :func:`ruledmesh.compound.compound_mesh`)
+:func:`ruledmesh.skew.hybrid_mesh`, :func:`ruledmesh.skew.compound_mesh`)
 mesh a copy of their input moved to the origin and scaled by a **power of two**
 to a box whose longest side is in [1, 2), then map the vertices back.  Scaling by a power of two
 is exact in binary floating point, so a design scaled by ``2**k`` gives the same
@@ -27,6 +27,7 @@ from typing import Any, TypeVar
 import numpy as np
 
 from .errors import GeometryError
+from .tolerances import MIN_EXTENT, MIN_RELATIVE_EXTENT
 
 __all__ = ["MAX_COORDINATE", "MIN_EXTENT", "check_range", "normalised", "unit_frame"]
 
@@ -35,10 +36,7 @@ __all__ = ["MAX_COORDINATE", "MIN_EXTENT", "check_range", "normalised", "unit_fr
 # design's own scale, with products of four lengths (Gauss-Newton determinants),
 # measured exact to 1e+-70; 1e+-60 leaves a margin.
 MAX_COORDINATE = 1e60
-# Extent (bounding-box diagonal) of the input below which it is refused.
-MIN_EXTENT = 1e-60
-# Extent relative to the largest coordinate below which float64 cannot hold the shape.
-MIN_RELATIVE_EXTENT = 1e-12
+# MIN_EXTENT and MIN_RELATIVE_EXTENT (the smallest extents accepted) live in tolerances.
 
 F = TypeVar("F", bound=Callable[..., Any])
 

@@ -22,7 +22,7 @@ from ._validation import check_choice, check_float, check_int
 from .analysis import faces as F
 from .errors import ExportError, ParameterError
 from .mesh import FaceKind, Mesh
-from .tolerances import DEFAULT
+from .tolerances import COLLINEAR, DEFAULT, DEPTH_BIAS, PLANARITY_FLOOR, TINY
 
 __all__ = ["FORMATS", "MAX_LABELS", "MIN_FACE_PIXELS", "MIN_GENERATOR_SPACING", "MIN_LABEL_PIXELS",
            "ColorBy", "Switch", "face_values", "render", "save_render", "visible_faces"]
@@ -30,8 +30,7 @@ __all__ = ["FORMATS", "MAX_LABELS", "MIN_FACE_PIXELS", "MIN_GENERATOR_SPACING", 
 # File types the Agg-based figure can write, by extension.
 FORMATS = {".png": "png", ".svg": "svg", ".pdf": "pdf"}
 
-# Planarity below this is rounding noise in float64; clamping keeps the log scale finite.
-_PLANARITY_FLOOR = 1e-17
+_PLANARITY_FLOOR = PLANARITY_FLOOR
 
 # One fixed colour per FaceKind so figures agree with each other.
 _KIND_COLORS = {
@@ -204,7 +203,7 @@ def visible_faces(ax, mesh: Mesh, faces: np.ndarray) -> np.ndarray:
     tri = tri.reshape(-1, 3, 3)
     e1, e2 = tri[:, 1, :2] - tri[:, 0, :2], tri[:, 2, :2] - tri[:, 0, :2]
     det = e1[:, 0] * e2[:, 1] - e1[:, 1] * e2[:, 0]
-    keep = np.abs(det) > 1e-14 * (np.abs(e1).sum(axis=1) * np.abs(e2).sum(axis=1) + 1e-300)
+    keep = np.abs(det) > COLLINEAR * (np.abs(e1).sum(axis=1) * np.abs(e2).sum(axis=1) + TINY)
     tri, e1, e2, det, owner = tri[keep], e1[keep], e2[keep], det[keep], owner[keep]
     depth = float(np.ptp(poly[..., 2])) or 1.0
     seen = np.ones(len(faces), dtype=bool)
@@ -216,7 +215,7 @@ def visible_faces(ax, mesh: Mesh, faces: np.ndarray) -> np.ndarray:
         v = (e1[:, 0] * d[..., 1] - e1[:, 1] * d[..., 0]) / det
         inside = (u >= 0) & (v >= 0) & (u + v <= 1)
         z = tri[:, 0, 2] + u * (tri[:, 1, 2] - tri[:, 0, 2]) + v * (tri[:, 2, 2] - tri[:, 0, 2])
-        nearer = z < c[s:s + block, None, 2] - 1e-6 * depth
+        nearer = z < c[s:s + block, None, 2] - DEPTH_BIAS * depth
         other = owner[None, :] != faces[s:s + block, None]
         seen[s:s + block] = ~np.any(inside & nearer & other, axis=1)
     return seen
@@ -250,7 +249,7 @@ def _draw_labels(ax, mesh: Mesh, labels: bool | str, pixels: float) -> int:
 def _frame(ax, mesh: Mesh, elev: float, azim: float) -> None:
     """Axis limits around the mesh at equal scale, the camera, no axes drawn."""
     lo, hi = mesh.bounding_box()
-    span = np.maximum(hi - lo, 1e-9 * max(float(np.max(hi - lo)), 1.0))
+    span = np.maximum(hi - lo, DEFAULT.degenerate * max(float(np.max(hi - lo)), 1.0))
     ax.set_xlim(lo[0], lo[0] + span[0])
     ax.set_ylim(lo[1], lo[1] + span[1])
     ax.set_zlim(lo[2], lo[2] + span[2])

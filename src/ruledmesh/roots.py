@@ -11,16 +11,18 @@ compare the two.
 from __future__ import annotations
 
 import math
+import sys
 from collections.abc import Callable
 
 from .errors import GeometryError
+from .tolerances import BRENTQ_XTOL
 
 __all__ = ["brentq"]
 
-_EPS = 2.220446049250313e-16
+_EPS = sys.float_info.epsilon
 
 
-def brentq(f: Callable[[float], float], a: float, b: float, xtol: float = 2e-12,
+def brentq(f: Callable[[float], float], a: float, b: float, xtol: float = BRENTQ_XTOL,
            rtol: float = 4 * _EPS, maxiter: int = 100) -> float:
     """A root of ``f`` in ``[a, b]``, where ``f(a)`` and ``f(b)`` differ in sign.
 

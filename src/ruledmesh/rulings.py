@@ -52,9 +52,10 @@ from ._validation import (
 
 # scipy is imported where it is used (lines through points, PCHIP at tangencies, root
 # brackets), so building from director curves starts without it.
+from .budget import MAX_GENERATORS, PQ_BYTES_PER_GRID_POINT
 from .curves import BSpline, CubicHermite, Curve, LevelSet, perpendicular
 from .errors import GeometryError, ParameterError
-from .tolerances import DEFAULT, Tolerances
+from .tolerances import DEFAULT, PARAMETER_SLACK, ROOT_RTOL, ROOT_XTOL, ROUNDING, SAME_ROOT, TINY, ULPS, Tolerances
 
 __all__ = [
     "Distribution",
@@ -100,10 +101,10 @@ class _ArcLength:
     curve: Curve
 
     def value(self, u):
-        return self.curve._param_at_length(u * self.curve.length())
+        return self.curve.param_at_fraction(u)
 
     def deriv(self, u):
-        return self.curve.length() / self.curve._speed(self.value(u))
+        return self.curve.length() / self.curve.speed_at(self.value(u))
 
 
 def _arc_sigma(curve: Curve, count: int) -> Any:
@@ -119,8 +120,8 @@ def _arc_sigma(curve: Curve, count: int) -> Any:
         return exact
     grid, _ = dense_grid(count)
     values = exact.value(grid)
-    speed = curve._speed(values)
-    if np.all(speed > 1e-12 * curve.length()):
+    speed = curve.speed_at(values)
+    if np.all(speed > ROUNDING * curve.length()):
         return _Pchip.of(grid, values, curve.length() / speed)
     # A cusp (zero speed, e.g. a spline doubling back) has an infinite slope
     # there: use the monotone interpolant of the samples instead.
@@ -160,10 +161,10 @@ class _CurveTrack:
     sigma: Any
 
     def value(self, u):
-        return self.curve._eval(self.sigma.value(u))
+        return self.curve.point_at(self.sigma.value(u))
 
     def deriv(self, u):
-        return self.curve._deriv(self.sigma.value(u), 1) * self.sigma.deriv(u)[..., None]
+        return self.curve.tangent_at(self.sigma.value(u)) * self.sigma.deriv(u)[..., None]
 
 
 @dataclass(frozen=True, eq=False)
@@ -315,7 +316,7 @@ class Rulings:
 
 def _check_generators(a: np.ndarray, b: np.ndarray, what: str, tol: Tolerances) -> None:
     pts = np.concatenate([a, b])
-    size = max(float(np.linalg.norm(pts.max(axis=0) - pts.min(axis=0))), 1e-300)
+    size = max(float(np.linalg.norm(pts.max(axis=0) - pts.min(axis=0))), TINY)
     short = np.nonzero(np.linalg.norm(b - a, axis=1) <= tol.degenerate * size)[0]
     if len(short):
         i = int(short[0])
@@ -342,7 +343,7 @@ def _curve_rulings(c1: Curve, s1: Any, c2: Curve, s2: Any, count: int, info: dic
     u = np.linspace(0.0, 1.0, count)
     sig1 = s1.value(u) if sig1 is None else sig1
     sig2 = s2.value(u) if sig2 is None else sig2
-    a, b = c1._eval(sig1), c2._eval(sig2)
+    a, b = c1.point_at(sig1), c2.point_at(sig2)
     _check_generators(a, b, info["distribution"], tol)
     info = {**info, "c1_params": sig1, "c2_params": sig2}
     surface = RuledSurface(_CurveTrack(c1, s1), _CurveTrack(c2, s2), u)
@@ -422,7 +423,7 @@ def check_line(value: Any, name: str, err: type = ParameterError) -> np.ndarray:
     d = check_points(value, name, err=err)
     if len(d) != 2:
         raise err(f"expected 2 points of the line, got {len(d)}", name)
-    if np.linalg.norm(d[1] - d[0]) <= DEFAULT.degenerate * max(np.abs(d).max(), 1e-300):
+    if np.linalg.norm(d[1] - d[0]) <= DEFAULT.degenerate * max(np.abs(d).max(), TINY):
         raise err("the two points coincide; a line needs two distinct points", name)
     return d
 
@@ -440,7 +441,7 @@ def _ended(what: str, curve_name: str, end: tuple, k: int, count: int, extra: st
 def _director_plane(c1: Curve, c2: Curve, count: int, normal: np.ndarray, info: dict,
                     tol: Tolerances) -> Rulings:
     n = normal / np.linalg.norm(normal)
-    levels = [c._plane_level(n, tol) for c in (c1, c2)]
+    levels = [c.height_function(n, tol) for c in (c1, c2)]
     for name, lev in zip(("c1", "c2"), levels):
         lo, hi = lev.range
         if hi - lo <= lev.tol:
@@ -471,7 +472,7 @@ def _director_plane(c1: Curve, c2: Curve, count: int, normal: np.ndarray, info: 
         sig.append(u)
     ds = (s[-1] - s[0])
     with np.errstate(divide="ignore", invalid="ignore"):  # n . c' = 0 at a range end: PCHIP
-        slopes = [ds / (c._deriv(u, 1) @ n) for c, u in zip((c1, c2), sig)]
+        slopes = [ds / (c.tangent_at(u) @ n) for c, u in zip((c1, c2), sig)]
     s1, s2 = _Pchip.of(grid, sig[0], slopes[0]), _Pchip.of(grid, sig[1], slopes[1])
     info = {**info, "levels": s[::k].copy(), "director_plane": n}
     return _curve_rulings(c1, s1, c2, s2, count, info, tol, sig[0][::k].copy(), sig[1][::k].copy())
@@ -506,29 +507,29 @@ class _PencilAngle:
         return np.hypot(x, y)
 
     def level(self, curve: Curve, name: str, tol: Tolerances) -> LevelSet:
-        grid = np.unique(np.concatenate([curve._level_grid(), curve._breaks()]))
+        grid = np.unique(np.concatenate([curve.level_grid(), curve.breaks()]))
         # the closest approach to d, polished between the neighbours of the
         # nearest sample (there the pencil angle jumps by pi)
-        i = int(np.argmin(self.radius(curve._eval(grid))))
+        i = int(np.argmin(self.radius(curve.point_at(grid))))
         lo, hi = grid[max(i - 1, 0)], grid[min(i + 1, len(grid) - 1)]
         def approach(x):  # d/dx of radius^2 / 2: smooth, zero at the closest approach
             x = np.float64(x)
-            px, py = self.xy(curve._eval(x))
-            dx, dy = self.xy(curve._deriv(x, 1) + self.d0)
+            px, py = self.xy(curve.point_at(x))
+            dx, dy = self.xy(curve.tangent_at(x) + self.d0)
             return float(px * dx + py * dy)
 
         xm = grid[i]
         if approach(lo) < 0 < approach(hi):
             from .roots import brentq
 
-            xm = brentq(approach, lo, hi, xtol=1e-16, rtol=8.9e-16)
-        rmin = float(self.radius(curve._eval(np.asarray(xm, dtype=np.float64))))
-        if rmin <= tol.degenerate * curve._size:
+            xm = brentq(approach, lo, hi, xtol=ROOT_XTOL, rtol=ROOT_RTOL)
+        rmin = float(self.radius(curve.point_at(np.asarray(xm, dtype=np.float64))))
+        if rmin <= tol.degenerate * curve.size:
             raise GeometryError(
                 f"linear-directrix: {name} meets the directrix d at u = {xm:.6g}: "
                 "every plane through d contains that point")
         for _ in range(6):
-            pts = curve._eval(grid)
+            pts = curve.point_at(grid)
             ref = np.unwrap(self.raw(pts))
             if np.max(np.abs(np.diff(ref))) < 0.5:
                 break
@@ -540,12 +541,12 @@ class _PencilAngle:
         def g(u):
             u = np.asarray(u, dtype=np.float64)
             lin = np.interp(u, grid, ref)
-            return lin + (np.mod(self.raw(curve._eval(u)) - lin + np.pi, 2 * np.pi) - np.pi)
+            return lin + (np.mod(self.raw(curve.point_at(u)) - lin + np.pi, 2 * np.pi) - np.pi)
 
         def dg(u):
             u = np.asarray(u, dtype=np.float64)
-            x, y = self.xy(curve._eval(u))
-            dx, dy = self.xy(curve._deriv(u, 1) + self.d0)
+            x, y = self.xy(curve.point_at(u))
+            dx, dy = self.xy(curve.tangent_at(u) + self.d0)
             return (x * dy - y * dx) / (x * x + y * y)
 
         return LevelSet(g, dg, grid, tol.degenerate)
@@ -557,10 +558,10 @@ def _linear_directrix(c1: Curve, c2: Curve, count: int, d: np.ndarray, info: dic
     grid, k = dense_grid(count)
     arc1 = _arc_sigma(c1, count)
     sig1 = arc1.value(grid)
-    pts1 = c1._eval(sig1)
+    pts1 = c1.point_at(sig1)
     r1 = pencil.radius(pts1)
     near = int(np.argmin(r1))
-    if r1[near] <= tol.degenerate * c1._size:
+    if r1[near] <= tol.degenerate * c1.size:
         gen = near / k
         where = f"a_{int(gen)} (generator {int(gen)})" if gen == int(gen) else (
             f"c1 between generators {int(gen)} and {int(gen) + 1}")
@@ -579,8 +580,8 @@ def _linear_directrix(c1: Curve, c2: Curve, count: int, d: np.ndarray, info: dic
             "and the points of c1 meet it everywhere or nowhere")
     # the plane through d and a_0 has angle theta1[0] modulo pi
     starts = []
-    for j in range(math.ceil((lo - theta1[0]) / np.pi - 1e-12),
-                   math.floor((hi - theta1[0]) / np.pi + 1e-12) + 1):
+    for j in range(math.ceil((lo - theta1[0]) / np.pi - ROUNDING),
+                   math.floor((hi - theta1[0]) / np.pi + ROUNDING) + 1):
         for r in lev2.roots(float(theta1[0] + j * np.pi)):
             starts.append((float(r), j))
     if not starts:
@@ -595,7 +596,7 @@ def _linear_directrix(c1: Curve, c2: Curve, count: int, d: np.ndarray, info: dic
                      "branch; move d or shorten c1")
     # d sigma2 / du = theta1'(u) / g2'(sigma2), theta1' through the arc length of c1
     x1, y1 = pencil.xy(pts1)
-    dx1, dy1 = pencil.xy(c1._deriv(sig1, 1) * arc1.deriv(grid)[:, None] + pencil.d0)
+    dx1, dy1 = pencil.xy(c1.tangent_at(sig1) * arc1.deriv(grid)[:, None] + pencil.d0)
     with np.errstate(divide="ignore", invalid="ignore"):
         slope2 = (x1 * dy1 - y1 * dx1) / (x1 * x1 + y1 * y1) / lev2.dg(sig2)
     info = {**info, "directrix": d}
@@ -613,10 +614,10 @@ def _newton_3(c2: Curve, c3: Curve, p: np.ndarray, x: np.ndarray, size: float,
     x = x.copy()
     for _ in range(iterations):
         v, w, lam = x
-        q = c2._eval(np.array(v))
-        r = c3._eval(np.array(w))
+        q = c2.point_at(np.array(v))
+        r = c3.point_at(np.array(w))
         f = r - p - lam * (q - p)
-        jac = np.column_stack([-lam * c2._deriv(np.array(v), 1), c3._deriv(np.array(w), 1), p - q])
+        jac = np.column_stack([-lam * c2.tangent_at(np.array(v)), c3.tangent_at(np.array(w)), p - q])
         try:
             dx = np.linalg.solve(jac, -f)
         except np.linalg.LinAlgError:
@@ -626,11 +627,11 @@ def _newton_3(c2: Curve, c3: Curve, p: np.ndarray, x: np.ndarray, size: float,
         x = x + dx
         if abs(x[0] - 0.5) > 1.5 or abs(x[1] - 0.5) > 1.5:
             return x, False
-        if np.linalg.norm(dx[:2]) <= 1e-15 and np.linalg.norm(f) <= 1e-12 * size:
+        if np.linalg.norm(dx[:2]) <= ULPS and np.linalg.norm(f) <= ROUNDING * size:
             return x, True
     v, w, lam = x
-    f = c3._eval(np.array(w)) - p - lam * (c2._eval(np.array(v)) - p)
-    return x, bool(np.linalg.norm(f) <= 1e-12 * size)
+    f = c3.point_at(np.array(w)) - p - lam * (c2.point_at(np.array(v)) - p)
+    return x, bool(np.linalg.norm(f) <= ROUNDING * size)
 
 
 def _first_transversal(c2: Curve, c3: Curve, p: np.ndarray, size: float,
@@ -639,10 +640,10 @@ def _first_transversal(c2: Curve, c3: Curve, p: np.ndarray, size: float,
     from scipy.ndimage import minimum_filter
 
     v = np.linspace(0.0, 1.0, samples)
-    q = c2._eval(v) - p
-    r = c3._eval(v) - p
-    qn = q / np.maximum(np.linalg.norm(q, axis=1), 1e-300)[:, None]
-    rn = r / np.maximum(np.linalg.norm(r, axis=1), 1e-300)[:, None]
+    q = c2.point_at(v) - p
+    r = c3.point_at(v) - p
+    qn = q / np.maximum(np.linalg.norm(q, axis=1), TINY)[:, None]
+    rn = r / np.maximum(np.linalg.norm(r, axis=1), TINY)[:, None]
     sine = np.linalg.norm(np.cross(qn[:, None, :], rn[None, :, :]), axis=-1)
     minima = (sine == minimum_filter(sine, size=3, mode="nearest")) & (sine < 0.3)
     order = np.argsort(sine[minima])
@@ -650,11 +651,11 @@ def _first_transversal(c2: Curve, c3: Curve, p: np.ndarray, size: float,
     found: list[np.ndarray] = []
     for idx in order[:200]:
         i, j = iv[idx], iw[idx]
-        lam = float(r[j] @ q[i] / max(q[i] @ q[i], 1e-300))
+        lam = float(r[j] @ q[i] / max(q[i] @ q[i], TINY))
         x, ok = _newton_3(c2, c3, p, np.array([v[i], v[j], lam]), size)
-        if ok and -1e-12 <= x[0] <= 1 + 1e-12 and -1e-12 <= x[1] <= 1 + 1e-12:
+        if ok and -ROUNDING <= x[0] <= 1 + ROUNDING and -ROUNDING <= x[1] <= 1 + ROUNDING:
             x[:2] = np.clip(x[:2], 0.0, 1.0)
-            if not any(np.linalg.norm(x[:2] - y[:2]) < 1e-8 for y in found):
+            if not any(np.linalg.norm(x[:2] - y[:2]) < SAME_ROOT for y in found):
                 found.append(x)
     return sorted(found, key=lambda y: (y[0], y[1]))
 
@@ -690,11 +691,11 @@ def three_directrices(c1: Curve, c2: Curve, c3: Curve, count: int, *,
     c2 = _check_curve(c2, "c2")
     c3 = _check_curve(c3, "c3")
     count = check_int(count, "count", lo=2)
-    size = max(c1._size, c2._size, c3._size)
+    size = max(c1.size, c2.size, c3.size)
     grid, k = dense_grid(count)
     arc1 = _arc_sigma(c1, count)
     sig1 = arc1.value(grid)
-    pts1 = c1._eval(sig1)
+    pts1 = c1.point_at(sig1)
     candidates = _first_transversal(c2, c3, pts1[0], size)
     if not candidates:
         raise GeometryError("three directrices: no line through c1(0) meets both c2 and c3")
@@ -715,14 +716,15 @@ def three_directrices(c1: Curve, c2: Curve, c3: Curve, count: int, *,
         h = g1 - g0
         while g < g1:
             h = min(h, g1 - g)
-            gn = g1 if g + h >= g1 - 1e-15 else g + h
-            p = c1._eval(np.array(a_param(gn)))
+            gn = g1 if g + h >= g1 - ULPS else g + h
+            p = c1.point_at(np.array(a_param(gn)))
             pred = cur + prev_step * ((gn - g) / h_prev)
             x, ok = _newton_3(c2, c3, p, pred, size)
             jump = np.linalg.norm(x[:2] - cur[:2]) if ok else np.inf
             if ok and jump <= 0.05 + 4 * np.linalg.norm(prev_step[:2]) * (gn - g) / h_prev:
-                if not (-1e-9 <= x[0] <= 1 + 1e-9 and -1e-9 <= x[1] <= 1 + 1e-9):
-                    which = "c2" if not -1e-9 <= x[0] <= 1 + 1e-9 else "c3"
+                inside = (x[:2] >= -PARAMETER_SLACK) & (x[:2] <= 1 + PARAMETER_SLACK)
+                if not inside.all():
+                    which = "c2" if not inside[0] else "c3"
                     raise _family_end(f"the line runs off the end of {which}", gn, sig1, grid,
                                       k, count)
                 prev_step, h_prev = x - cur, gn - g
@@ -730,7 +732,7 @@ def three_directrices(c1: Curve, c2: Curve, c3: Curve, count: int, *,
                 h = 2 * h
             else:
                 h = h / 2
-                if h < 1e-9:
+                if h < DEFAULT.degenerate:
                     raise _family_end("the solution turns back (the line becomes tangent to "
                                       "the surface's director curves)", g, sig1, grid, k, count)
         cur[:2] = np.clip(cur[:2], 0.0, 1.0)
@@ -738,8 +740,8 @@ def three_directrices(c1: Curve, c2: Curve, c3: Curve, count: int, *,
     # implicit differentiation of c3(w) - p - lam (c2(v) - p) = 0 in p = c1(sigma1(u)):
     # J dx/du = (1 - lam) dp/du
     v, w, lam = sol.T
-    jac = np.stack([-lam[:, None] * c2._deriv(v, 1), c3._deriv(w, 1), pts1 - c2._eval(v)], axis=-1)
-    dp = c1._deriv(sig1, 1) * arc1.deriv(grid)[:, None]
+    jac = np.stack([-lam[:, None] * c2.tangent_at(v), c3.tangent_at(w), pts1 - c2.point_at(v)], axis=-1)
+    dp = c1.tangent_at(sig1) * arc1.deriv(grid)[:, None]
     try:
         dx = np.linalg.solve(jac, ((1 - lam)[:, None] * dp)[..., None])[..., 0]
     except np.linalg.LinAlgError:
@@ -801,7 +803,7 @@ def conoid(curve: Curve, directrix: Any, director_plane: Any, count: int, *,
     sig = arc.value(u)
     rail_a = _CurveTrack(curve, arc)
     rail_b = _ConoidTrack(rail_a, d[0], e, n)
-    a = curve._eval(sig)
+    a = curve.point_at(sig)
     b = rail_b.value(u)
     _check_generators(a, b, "conoid", tol)
     info = {"distribution": "conoid", "warnings": [], "c1_params": sig,
@@ -867,10 +869,5 @@ def from_lines(lines: Any, *, tol: Tolerances = DEFAULT) -> Rulings:
 # limits
 # --------------------------------------------------------------------------
 
-# Most generators a design may ask for.  Measured peak memory of ``ruledmesh
-# build`` (mesh, analysis against the smooth surface, export) is about 1 KiB per
-# grid point, i.e. per generator and row: 10^5 generators at the default 20 rows
-# already need ~2 GiB, a million ~20 GiB.  Refusing up front beats an
-# out-of-memory kill halfway through.
-MAX_GENERATORS = 100_000
-BUILD_BYTES_PER_GRID_POINT = 1024
+# The limit on generators and the measured memory per generator and row live in ruledmesh.budget.
+BUILD_BYTES_PER_GRID_POINT = PQ_BYTES_PER_GRID_POINT

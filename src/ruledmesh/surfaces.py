@@ -35,6 +35,7 @@ import numpy as np
 
 from .analysis.surface import RuledPatch, RuledReference
 from .errors import GeometryError
+from .tolerances import ROUNDING
 from .tolerances import TINY as _TINY
 
 __all__ = [
@@ -205,7 +206,7 @@ def revolution_of_polyline(meridian_rz: np.ndarray, origin: np.ndarray, axis: np
     nearer of the two end meridians.
     """
     y_dir = np.cross(axis, x_dir)
-    full = angle >= 2 * np.pi - 1e-12
+    full = angle >= 2 * np.pi - ROUNDING
 
     def local(p):
         rel = p - origin

@@ -11,22 +11,24 @@ modified copy of :data:`DEFAULT` to override it for one call::
     >>> loose = replace(DEFAULT, planarity=1e-9)
     >>> loose.planarity
     1e-09
+
+The module-level constants below are the fixed thresholds of the numerical
+kernels (root finders, degeneracy tests, rounding slack).  They are not meant
+to be changed per call; each says why it has its value.  A test
+(``tests/test_tolerances.py``) keeps float literals of this kind out of the
+other modules.
 """
 
 from __future__ import annotations
 
 from dataclasses import dataclass
 
-__all__ = [
-    "DEFAULT",
-    "FLIP_ACTIVE_DEG",
-    "FLIP_MAX_BEND_DEG",
-    "FLIP_MAX_SAG",
-    "FLIP_MIN_GAIN_DEG",
-    "RESTART_ANGLE_DEG",
-    "TINY",
-    "Tolerances",
-]
+__all__ = ["BRENTQ_XTOL", "COLLINEAR", "COLLINEAR_SQ", "CONGRUENCE_ANGLE_DEG", "CONVERGED",
+           "DEFAULT", "DEPTH_BIAS", "FLIP_ACTIVE_DEG", "FLIP_MAX_BEND_DEG", "FLIP_MAX_SAG",
+           "FLIP_MIN_GAIN_DEG", "FLOAT32_WARNING", "INTERIOR", "KKT_REGULARISATION",
+           "MIN_EXTENT", "MIN_HALF_ANGLE", "MIN_RELATIVE_EXTENT", "MITRE_FLOOR", "OCCT_FACE",
+           "ON_BORDER", "PARAMETER_SLACK", "PLANARITY_FLOOR", "RESTART_ANGLE_DEG", "ROOT_RTOL", "ROOT_XTOL",
+           "ROUNDING", "ROUNDING_SQ", "SAME_ROOT", "SNAP_GAP", "TINY", "ULPS", "Tolerances"]
 
 
 @dataclass(frozen=True)
@@ -65,19 +67,115 @@ class Tolerances:
     far: float = 1e3
 
 
+#: The tolerances every function uses unless given others (its ``tol`` argument).
 DEFAULT = Tolerances()
 
 #: The positive floor a division by a length, area or norm is guarded with (``x / max(n, TINY)``).
 #: Not a tolerance: far below any rounding level, it only keeps 0 / 0 out of the arrays.
 TINY = 1e-300
 
-# Edge flips of the triangles a PQ mesh keeps (ruledmesh.pq.flips): a flip must
-# raise the pair's smallest angle by this much (degrees), so rounds end; the two
-# triangles may bend against each other by at most this angle before and after
-# (a flip across a ridge would cut it off); and the new diagonal may lie at most
-# this share of the patch diagonal off the old pair (the mesh keeps to the surface).
+# --------------------------------------------------------------------------
+# Rounding slack: values equal in exact arithmetic, compared after float64 work
+# --------------------------------------------------------------------------
+
+#: Relative slack for a computed value compared with a bound it equals in exact
+#: arithmetic (a parameter at the end of [0, 1], a length against the width it
+#: must fit, a full turn of 2 pi).  About 4500 ulps of a unit-size double: above
+#: the rounding of the few dozen operations that produce such values, far below
+#: any length a design can mean.
+ROUNDING = 1e-12
+#: :data:`ROUNDING` squared, for tests on products of two squared lengths
+#: (``|u x w|**2 <= ROUNDING_SQ * |u|**2 |w|**2`` is ``sin(angle) <= ROUNDING``).
+ROUNDING_SQ = 1e-24
+#: A few ulps of a unit-size number: values that differ only in their last digits
+#: (a unit vector's component against 1, two sorted candidates, a Newton step).
+ULPS = 1e-15
+#: Relative distance or sine of an angle below which two directions are parallel
+#: or a point lies on an axis, where the inputs carry a few operations of rounding
+#: more than :data:`ULPS` allows (a profile point on the rotation axis, a sliver
+#: triangle seen edge-on).
+COLLINEAR = 1e-14
+#: :data:`COLLINEAR` squared, for tests on ``|u x w|**2`` against ``|u|**2 |w|**2``.
+COLLINEAR_SQ = 1e-28
+#: Looser slack for a parameter found by iteration (Newton, a root solve) that
+#: must lie in [0, 1]: the iteration stops at about 1e-12 relative, so a
+#: thousandfold margin keeps every true in-range solution in range.
+PARAMETER_SLACK = 1e-9
+#: Two roots of the same equation closer than this (in parameter space) are one root.
+SAME_ROOT = 1e-8
+
+# --------------------------------------------------------------------------
+# Root finding
+# --------------------------------------------------------------------------
+
+#: Absolute parameter tolerance handed to brentq where the root should be found to
+#: full precision (the parameters live in [0, 1], so this is below one ulp there).
+ROOT_XTOL = 1e-16
+#: Relative tolerance for those roots: scipy's brentq refuses anything below
+#: ``4 * eps`` = 8.88e-16, and this is the smallest round number above it.
+ROOT_RTOL = 8.9e-16
+#: A Newton update smaller than this relative to the iterate (about two ulps)
+#: changes only the last bits: the iteration has converged.
+CONVERGED = 4e-16
+#: Default absolute tolerance of :func:`ruledmesh.roots.brentq`, scipy's own default.
+BRENTQ_XTOL = 2e-12
+
+# --------------------------------------------------------------------------
+# Sizes and clearances
+# --------------------------------------------------------------------------
+
+#: Extent (bounding-box diagonal) of the input below which it is refused: products
+#: of four lengths must stay normal doubles (see :mod:`ruledmesh.normalise`).
+MIN_EXTENT = 1e-60
+#: Extent relative to the largest coordinate below which float64 cannot hold the
+#: shape: it is :data:`ROUNDING`, the relative precision the constructions need.
+MIN_RELATIVE_EXTENT = 1e-12
+#: Relative clearance kept between a point chosen inside an interval and the
+#: interval's ends (a kink split, the first step of a distribution): far above
+#: rounding, so the point is really interior, and far below any spacing a user sees.
+INTERIOR = 1e-6
+#: Parameters this close to 0 or 1 are on the patch border (rounding of t).
+ON_BORDER = 1e-12
+#: A border made by snapping stays this close (share of the diagonal) to the director curve.
+SNAP_GAP = 1e-3
+#: Regularisation of the KKT matrix of the parallel-offset fit, relative to its
+#: unit-size rows: small enough that refinement converges in a few steps, large
+#: enough for a stable sparse LU.
+KKT_REGULARISATION = 1e-10
+#: Floor of ``1 + cos(turn)`` at a mitred corner of a hot-wire path: a turn
+#: sharper than about 177 degrees is mitred as if it were this one, so the
+#: offset corner stays at a finite distance.
+MITRE_FLOOR = 1e-3
+#: Smallest half angle (radians) between two panels at a beam node; below it the
+#: panels are treated as folded flat and the set-back stays finite.
+MIN_HALF_ANGLE = 1e-6
+
+# --------------------------------------------------------------------------
+# Fabrication, export and figures
+# --------------------------------------------------------------------------
+
+#: Default angle tolerance (degrees) under which two panels are congruent: well
+#: below any cutting precision, well above the rounding of corner angles.
+CONGRUENCE_ANGLE_DEG = 1e-4
+#: Warn when float32 rounding (STL) moves corners by more than this fraction of the mesh size.
+FLOAT32_WARNING = 1e-5
+#: Planarity below this is rounding noise in float64; clamping keeps a log colour scale finite.
+PLANARITY_FLOOR = 1e-17
+#: Depth bias of the visibility test in figures, relative to the depth of the
+#: scene: a face does not hide itself or its neighbours along a shared edge.
+DEPTH_BIAS = 1e-6
+#: Tolerance handed to Open CASCADE's face builder for the reference surface
+#: (the figures are compared at the unit scale, where this is below any deflection asked for).
+OCCT_FACE = 1e-9
+
+# Edge flips of the triangles a PQ mesh keeps (ruledmesh.pq.flips).
+#: A flip must raise the pair's smallest angle by this much (degrees), so the rounds end.
 FLIP_MIN_GAIN_DEG = 1e-3
+#: The two triangles may bend against each other by at most this angle (degrees), before
+#: and after: a flip across a ridge would cut it off.
 FLIP_MAX_BEND_DEG = 20.0
+#: The new diagonal may lie at most this share of the patch diagonal off the old pair, so
+#: the mesh keeps to the surface (the gap goal is 2e-3).
 FLIP_MAX_SAG = 2.5e-4
 # Only triangles with an angle below this (and their neighbours) are worth flipping.
 FLIP_ACTIVE_DEG = 20.0

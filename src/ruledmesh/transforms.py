@@ -38,7 +38,7 @@ from .errors import GeometryError, ParameterError
 from .mesh import Mesh
 from .registry import Built
 from .surfaces import ImplicitSurface
-from .tolerances import DEFAULT, Tolerances
+from .tolerances import DEFAULT, ROUNDING, ULPS, Tolerances
 
 __all__ = [
     "affine",
@@ -94,7 +94,7 @@ def affine_matrix(matrix, offset=None, *, name: str = "matrix") -> tuple[np.ndar
     if m is None or m.shape not in ((3, 3), (3, 4), (4, 4)) or not np.all(np.isfinite(m)):
         raise ParameterError(f"expected a 3x3, 3x4 or 4x4 matrix of finite numbers, got "
                              f"{describe(matrix)}", name)
-    if m.shape == (4, 4) and not np.allclose(m[3], [0, 0, 0, 1], rtol=0, atol=1e-15):
+    if m.shape == (4, 4) and not np.allclose(m[3], [0, 0, 0, 1], rtol=0, atol=ULPS):
         raise ParameterError("expected last row 0 0 0 1 for an affine map (use a projective "
                              "map for anything else)", name)
     A = m[:3, :3].copy()
@@ -108,7 +108,7 @@ def _similarity_scale(A: np.ndarray) -> float | None:
     """``s`` if ``A`` is ``s`` times an orthogonal matrix, else ``None``."""
     g = A.T @ A
     s2 = np.trace(g) / 3.0
-    if s2 > 0 and np.abs(g - s2 * np.eye(3)).max() <= 1e-12 * s2:
+    if s2 > 0 and np.abs(g - s2 * np.eye(3)).max() <= ROUNDING * s2:
         return float(np.sqrt(s2))
     return None
 
@@ -198,7 +198,7 @@ def affine(mesh: Mesh, matrix, offset=None) -> Mesh:
 def _check_regular(A: np.ndarray, name: str) -> None:
     n = A.shape[0]
     det = np.linalg.det(A)
-    if not abs(det) > 1e-12 * np.linalg.norm(A) ** n:
+    if not abs(det) > ROUNDING * np.linalg.norm(A) ** n:
         raise ParameterError(f"expected an invertible matrix, got determinant {det:.3g}", name)
 
 

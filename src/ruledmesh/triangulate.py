@@ -36,6 +36,7 @@ import numpy as np
 
 from ._validation import check_choice
 from .mesh import Mesh
+from .tolerances import ROUNDING
 from .tolerances import TINY as _TINY
 
 __all__ = [
@@ -197,7 +198,7 @@ def _best_template(points: np.ndarray, templates: np.ndarray) -> np.ndarray:
     turn = np.einsum("fctj,fj->fct", cross, normal)
     # Relative threshold: a triangle with area below ~1e-12 of the face's
     # is as good as reversed (it would be a zero-area sliver).
-    positive = turn > 1e-12 * np.maximum(scale, _TINY)[:, None, None]
+    positive = turn > ROUNDING * np.maximum(scale, _TINY)[:, None, None]
     valid = positive.all(axis=2)
     min_angle = triangle_angles(tri).min(axis=(2, 3))
     score = np.where(valid, min_angle, -1.0 - (~positive).sum(axis=2))
@@ -216,7 +217,7 @@ def _quads_shorter(points: np.ndarray) -> np.ndarray:
     cross = np.cross(tri[..., 1, :] - tri[..., 0, :], tri[..., 2, :] - tri[..., 0, :])
     turn = np.einsum("fctj,fj->fct", cross, normal)
     scale = np.einsum("fi,fi->f", normal, normal)
-    valid = (turn > 1e-12 * np.maximum(scale, _TINY)[:, None, None]).all(axis=2)
+    valid = (turn > ROUNDING * np.maximum(scale, _TINY)[:, None, None]).all(axis=2)
     rows = np.arange(len(points))
     # The shorter diagonal of a non-convex quad may lie outside it; then the
     # other diagonal (through the reflex corner) is the only valid cut.
@@ -235,7 +236,7 @@ def _ear_clip(points: np.ndarray) -> np.ndarray:
         prv, nxt = np.roll(idx, 1), np.roll(idx, -1)
         tri = np.stack([points[prv], points[idx], points[nxt]], axis=1)
         cross = np.cross(tri[:, 1] - tri[:, 0], tri[:, 2] - tri[:, 0])
-        convex = cross @ normal > 1e-12 * max(scale, _TINY)
+        convex = cross @ normal > ROUNDING * max(scale, _TINY)
         # An ear contains no other remaining vertex.
         ear = convex.copy()
         for e in np.flatnonzero(convex):

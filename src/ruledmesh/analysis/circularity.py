@@ -22,7 +22,7 @@ from __future__ import annotations
 import numpy as np
 
 from ..mesh import Mesh
-from ..tolerances import DEFAULT, Tolerances
+from ..tolerances import COLLINEAR_SQ, DEFAULT, Tolerances
 from ..tolerances import TINY as _TINY
 
 __all__ = ["circle_through", "quad_circularity", "circularity", "quad_parallelogram",
@@ -49,7 +49,7 @@ def circle_through(a: np.ndarray, b: np.ndarray, c: np.ndarray):
     nn = np.einsum("ij,ij->i", n, n)
     uu = np.einsum("ij,ij->i", u, u)
     ww = np.einsum("ij,ij->i", w, w)
-    degenerate = nn <= 1e-28 * np.maximum(uu * ww, _TINY)
+    degenerate = nn <= COLLINEAR_SQ * np.maximum(uu * ww, _TINY)
     safe = np.where(degenerate, 1.0, nn)
     center = a + (np.cross(n, u) * ww[:, None] + np.cross(w, n) * uu[:, None]) / (2 * safe[:, None])
     radius = np.where(degenerate, np.inf, np.linalg.norm(center - a, axis=1))

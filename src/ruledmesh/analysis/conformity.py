@@ -14,6 +14,7 @@ from __future__ import annotations
 import numpy as np
 
 from ..mesh import Mesh
+from ..tolerances import DEFAULT, TINY
 
 __all__ = ["t_junctions"]
 
@@ -51,7 +52,7 @@ def _near_pairs(centre: np.ndarray, radius: np.ndarray, pts: np.ndarray):
             np.concatenate([np.asarray(n, np.int64) for n in near if n]))
 
 
-def t_junctions(mesh: Mesh, tol: float = 1e-9) -> np.ndarray:
+def t_junctions(mesh: Mesh, tol: float = DEFAULT.degenerate) -> np.ndarray:
     """Vertices lying strictly inside a border edge of the mesh.
 
     Parameters
@@ -82,7 +83,7 @@ def t_junctions(mesh: Mesh, tol: float = 1e-9) -> np.ndarray:
     keep = (w != edges[e, 0]) & (w != edges[e, 1])
     e, w = e[keep], w[keep]
     d = q[e] - p[e]
-    L2 = np.maximum(length[e] ** 2, 1e-300)
+    L2 = np.maximum(length[e] ** 2, TINY)
     t = np.einsum("ij,ij->i", v[w] - p[e], d) / L2
     off = np.linalg.norm(v[w] - p[e] - t[:, None] * d, axis=1)
     inside = (t > tol) & (t < 1 - tol) & (off <= tol * length[e])

@@ -12,6 +12,7 @@ from __future__ import annotations
 import numpy as np
 
 from ..mesh import Mesh
+from ..tolerances import DEFAULT, ROUNDING_SQ
 from ..tolerances import TINY as _TINY
 
 __all__ = [
@@ -62,7 +63,7 @@ def quad_diagonal_crossing(corners: np.ndarray) -> tuple[np.ndarray, np.ndarray,
     d = np.einsum("ij,ij->i", d1, w)
     e = np.einsum("ij,ij->i", d2, w)
     den = a * c - b * b
-    parallel = den <= 1e-24 * np.maximum(a * c, _TINY)
+    parallel = den <= ROUNDING_SQ * np.maximum(a * c, _TINY)
     safe = np.where(parallel, 1.0, den)
     s = np.where(parallel, 0.0, (b * e - c * d) / safe)
     t = np.where(parallel, e / np.maximum(c, _TINY), (a * e - b * d) / safe)
@@ -224,7 +225,7 @@ def corner_angles(mesh: Mesh) -> np.ndarray:
     return np.degrees(np.arctan2(sinang, cosang))
 
 
-def convexity(mesh: Mesh, tol: float = 1e-9) -> np.ndarray:
+def convexity(mesh: Mesh, tol: float = DEFAULT.convexity) -> np.ndarray:
     """(F,) bool: every face convex (no bow-tie, no reflex corner).
 
     A quad is convex when its diagonals cross strictly inside both (by
@@ -260,7 +261,7 @@ def edge_lengths(mesh: Mesh) -> np.ndarray:
     return np.linalg.norm(mesh.vertices[e[:, 1]] - mesh.vertices[e[:, 0]], axis=1)
 
 
-def degenerate_faces(mesh: Mesh, tol: float = 1e-9) -> np.ndarray:
+def degenerate_faces(mesh: Mesh, tol: float = DEFAULT.degenerate) -> np.ndarray:
     """(F,) bool: faces with no area, by the rule :mod:`ruledmesh.fabricate` refuses them by.
 
     A face is degenerate when its (Newell) area is at most ``tol`` times the

@@ -14,6 +14,8 @@ from typing import Protocol
 
 import numpy as np
 
+from ..tolerances import TINY
+
 # Up to this many point-sample pairs the nearest seeds are found by comparing all pairs.
 _BRUTE_FORCE = 2_000_000
 
@@ -105,9 +107,9 @@ class RuledReference:
             gu = np.einsum("ij,ij->i", su, r)
             gt = np.einsum("ij,ij->i", st, r)
             det = a * c - b * b
-            safe = np.where(np.abs(det) > 1e-300, det, 1.0)
-            du = np.where(np.abs(det) > 1e-300, (c * gu - b * gt) / safe, 0.0)
-            dt = np.where(np.abs(det) > 1e-300, (a * gt - b * gu) / safe, 0.0)
+            safe = np.where(np.abs(det) > TINY, det, 1.0)
+            du = np.where(np.abs(det) > TINY, (c * gu - b * gt) / safe, 0.0)
+            dt = np.where(np.abs(det) > TINY, (a * gt - b * gu) / safe, 0.0)
             u = np.clip(u - du, 0.0, 1.0)
             t = np.clip(t - dt, 0.0, 1.0)
         return u, t

@@ -25,6 +25,7 @@ import numpy as np
 
 from ..errors import ParameterError
 from ..mesh import Mesh
+from ..tolerances import OCCT_FACE, TINY
 from ..triangulate import triangle_angles, triangulate
 from .report import METRIC_HOOKS
 
@@ -174,7 +175,7 @@ def _grid_counts(point, n_triangles: int) -> tuple[int, int]:
     len_u = np.linalg.norm(np.diff(p, axis=0), axis=2).sum(axis=0).mean()
     len_t = np.linalg.norm(np.diff(p, axis=1), axis=2).sum(axis=1).mean()
     cells = max(n_triangles / 2.0, 1.0)
-    nu = max(int(round(np.sqrt(cells * len_u / max(len_t, 1e-300)))), 1)  # noqa: RUF046 - numpy scalar
+    nu = max(int(round(np.sqrt(cells * len_u / max(len_t, TINY)))), 1)  # noqa: RUF046 - numpy scalar
     nt = max(round(cells / nu), 1)
     return nu, nt
 
@@ -217,7 +218,7 @@ def occt_tessellation(point: Callable[[np.ndarray, np.ndarray], np.ndarray],
         for j in range(samples):
             grid.SetValue(i + 1, j + 1, gp_Pnt(*map(float, pts[i, j])))
     surface = GeomAPI_PointsToBSplineSurface(grid).Surface()
-    face = BRepBuilderAPI_MakeFace(surface, 1e-9).Face()
+    face = BRepBuilderAPI_MakeFace(surface, OCCT_FACE).Face()
     BRepMesh_IncrementalMesh(face, float(deflection), False, 0.5, True)
     tri = BRep_Tool.Triangulation_s(face, TopLoc_Location())
     if tri is None:
@@ -263,7 +264,7 @@ def compare_tessellations(mesh: Mesh, point: Callable[[np.ndarray, np.ndarray], 
                                          axis=1).mean())
         # A deflection giving a comparable triangle count: the sagitta of a
         # chord of the mean edge length on a curvature radius ~ the patch size.
-        res = occt_tessellation(point, deflection=mean_edge ** 2 / (8 * max(mesh.diagonal(), 1e-300)))
+        res = occt_tessellation(point, deflection=mean_edge ** 2 / (8 * max(mesh.diagonal(), TINY)))
         if res is not None:
             rows.append({"tessellation": "OCCT BRepMesh", **triangle_quality(*res)})
     return rows

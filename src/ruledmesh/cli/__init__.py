@@ -19,7 +19,7 @@ __all__ = ["main", "COMMANDS"]
 
 # Subcommand modules (relative to ruledmesh.cli), in the order --help lists them.
 COMMANDS = ["build", "analyze", "export", "render", "fabricate", "compare", "design", "structure",
-            "examples", "hops", "blender"]
+            "examples", "schema", "hops", "blender"]
 
 EPILOG = """examples:
   ruledmesh build examples/skew.toml -o skew.obj     build a PQ mesh from a design file

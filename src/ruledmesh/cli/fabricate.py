@@ -4,6 +4,8 @@ from __future__ import annotations
 
 import sys
 
+from ..tolerances import CONGRUENCE_ANGLE_DEG
+
 
 def _size(text: str) -> tuple[float, float]:
     import argparse
@@ -65,7 +67,7 @@ def add_parser(sub) -> None:
     p.add_argument("--decimals", type=int, default=3, help="decimals of edge-length labels (default 3)")
     p.add_argument("--length-tol", type=float, help="congruence tolerance on edge lengths "
                    "(default 1e-9 x diagonal)")
-    p.add_argument("--angle-tol", type=float, default=1e-4,
+    p.add_argument("--angle-tol", type=float, default=CONGRUENCE_ANGLE_DEG,
                    help="congruence tolerance on angles, degrees (default 1e-4)")
     p.add_argument("--no-dxf", action="store_true", help="do not write DXF sheets")
     p.add_argument("--span", default="auto", choices=["auto", "x", "y", "z"],

@@ -19,6 +19,7 @@ import numpy as np
 
 from .._validation import check_float, check_int, check_points
 from ..errors import GeometryError, ParameterError
+from ..tolerances import DEFAULT, ROUNDING, TINY
 from ._grid import grid_mesh
 from .frames import perpendicular
 
@@ -92,11 +93,11 @@ def canal_mesh(centers: np.ndarray, radii, segments: int):
         # Unit vectors in the symmetry plane, perpendicular to each circle's axis,
         # oriented alike; a straight piece of spine keeps the previous one.
         ek = n[k + 1] - (n[k + 1] @ n[k]) * n[k]
-        if np.linalg.norm(ek) <= 1e-12:
+        if np.linalg.norm(ek) <= ROUNDING:
             ek = e - (e @ n[k]) * n[k]
         ek /= np.linalg.norm(ek)
         e1 = ek - (ek @ n[k + 1]) * n[k + 1]
-        if np.linalg.norm(e1) <= 1e-9:
+        if np.linalg.norm(e1) <= DEFAULT.degenerate:
             raise GeometryError(f"circles {k} and {k + 1} lie in perpendicular planes (the spine "
                                 f"turns by 90 degrees or more at point {k + 1}): sample the spine "
                                 "more densely there")
@@ -107,7 +108,7 @@ def canal_mesh(centers: np.ndarray, radii, segments: int):
         h = np.stack([ends @ n[k], ends @ ek, np.ones(4)], axis=1)
         apex = np.cross(np.cross(h[0], h[2]), np.cross(h[1], h[3]))
         size = np.linalg.norm(apex)
-        if not np.isfinite(size) or size <= 1e-300 or np.abs(h).max() * 1e-12 > size:
+        if not np.isfinite(size) or size <= TINY or np.abs(h).max() * ROUNDING > size:
             # The lines through corresponding points coincide: the two circles coincide
             # or the spine has no length between them.
             raise GeometryError(f"circles {k} and {k + 1} coincide (the spine doubles back or has "

@@ -11,6 +11,7 @@ import numpy as np
 
 from .._validation import check_points, check_vector
 from ..errors import GeometryError, ParameterError
+from ..tolerances import DEFAULT, ROUNDING
 from ._grid import grid_mesh, polyline_members
 
 __all__ = ["prism", "pyramid", "torsal_polyhedron"]
@@ -106,11 +107,11 @@ def torsal_polyhedron(polygon: np.ndarray, lengths=(0.2, 1.0), rows: int = 4):
         raise ParameterError(f"expected 0 < lengths[0] < lengths[1], got {[l0, l1]}", "lengths")
     e = np.diff(p, axis=0)
     n = np.linalg.norm(e, axis=1)
-    if np.any(n <= 1e-12 * max(np.abs(p).max(), 1.0)):
+    if np.any(n <= ROUNDING * max(np.abs(p).max(), 1.0)):
         raise GeometryError("polygon has coincident consecutive vertices")
     d = e / n[:, None]
     turn = np.linalg.norm(np.cross(d[:-1], d[1:]), axis=1)
-    if np.any(turn < 1e-9):
+    if np.any(turn < DEFAULT.degenerate):
         raise GeometryError("consecutive edges are parallel: the strip between them is degenerate")
     s = np.linspace(l0, l1, rows + 1)
     # Edge line k starts at P_{k+1} and runs along d_k: X[k, j] = P_{k+1} + s_j d_k.

@@ -4,6 +4,8 @@ from __future__ import annotations
 
 import numpy as np
 
+from ..tolerances import ULPS
+
 __all__ = ["rotation_matrix", "rotate_about_line", "perpendicular", "axis_frame"]
 
 
@@ -38,7 +40,7 @@ def axis_frame(direction: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarra
     """
     a = np.asarray(direction, dtype=np.float64)
     a = a / np.linalg.norm(a)
-    if abs(a[2]) > 1 - 1e-15 and a[0] == 0 and a[1] == 0:
+    if abs(a[2]) > 1 - ULPS and a[0] == 0 and a[1] == 0:
         e1 = np.array([1.0, 0.0, 0.0])
     else:
         e1 = perpendicular(a)

@@ -23,7 +23,7 @@ from .._validation import check_float, check_int
 from ..errors import GeometryError
 from ..mesh import Mesh
 from ..surfaces import ImplicitSurface
-from ..tolerances import DEFAULT
+from ..tolerances import DEFAULT, ROUNDING
 from ._grid import grid_mesh
 
 __all__ = ["helicoid_mesh", "helicoid"]
@@ -93,7 +93,7 @@ def helicoid_mesh(radius: float, pitch: float, turns: float = 1.0, u: int = 48,
     # Keep cells whose corners all have 0 <= (u - v)/2 <= pi and 0 <= (u + v)/2 <= 2 pi turns.
     d = su[:, None] - sv[None, :]
     s = su[:, None] + sv[None, :]
-    eps = 1e-12 * span
+    eps = ROUNDING * span
     inside = (d >= -eps) & (d <= 2 * np.pi + eps) & (s >= -eps) & (s <= 4 * np.pi * turns + eps)
     cell = inside[:-1, :-1] & inside[1:, :-1] & inside[1:, 1:] & inside[:-1, 1:]
     if not cell.any():

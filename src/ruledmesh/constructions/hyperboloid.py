@@ -23,6 +23,7 @@ import numpy as np
 from .._validation import check_choice, check_float, check_int
 from ..errors import GeometryError
 from ..surfaces import ImplicitSurface, parametric_area
+from ..tolerances import ROUNDING
 from ._grid import grid_mesh
 
 __all__ = ["HyperboloidStyle", "hyperboloid_mesh", "one_sheet_hyperboloid"]
@@ -88,7 +89,7 @@ def hyperboloid_mesh(a: float, c: float, height: float, u: int, v: int | None = 
         members = mid = None
     else:
         step = 2 * np.pi / u
-        pmax = np.floor(np.arctan(height / c) / step * (1 + 1e-12))
+        pmax = np.floor(np.arctan(height / c) / step * (1 + ROUNDING))
         if pmax < 1:
             raise GeometryError(f"height {height:g} is below the first crossing of the generators "
                                 f"(z = {c * np.tan(step):g} for u = {u}): raise height or u")

@@ -25,6 +25,7 @@ import numpy as np
 
 from .._validation import check_float, check_int, check_points, check_vector
 from ..errors import GeometryError, ParameterError
+from ..tolerances import DEFAULT, ROUNDING, ROUNDING_SQ, TINY
 from ._grid import grid_mesh
 from .frames import perpendicular, rotation_matrix
 
@@ -76,10 +77,10 @@ def moulding_mesh(profile: np.ndarray, origins: np.ndarray, directions: np.ndarr
         raise ParameterError("expected non-zero axis directions", "directions")
     d = d / np.linalg.norm(d, axis=1)[:, None]
     normal = _profile_plane(c, o[0], d[0])
-    size = max(float(np.ptp(c, axis=0).max()), 1e-300)
+    size = max(float(np.ptp(c, axis=0).max()), TINY)
     off = np.abs((o - c[0]) @ normal)
     tilt = np.abs(d @ normal)
-    bad = np.flatnonzero((off > 1e-9 * size) | (tilt > 1e-9))
+    bad = np.flatnonzero((off > DEFAULT.degenerate * size) | (tilt > DEFAULT.degenerate))
     if bad.size:
         raise GeometryError(f"axis {int(bad[0])} is not in the plane of the profile: every "
                             f"quad would be twisted")
@@ -96,14 +97,14 @@ def moulding_mesh(profile: np.ndarray, origins: np.ndarray, directions: np.ndarr
 def _profile_plane(c: np.ndarray, o: np.ndarray, d: np.ndarray) -> np.ndarray:
     """Unit normal of the plane of a planar profile (with the first axis if it is a line)."""
     rel = c - c[0]
-    size = max(float(np.abs(rel).max()), 1e-300)
+    size = max(float(np.abs(rel).max()), TINY)
     _, sv, vt = np.linalg.svd(rel, full_matrices=False)
-    if len(sv) < 2 or sv[1] <= 1e-12 * size:
-        n = np.cross(vt[0], np.where(np.abs(d @ vt[0]) < 1 - 1e-12, d, o - c[0]))
-        if np.linalg.norm(n) <= 1e-12:
+    if len(sv) < 2 or sv[1] <= ROUNDING * size:
+        n = np.cross(vt[0], np.where(np.abs(d @ vt[0]) < 1 - ROUNDING, d, o - c[0]))
+        if np.linalg.norm(n) <= ROUNDING:
             raise GeometryError("profile and first axis are collinear: no plane to roll")
         return n / np.linalg.norm(n)
-    if len(sv) > 2 and sv[2] > 1e-12 * size * max(1, np.sqrt(len(c))):
+    if len(sv) > 2 and sv[2] > ROUNDING * size * max(1, np.sqrt(len(c))):
         raise GeometryError("the moulding profile must be planar")
     return vt[2] if len(vt) > 2 else np.cross(vt[0], vt[1])
 
@@ -121,7 +122,7 @@ def _first_tangent(spine: np.ndarray) -> np.ndarray:
     u, w = spine[1] - spine[0], spine[2] - spine[0]
     n = np.cross(u, w)
     nn = n @ n
-    if nn <= 1e-24 * (u @ u) * (w @ w):
+    if nn <= ROUNDING_SQ * (u @ u) * (w @ w):
         return d / np.linalg.norm(d)
     center = spine[0] + (np.cross(n, u) * (w @ w) + np.cross(w, n) * (u @ u)) / (2 * nn)
     t = np.cross(n, spine[0] - center)
@@ -151,7 +152,7 @@ def pipe_mesh(spine: np.ndarray, radius: float, segments: int, *, normal=None):
     radius = check_float(radius, "radius", lo=0.0, lo_open=True)
     segments = check_int(segments, "segments", lo=3)
     chords = np.diff(s, axis=0)
-    if np.any(np.linalg.norm(chords, axis=1) <= 1e-12 * np.abs(s).max()):
+    if np.any(np.linalg.norm(chords, axis=1) <= ROUNDING * np.abs(s).max()):
         raise GeometryError("spine has coincident consecutive points")
     n = _first_tangent(s) if normal is None else check_vector(normal, "normal", nonzero=True)
     n = n / np.linalg.norm(n)
@@ -163,7 +164,7 @@ def pipe_mesh(spine: np.ndarray, radius: float, segments: int, *, normal=None):
     for k in range(len(s) - 1):  # two reflections per circle, vectorised over its points
         mid = 0.5 * (s[k] + s[k + 1])
         chord = s[k + 1] - s[k]
-        if abs(n @ chord) <= 1e-9 * np.linalg.norm(chord):
+        if abs(n @ chord) <= DEFAULT.degenerate * np.linalg.norm(chord):
             raise GeometryError(f"spine turns by 90 degrees or more at point {k}: the circle "
                                 f"plane contains the next chord")
         pts = _reflect(rows[-1], mid, chord)

@@ -11,6 +11,7 @@ from __future__ import annotations
 import numpy as np
 
 from .._validation import check_float, check_int, check_points, check_vector
+from ..tolerances import COLLINEAR, TINY
 from ._grid import grid_mesh
 from .frames import axis_frame
 
@@ -37,8 +38,8 @@ def meridian_coordinates(points: np.ndarray, origin: np.ndarray, axis: np.ndarra
     h = rel @ a
     x, y = rel @ e1, rel @ e2
     rho = np.hypot(x, y)
-    scale = max(float(np.abs(rel).max()), 1e-300)
-    on_axis = rho <= 1e-14 * scale
+    scale = max(float(np.abs(rel).max()), TINY)
+    on_axis = rho <= COLLINEAR * scale
     rho = np.where(on_axis, 0.0, rho)
     return rho, h, np.where(on_axis, 0.0, np.arctan2(y, x))
 

@@ -11,6 +11,7 @@ from __future__ import annotations
 
 import math
 import os
+import sys
 import tomllib
 from collections.abc import Mapping
 from dataclasses import dataclass
@@ -24,6 +25,7 @@ from .._validation import check_keys, describe, near_miss
 from ..errors import DesignError, GeometryError, RuledMeshError
 from ..progress import SILENT, Progress, Task, stages
 from ..registry import MESH_METHODS, SURFACE_KINDS, TRANSFORMS, BuildContext, Built, load_plugins
+from ..tolerances import DEFAULT, INTERIOR, ULPS
 
 __all__ = ["Design", "load_design", "parse_design", "design_from_tables", "build_design", "build_file"]
 
@@ -95,7 +97,7 @@ def design_from_tables(data: Mapping[str, Any], source: str = "<dict>",
 # (transform tables holding a matrix) has 4; deeper data only makes every walker
 # over it recurse.
 MAX_NESTING = 32
-_SMALLEST_NORMAL = 2.2250738585072014e-308
+_SMALLEST_NORMAL = sys.float_info.min
 
 
 def _check_tree(data: Any, source: str) -> None:
@@ -262,7 +264,7 @@ def _in_range(mesh: Any, what: str, hint: str = "") -> None:
     _, area = face_normals(mesh)
     extent = float(np.linalg.norm(np.ptp(v, axis=0)))
     # Cheap first: one face of real area (relative to the whole) settles it.
-    if area.max() > 1e-6 * extent * extent:
+    if area.max() > INTERIOR * extent * extent:
         return
     centre, scale = unit_frame(v)
     if np.all(degenerate_faces(mesh.with_vertices((v - centre) / scale))):
@@ -334,7 +336,7 @@ def curve_kinks(curve) -> np.ndarray:
     from ..curves import BSpline, Polyline
 
     if isinstance(curve, Polyline):
-        return np.asarray(curve._knots[1:-1], dtype=float)
+        return np.asarray(curve.breaks()[1:-1], dtype=float)
     if isinstance(curve, BSpline):
         k = np.asarray(curve.knots if curve.knots is not None else [], dtype=float)
         p = curve.degree
@@ -393,7 +395,7 @@ def _with_creases(rulings, table: Mapping, curves: Mapping) -> Any:
                 new_u.append(u)
     if new_u and surface is not None:
         u_all = np.unique(np.concatenate([rulings.u, new_u]))
-        keep = np.r_[True, np.diff(u_all) > 1e-9]
+        keep = np.r_[True, np.diff(u_all) > DEFAULT.degenerate]
         u_all = u_all[keep]
         inserted = len(u_all) - len(rulings.u)
         info = {**rulings.info, "inserted": inserted,
@@ -417,8 +419,8 @@ def _kink_parameter(rail: Any, u0: float, u1: float, kink: float) -> float | Non
         return None
     from ..roots import brentq
 
-    u = brentq(lambda x: float(sigma.value(np.float64(x))) - kink, u0, u1, xtol=1e-15)
-    if u - u0 < 1e-6 * (u1 - u0) or u1 - u < 1e-6 * (u1 - u0):
+    u = brentq(lambda x: float(sigma.value(np.float64(x))) - kink, u0, u1, xtol=ULPS)
+    if u - u0 < INTERIOR * (u1 - u0) or u1 - u < INTERIOR * (u1 - u0):
         return None
     return float(u)
 

@@ -36,6 +36,7 @@ from ..constructions.translational import TranslationalPatch, translational_mesh
 from ..errors import DesignError, GeometryError, ParameterError
 from ..registry import BuildContext, Built, surface_kind
 from ..surfaces import pipe_of_polyline, revolution_of_polyline, torus
+from ..tolerances import PARAMETER_SLACK
 from .fields import Fields, mesh_counts
 from .profiles import profile_from_spec
 
@@ -314,7 +315,7 @@ def _build_hyperboloid(table: Mapping, mesh_table: Mapping, ctx: BuildContext) -
     if style is HyperboloidStyle.GENERATORS:
         guarantee += "; diagonals are generators of both reguli"
     reach = float(np.abs(z).max())
-    if reach < height * (1 - 1e-9):
+    if reach < height * (1 - PARAMETER_SLACK):
         # The crossings of the generators fix the parallels: the last one below
         # `height` ends the mesh.  The reference stays the designed patch, so the
         # coverage says how much is missing, and this warning says why.

@@ -21,6 +21,7 @@ from .._validation import (
     check_vector,
     describe,
 )
+from ..budget import MAX_COUNT, MAX_SURFACE_FACES
 from ..errors import DesignError
 
 __all__ = ["Fields", "mesh_counts"]
@@ -143,9 +144,10 @@ def mesh_counts(mesh_table: Mapping[str, Any], default_u: int | None, default_v:
     out: list[int | None] = []
     for key, default, lo in (("u", default_u, min_u), ("v", default_v, min_v)):
         out.append(None if default is None else
-                   check_int(mesh_table.get(key, default), f"mesh.{key}", lo=lo, hi=100_000,
+                   check_int(mesh_table.get(key, default), f"mesh.{key}", lo=lo, hi=MAX_COUNT,
                              err=DesignError))
     u, v = out
-    if (u or 1) * (v or 1) > 4_000_000:
-        raise DesignError(f"u * v = {(u or 1) * (v or 1)} faces is too many (at most 4000000)", "mesh")
+    if (u or 1) * (v or 1) > MAX_SURFACE_FACES:
+        raise DesignError(f"u * v = {(u or 1) * (v or 1)} faces is too many "
+                          f"(at most {MAX_SURFACE_FACES})", "mesh")
     return u, v

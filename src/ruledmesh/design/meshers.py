@@ -1,8 +1,8 @@
 """The design-file builders of the §4 meshers besides §4.3: hybrid (§4.1) and compound HP (§4.2).
 
 ``[mesh] method = "hybrid"`` meshes the generators of ``[rulings]`` with
-:func:`ruledmesh.hybrid.hybrid_mesh`; ``[surface] kind = "compound-hp"`` builds the
-C1 net of :func:`ruledmesh.compound.compound_net` and meshes it.  Each value is
+:func:`ruledmesh.skew.hybrid_mesh`; ``[surface] kind = "compound-hp"`` builds the
+C1 net of :func:`ruledmesh.skew.compound_net` and meshes it.  Each value is
 checked here once, with messages naming the field.
 """
 
@@ -14,11 +14,12 @@ from typing import Any
 import numpy as np
 
 from .._validation import check_bool, check_int, check_keys, check_points, describe
-from ..compound import CompoundReference, c1_residual, check_steps, compound_mesh, compound_net
+from ..budget import MAX_COUNT, MAX_DIVISIONS
 from ..errors import DesignError
-from ..hybrid import hybrid_mesh
 from ..mesh import FaceKind
 from ..registry import BuildContext, Built, mesh_method, surface_kind
+from ..skew.compound import CompoundReference, c1_residual, check_steps, compound_mesh, compound_net
+from ..skew.hybrid import hybrid_mesh
 from ..surfaces import RuledReference
 from ..tolerances import DEFAULT, Tolerances
 
@@ -34,7 +35,7 @@ def build_hybrid(rulings, table: Mapping[str, Any], ctx: BuildContext) -> Built:
     check_keys(table, HYBRID_MESH_KEYS, "mesh", err=DesignError)
     midpoints = check_int(table.get("midpoints", 1), "mesh.midpoints", lo=0, hi=10_000,
                           err=DesignError)
-    divisions = check_int(table.get("divisions", 8), "mesh.divisions", lo=1, hi=1_000_000,
+    divisions = check_int(table.get("divisions", 8), "mesh.divisions", lo=1, hi=MAX_DIVISIONS,
                           err=DesignError)
     flip = check_bool(table.get("flip", False), "mesh.flip", err=DesignError)
     orient = check_bool(table.get("orient", True), "mesh.orient", err=DesignError)
@@ -83,7 +84,7 @@ def build_compound(surface: Mapping[str, Any], mesh_table: Mapping[str, Any],
         steps[key] = check_steps(value, f"surface.{key}", err=DesignError)
     midpoints = check_int(mesh_table.get("midpoints", 1), "mesh.midpoints", lo=0, hi=10_000,
                           err=DesignError)
-    divisions = check_int(mesh_table.get("divisions", 8), "mesh.divisions", lo=1, hi=100_000,
+    divisions = check_int(mesh_table.get("divisions", 8), "mesh.divisions", lo=1, hi=MAX_COUNT,
                           err=DesignError)
     border = mesh_table.get("border", "notched")
     if border not in ("notched", "triangles"):

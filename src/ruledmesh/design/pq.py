@@ -8,9 +8,11 @@ from typing import Any
 import numpy as np
 
 from .._validation import check_bool, check_float, check_int, check_keys, describe
+from ..budget import MAX_COUNT
 from ..errors import DesignError, GeometryError
 from ..pq import MAX_GRID_POINTS, pq_mesh
 from ..registry import BuildContext, Built, mesh_method
+from ..tolerances import DEFAULT, TINY
 
 __all__ = ["MESH_KEYS", "build_pq"]
 
@@ -22,7 +24,7 @@ MESH_KEYS = ("method", "rows", "primary", "option", "extend", "trim", "max_exten
 def build_pq(rulings, table: Mapping[str, Any], ctx: BuildContext) -> Built:
     """Design-file builder for ``[mesh] method = "pq"``."""
     check_keys(table, MESH_KEYS, "mesh", err=DesignError)
-    rows = check_int(table.get("rows", 20), "mesh.rows", lo=1, hi=100_000, err=DesignError)
+    rows = check_int(table.get("rows", 20), "mesh.rows", lo=1, hi=MAX_COUNT, err=DesignError)
     primary = table.get("primary", "middle")
     m = len(rulings.a)
     if isinstance(primary, str):
@@ -40,7 +42,7 @@ def build_pq(rulings, table: Mapping[str, Any], ctx: BuildContext) -> Built:
     max_extend = check_float(table.get("max_extend", 20.0), "mesh.max_extend", lo=0.0, hi=1e3,
                              err=DesignError)
     # Relative, the paper's measure (analysis.planarity); 1e-12 (the default) is exact.
-    ptol = check_float(table.get("planarity_tolerance", 1e-12), "mesh.planarity_tolerance",
+    ptol = check_float(table.get("planarity_tolerance", DEFAULT.planarity), "mesh.planarity_tolerance",
                        lo=0.0, hi=0.1, err=DesignError)
     refine = check_bool(table.get("refine", True), "mesh.refine", err=DesignError)
     options = {"rows": rows, "primary": primary, "option": option, "extend": extend,
@@ -143,4 +145,4 @@ def _trouble_strips(mesh, m: int) -> np.ndarray:
         s = np.clip(g0[sel] + k, 0, m - 2)
         np.add.at(total, s, area[sel] / span[sel])
         np.add.at(other, s, np.where(off[sel], area[sel] / span[sel], 0.0))
-    return np.flatnonzero(other > _TROUBLE_SHARE * np.maximum(total, 1e-300))
+    return np.flatnonzero(other > _TROUBLE_SHARE * np.maximum(total, TINY))

@@ -47,7 +47,7 @@ import numpy as np
 from .._validation import check_float
 from ..errors import GeometryError, ParameterError
 from ..mesh import Mesh
-from ..tolerances import DEFAULT, Tolerances
+from ..tolerances import DEFAULT, MITRE_FLOOR, TINY, Tolerances
 from .machine import Machine, check, program
 from .schedules import member_schedule
 
@@ -119,7 +119,7 @@ def _offset_path(path: np.ndarray, distance: float) -> np.ndarray:
     m = before + after
     # Mitre: the offset corner lies distance away from both offset segments.
     scale = 1.0 + np.einsum("ij,ij->i", before, after)
-    m = m / np.maximum(scale, 1e-3)[:, None]
+    m = m / np.maximum(scale, MITRE_FLOOR)[:, None]
     return path + distance * m
 
 
@@ -164,7 +164,7 @@ def wire_paths(mesh: Mesh, *, span: str = "auto", up: str | None = None,
     p0 = np.stack([table["x0"], table["y0"], table["z0"]], axis=1)
     p1 = np.stack([table["x1"], table["y1"], table["z1"]], axis=1)
     d = p1 - p0
-    dn = d / np.maximum(np.linalg.norm(d, axis=1), 1e-300)[:, None]
+    dn = d / np.maximum(np.linalg.norm(d, axis=1), TINY)[:, None]
     if span == "auto":
         span = "xyz"[int(np.argmax(np.abs(dn).min(axis=0)))]
     if span not in AXES:

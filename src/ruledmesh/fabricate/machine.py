@@ -30,6 +30,7 @@ import numpy as np
 
 from .._validation import check_float
 from ..errors import GeometryError, ParameterError
+from ..tolerances import ROUNDING
 from ..units import Unit, unit_of
 
 __all__ = ["Machine", "Program", "check", "machine_unit", "program"]
@@ -186,7 +187,7 @@ def check(prog: Program, machine: Machine) -> None:
     """
     need = prog.extent()
     problems = []
-    if machine.travel is not None and np.any(need > np.asarray(machine.travel) * (1 + 1e-12)):
+    if machine.travel is not None and np.any(need > np.asarray(machine.travel) * (1 + ROUNDING)):
         problems.append(f"a travel of {need[0]:.1f} x {need[1]:.1f} {prog.unit} (the machine has "
                         f"{machine.travel[0]:g} x {machine.travel[1]:g})")
     if prog.tilt_deg > machine.max_tilt:

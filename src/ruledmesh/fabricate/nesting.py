@@ -27,6 +27,7 @@ import numpy as np
 from .._validation import check_float
 from ..errors import ParameterError
 from ..progress import Progress
+from ..tolerances import DEFAULT
 from .unroll import Unrolled, corner_structure, min_area_rotation
 
 __all__ = ["DEFAULT_TOOL_MM", "METHODS", "Layout", "auto_sheet", "default_gap", "layout"]
@@ -250,7 +251,7 @@ def _true_shape(unrolled: Unrolled, gap: float, sw: float, sh: float, seconds: i
     points = _rotate(unrolled.points, nested.rotation[face]) + offset[face]
     lo = np.stack([np.minimum.reduceat(points[:, i], off[:-1]) for i in (0, 1)], axis=1)
     hi = np.stack([np.maximum.reduceat(points[:, i], off[:-1]) for i in (0, 1)], axis=1)
-    eps = 1e-9 * max(sw, sh)
+    eps = DEFAULT.degenerate * max(sw, sh)
     if lo.min() < gap - eps or hi[:, 0].max() > sw - gap + eps or hi[:, 1].max() > sh - gap + eps:
         return None
     return Layout(unrolled, points, nested.sheet, nested.rotation, offset, hi - lo,

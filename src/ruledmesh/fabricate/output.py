@@ -28,7 +28,7 @@ from ..errors import GeometryError
 from ..io import write_atomic
 from ..mesh import Mesh
 from ..progress import SILENT, Progress, stages
-from ..tolerances import DEFAULT, Tolerances
+from ..tolerances import CONGRUENCE_ANGLE_DEG, DEFAULT, ROUNDING, Tolerances
 from . import hotwire as hw
 from . import machine as hm
 from .nesting import layout
@@ -76,7 +76,7 @@ def _hotwire(mesh: Mesh, unit: str, machine: hm.Machine, **options: Any):
         axis = hw.AXES[path.span]
         lo, hi = mesh.bounding_box()[:, axis]
         length = machine.wire_length / k
-        if hi - lo > length * (1 + 1e-12):
+        if hi - lo > length * (1 + ROUNDING):
             raise GeometryError(
                 f"the hot-wire cut does not fit the machine: it needs a wire length of at least "
                 f"{(hi - lo) * k:.1f} (the machine has {machine.wire_length:g}); nothing written")
@@ -136,7 +136,7 @@ def _write_hotwire(put: Any, path: Any, program_text: str, unit: str,
 
 def fabricate(mesh: Mesh, folder: str | os.PathLike, *, sheet: tuple[float, float] | None = None,
               gap: float | None = None, unit: str | None = None, decimals: int = 3,
-              length_tol: float | None = None, angle_tol: float = 1e-4, dxf: bool | None = None,
+              length_tol: float | None = None, angle_tol: float = CONGRUENCE_ANGLE_DEG, dxf: bool | None = None,
               hotwire: bool | None = None, span: str = "auto", up: str | None = None,
               kerf: float = 0.0, kerf_side: str = "left", feed: float = 300.0,
               machine: hm.Machine | None = None, nesting: str = "auto", nest_seconds: int = 2,
@@ -213,7 +213,7 @@ def fabricate(mesh: Mesh, folder: str | os.PathLike, *, sheet: tuple[float, floa
     labels = panel_labels(lay, decimals=decimals)
     task.advance(note="classes")
     tolerances = {"length_tol": length_tol if length_tol is not None
-                  else 1e-9 * (mesh.diagonal() or 1.0), "angle_tol": angle_tol}
+                  else DEFAULT.degenerate * (mesh.diagonal() or 1.0), "angle_tol": angle_tol}
     table = _panel_table(mesh, unrolled, lay, tolerances)
     task.advance()
     task.close()

@@ -20,6 +20,7 @@ import numpy as np
 
 from .._validation import check_float
 from ..mesh import FaceKind, Mesh
+from ..tolerances import CONGRUENCE_ANGLE_DEG, DEFAULT
 from .labels import panel_labels
 from .unroll import Unrolled, interior_angles, polygon_edges, unroll
 
@@ -46,7 +47,7 @@ def _signatures(lengths: np.ndarray, angles: np.ndarray) -> np.ndarray:
     return np.concatenate([fwd, back], axis=1)
 
 
-def congruence_classes(mesh: Mesh, *, length_tol: float | None = None, angle_tol: float = 1e-4,
+def congruence_classes(mesh: Mesh, *, length_tol: float | None = None, angle_tol: float = CONGRUENCE_ANGLE_DEG,
                        unrolled: Unrolled | None = None) -> np.ndarray:
     """(F,) int64: a class number per face, equal for congruent panels.
 
@@ -71,7 +72,7 @@ def congruence_classes(mesh: Mesh, *, length_tol: float | None = None, angle_tol
     from scipy.spatial import cKDTree
 
     if length_tol is None:
-        length_tol = 1e-9 * (mesh.diagonal() or 1.0)
+        length_tol = DEFAULT.degenerate * (mesh.diagonal() or 1.0)
     length_tol = check_float(length_tol, "length_tol", lo=0.0, lo_open=True)
     angle_tol = check_float(angle_tol, "angle_tol", lo=0.0, lo_open=True)
     if unrolled is None:
@@ -165,6 +166,6 @@ def panel_statistics(mesh: Mesh, *, table: dict[str, np.ndarray] | None = None,
                       "max": float(table["max_angle_deg"].max())},
         "distinct_panels": int(sizes.size),
         "largest_class": int(sizes.max()),
-        "tolerances": {"length": tolerances.get("length_tol", 1e-9 * (mesh.diagonal() or 1.0)),
-                       "angle_deg": tolerances.get("angle_tol", 1e-4)},
+        "tolerances": {"length": tolerances.get("length_tol", DEFAULT.degenerate * (mesh.diagonal() or 1.0)),
+                       "angle_deg": tolerances.get("angle_tol", CONGRUENCE_ANGLE_DEG)},
     }

@@ -23,6 +23,7 @@ import numpy as np
 
 from ..analysis.faces import face_normals
 from ..mesh import Mesh
+from ..tolerances import TINY
 from .unroll import corner_structure
 
 __all__ = ["node_schedule", "edge_schedule", "member_schedule", "csv_bytes"]
@@ -158,7 +159,7 @@ def member_schedule(mesh: Mesh) -> dict[str, np.ndarray]:
     order = np.lexsort((-seg_len, g))
     starts = np.r_[0, np.flatnonzero(np.diff(g[order])) + 1]
     longest = order[starts]
-    direction = seg[longest] / np.maximum(seg_len[longest], 1e-300)[:, None]
+    direction = seg[longest] / np.maximum(seg_len[longest], TINY)[:, None]
     origin = v[mem[longest, 0]]
     ends = mem.reshape(-1)
     eg = np.repeat(g, 2)

@@ -18,6 +18,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..errors import ExportError, ParameterError
+from ..tolerances import TINY
 from .labels import panel_labels as panel_labels_of
 from .nesting import Layout
 from .unroll import corner_structure
@@ -82,7 +83,7 @@ def panel_labels(layout: Layout, *, decimals: int = 3) -> Labels:
     edge_size = np.minimum(0.5 * face_size[face], 0.8 * length / (0.6 * chars + 1.0))
     angle = np.degrees(np.arctan2(d[:, 1], d[:, 0]))
     angle = np.where(angle > 90.0, angle - 180.0, np.where(angle <= -90.0, angle + 180.0, angle))
-    inward = np.stack([-d[:, 1], d[:, 0]], axis=1) / np.maximum(length, 1e-300)[:, None]
+    inward = np.stack([-d[:, 1], d[:, 0]], axis=1) / np.maximum(length, TINY)[:, None]
     pos = 0.5 * (p + p[nxt]) + inward * (0.9 * edge_size)[:, None]
     # Interleave: face f's labels are its id, then its edges in corner order.
     slot = np.arange(off[-1]) + face + 1

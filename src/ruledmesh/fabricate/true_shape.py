@@ -23,6 +23,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..progress import SILENT, Progress
+from ..tolerances import ROUNDING, TINY
 from .unroll import Unrolled, corner_structure
 
 __all__ = ["SheetNesting", "available", "nest_sheets", "panel_areas", "strip_pack"]
@@ -235,8 +236,8 @@ def _fill_one(unrolled: Unrolled, area: np.ndarray, faces: np.ndarray, width: fl
     rot, tr, used = strip_pack(unrolled, height, gap, seconds, seed, faces=faces)
     lo, hi = _x_extent(unrolled, faces, rot, tr)
     start = float(lo.min())
-    keep = hi - start <= width * (1 + 1e-12)
+    keep = hi - start <= width * (1 + ROUNDING)
     tr = tr - np.array([start, 0.0])
-    density = float(area[faces].sum()) / (max(used - start, 1e-300) * height)
+    density = float(area[faces].sum()) / (max(used - start, TINY) * height)
     fits = bool(keep.all())
     return _Fill(faces[keep], rot[keep], tr[keep], fits, used - start if fits else width, density)

@@ -18,6 +18,7 @@ from typing import Any
 import numpy as np
 
 from ..errors import ParameterError, RuledMeshError
+from ..tolerances import DEFAULT
 from .geometry import (
     curve_table,
     decode_curve,
@@ -133,7 +134,7 @@ _PRIMARY = Param("Primary", "Text", '"middle" or the index of the primary genera
                  default="middle")
 _OPTION = Param("Option", "Integer", "0 or 1: the two checkerboards of the PQ mesh", "O", default=0)
 _TOLERANCE = Param("Tolerance", "Number", "planarity tolerance of the report (relative)", "T",
-                   default=1e-12)
+                   default=DEFAULT.planarity)
 
 
 def _pq_mesh_table(inputs: Mapping[str, Any]) -> dict[str, Any]:

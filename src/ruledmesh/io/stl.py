@@ -26,6 +26,7 @@ from .._validation import check_vector
 from ..analysis.faces import face_normals
 from ..errors import RuledMeshWarning
 from ..mesh import Mesh
+from ..tolerances import FLOAT32_WARNING
 from ..triangulate import triangulate
 
 __all__ = ["RECORD", "dumpb", "float32_error"]
@@ -33,7 +34,7 @@ __all__ = ["RECORD", "dumpb", "float32_error"]
 # One STL triangle record: normal, three corners (float32), attribute word.
 RECORD = np.dtype([("normal", "<f4", (3,)), ("corners", "<f4", (3, 3)), ("attr", "<u2")])
 # Warn when float32 rounding moves corners by more than this fraction of the mesh size.
-PRECISION_WARNING = 1e-5
+PRECISION_WARNING = FLOAT32_WARNING
 
 
 def float32_error(vertices: np.ndarray) -> float:

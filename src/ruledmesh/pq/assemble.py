@@ -13,7 +13,7 @@ from __future__ import annotations
 import numpy as np
 
 from ..mesh import FaceKind, Mesh
-from ..tolerances import Tolerances
+from ..tolerances import ROUNDING, Tolerances
 from .ladders import free_edges, ladder_points
 from .runs import Run
 from .strips import ON_BORDER, Gaps, chains, strip_paths, zippers
@@ -275,12 +275,12 @@ def to_mesh(V, T, G, faces, kinds, warnings, chain, gstart, scale, meet=None) ->
     # nothing else; faces that collapse go.
     used0 = np.zeros(len(V), bool)
     used0[idx] = True
-    near = (T <= 1e-12) | (T >= 1 - 1e-12)
+    near = (T <= ON_BORDER) | (T >= 1 - ON_BORDER)
     if meet is not None and np.any(meet):
         near |= np.asarray(meet)[np.clip(G, 0, len(meet) - 1)] & (G >= 0)
     ends = np.flatnonzero(used0 & near)
     if len(ends) > 1:
-        key = np.round(V[ends] / (1e-12 * scale)).astype(np.int64)
+        key = np.round(V[ends] / (ROUNDING * scale)).astype(np.int64)
         _, first, inv = np.unique(key, axis=0, return_index=True, return_inverse=True)
         if len(first) < len(ends):
             remap = np.arange(len(V))

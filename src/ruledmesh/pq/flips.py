@@ -19,7 +19,7 @@ from __future__ import annotations
 import numpy as np
 
 from ..mesh import FaceKind, Mesh
-from ..tolerances import FLIP_ACTIVE_DEG, FLIP_MAX_BEND_DEG, FLIP_MAX_SAG, FLIP_MIN_GAIN_DEG
+from ..tolerances import FLIP_ACTIVE_DEG, FLIP_MAX_BEND_DEG, FLIP_MAX_SAG, FLIP_MIN_GAIN_DEG, TINY
 
 __all__ = ["flip_triangles"]
 
@@ -35,7 +35,7 @@ def _angles(P: np.ndarray) -> np.ndarray:
 
 def _unit_normals(p, q, r) -> np.ndarray:
     n = np.cross(q - p, r - p)
-    return n / np.maximum(np.linalg.norm(n, axis=1, keepdims=True), 1e-300)
+    return n / np.maximum(np.linalg.norm(n, axis=1, keepdims=True), TINY)
 
 
 def _edge_keys(mesh_faces: list[np.ndarray], n: int) -> np.ndarray:
@@ -83,7 +83,7 @@ def _round(V: np.ndarray, tri: np.ndarray, fixed: np.ndarray, scale: float) -> i
     n1, n2 = _unit_normals(A, B, C), _unit_normals(B, D, C)
     m1, m2 = _unit_normals(A, B, D), _unit_normals(A, D, C)
     mean = n1 + n2
-    mean /= np.maximum(np.linalg.norm(mean, axis=1, keepdims=True), 1e-300)
+    mean /= np.maximum(np.linalg.norm(mean, axis=1, keepdims=True), TINY)
     bend = np.cos(np.radians(FLIP_MAX_BEND_DEG))
     # The flipped pair's height over the old one: how far the surface moves.
     sag = np.abs(np.einsum("ij,ij->i", 0.5 * (A + D) - 0.5 * (B + C), mean))

@@ -17,6 +17,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from ..tolerances import TINY
 from .strips import Gaps
 
 __all__ = ["free_edges", "ladder_points"]
@@ -92,13 +93,13 @@ def ladder_points(V, T, G, chain, gstart, free, a, d, rows: int):
     for nb in (g - 1, g + 1):
         ok = (nb >= 0) & (nb < m)
         q = np.clip(nb, 0, m - 1)
-        u = d[q] / np.maximum(glen[q], 1e-300)[:, None]
+        u = d[q] / np.maximum(glen[q], TINY)[:, None]
         r = mid - a[q]
         along = np.einsum("ij,ij->i", r, u)
         dist = np.linalg.norm(r - along[:, None] * u, axis=1)
         width = np.where(ok, np.minimum(width, dist), width)
         wide = np.where(ok, np.maximum(wide, dist), wide)
-        tq = np.clip(along / np.maximum(glen[q], 1e-300), 0.0, 1.0)
+        tq = np.clip(along / np.maximum(glen[q], TINY), 0.0, 1.0)
         pos = np.clip(np.searchsorted(keys, q * 4.0 + tq, side="right") - 1, gstart[q],
                       gstart[q + 1] - 2)
         facing.append(np.where(ok, pos, -1))

@@ -16,6 +16,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..hop import crossing_maps, landing_maps
+from ..tolerances import TINY
 
 __all__ = [
     "ChainMaps",
@@ -45,7 +46,7 @@ class ChainMaps:
 def unit_det(H: np.ndarray) -> np.ndarray:
     """Scale 2x2 maps to |det| = 1 (rows then neither grow nor shrink on average)."""
     det = np.abs(H[:, 0, 0] * H[:, 1, 1] - H[:, 0, 1] * H[:, 1, 0])
-    scale = np.sqrt(np.where(det > 0, det, np.abs(H).max(axis=(1, 2)) ** 2 + 1e-300))
+    scale = np.sqrt(np.where(det > 0, det, np.abs(H).max(axis=(1, 2)) ** 2 + TINY))
     return H / scale[:, None, None]
 
 
@@ -155,7 +156,7 @@ def drift_maps(a: np.ndarray, d: np.ndarray, M: np.ndarray) -> np.ndarray:
         return N
     X = crossing_maps(a[:-2], d[:-2], a[1:-1], d[1:-1], a[2:], d[2:])
     inner = np.einsum("kij,kjl->kil", inverse(M[1:-1]), np.einsum("kij,kjl->kil", X, M[:-2]))
-    N[1:-1] = inner / np.maximum(np.abs(inner).max(axis=(1, 2)), 1e-300)[:, None, None]
+    N[1:-1] = inner / np.maximum(np.abs(inner).max(axis=(1, 2)), TINY)[:, None, None]
     return N
 
 

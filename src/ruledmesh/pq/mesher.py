@@ -11,7 +11,7 @@ from ..errors import GeometryError, ParameterError
 from ..hop import coplanarity
 from ..mesh import Mesh
 from ..normalise import normalised
-from ..tolerances import DEFAULT, Tolerances
+from ..tolerances import DEFAULT, PARAMETER_SLACK, Tolerances
 from .assemble import assemble
 from .flips import flip_triangles
 from .pairing import pair_triangles
@@ -224,6 +224,17 @@ def _single_generators(a: np.ndarray, d: np.ndarray, rows: int, warnings: list[s
     return np.flatnonzero(keep)
 
 
+def _keep(kept: np.ndarray, a: np.ndarray, d: np.ndarray, creases, crease_generators):
+    """The kept generators, and the crease indices in their numbering."""
+    if kept.size == len(a):
+        return a, d, creases, crease_generators
+
+    def renumber(ks):
+        return None if ks is None else np.searchsorted(kept, np.asarray(ks, np.int64), side="right") - 1
+
+    return a[kept], d[kept], renumber(creases), renumber(crease_generators)
+
+
 def _renumbered(mesh: Mesh, kept: np.ndarray) -> Mesh:
     """The mesh with generator indices of the kept generators mapped back to the given ones."""
     vdata = dict(mesh.vertex_data)
@@ -327,12 +338,28 @@ def pq_mesh(a, b, rows: int = 20, primary: int | str = "middle", option: int = 0
     warnings: list[str] = []
     m_given = len(a)
     kept = _single_generators(a, d, rows, warnings)
+    a, d, creases, crease_generators = _keep(kept, a, d, creases, crease_generators)
+    m = len(a)
+    flat, torsal, cg, segs = _cut(a, d, rows, ptol, scale, tol, creases, crease_generators, warnings)
+    plan = _Plan(a, d, tol, scale, warnings, frozenset(cg.tolist()))
+    primary = int(np.searchsorted(kept, args.primary, side="right") - 1)
+    parts = _build_all(plan, segs, primary, args.middle,
+                       Division(rows, args.option, args.extend, args.max_extend), m)
+    restarts = max(len([r for r in parts if len(r.left)]) - len([s for s in segs if s.hi - s.lo >= 2]), 0)
+    even = _even_ranges(parts, segs, warnings)
+    meet = np.r_[flat, False] | np.r_[False, flat]      # generators of a coplanar pair
+    mesh = assemble(parts, a, d, args.trim, tol, ptol, warnings, scale, meet, rows=rows)
+    mesh, flips, paired = _fattened(mesh, ptol, tol)
+    _warn_share(mesh, warnings, torsal.size, even, restarts, m, rows)
+    _warn_splinters(mesh, warnings, torsal)
     if kept.size < m_given:
-        a, b, d = a[kept], b[kept], d[kept]
-        creases = None if creases is None else \
-            np.searchsorted(kept, np.asarray(creases, np.int64), side="right") - 1
-        crease_generators = None if crease_generators is None else \
-            np.searchsorted(kept, np.asarray(crease_generators, np.int64), side="right") - 1
+        mesh = _renumbered(mesh, kept)
+    return mesh.with_info(runs=len(parts), restarts=restarts, planarity_tolerance=ptol, paired=paired,
+                          flips=flips)
+
+
+def _cut(a, d, rows, ptol, scale, tol, creases, crease_generators, warnings):
+    """Torsal strips and creases: (flat strips, torsal strips, crease generators, segments)."""
     m = len(a)
     # Torsal generators cut the generators into segments: where the twist changes
     # sign (hops across would reverse the rows), at a coplanar pair, or at a crease
@@ -350,25 +377,17 @@ def pq_mesh(a, b, rows: int = 20, primary: int | str = "middle", option: int = 0
     narrow = change & ~flat & ~crease & _narrow_strips(a, d, rows)
     segs = _segments(m, np.union1d(np.flatnonzero(narrow), cg),
                      np.flatnonzero(flat | crease | (change & ~narrow)))
-    plan = _Plan(a, d, tol, scale, warnings, frozenset(cg.tolist()))
-    primary = int(np.searchsorted(kept, args.primary, side="right") - 1)
-    parts = _build_all(plan, segs, primary, args.middle,
-                       Division(rows, args.option, args.extend, args.max_extend), m)
-    restarts = max(len([r for r in parts if len(r.left)]) - len([s for s in segs if s.hi - s.lo >= 2]), 0)
-    even = _even_ranges(parts, segs, warnings)
-    meet = np.r_[flat, False] | np.r_[False, flat]      # generators of a coplanar pair
-    mesh = assemble(parts, a, d, args.trim, tol, ptol, warnings, scale, meet, rows=rows)
+    return flat, torsal, cg, segs
+
+
+def _fattened(mesh: Mesh, ptol: float, tol: Tolerances) -> tuple[Mesh, int, int]:
+    """Flip the triangles for their angles, pair them in tolerance mode, flip what is left."""
     mesh, flips = flip_triangles(mesh)
     mesh, paired = _paired(mesh, ptol, tol)
     if paired:
         mesh, more = flip_triangles(mesh)
         flips += more
-    _warn_share(mesh, warnings, torsal.size, even, restarts, m, rows)
-    _warn_splinters(mesh, warnings, torsal)
-    if kept.size < m_given:
-        mesh = _renumbered(mesh, kept)
-    return mesh.with_info(runs=len(parts), restarts=restarts, planarity_tolerance=ptol, paired=paired,
-                          flips=flips)
+    return mesh, flips, paired
 
 
 @dataclass(frozen=True)
@@ -535,7 +554,7 @@ def _warn_splinters(mesh: Mesh, warnings: list[str], torsal: np.ndarray) -> None
     near_torsal = np.zeros(bad.size, bool)
     for k in torsal.tolist():
         near_torsal |= np.abs(g0 - k) <= 2
-    border = (t_lo <= 1e-9) | (t_hi >= 1 - 1e-9)
+    border = (t_lo <= PARAMETER_SLACK) | (t_hi >= 1 - PARAMETER_SLACK)
     quads = mesh.valences[bad] == 4
     where = []
     for count, label in ((near_torsal.sum(), "next to torsal generators"),
@@ -623,7 +642,7 @@ def _well_twisted(plan: _Plan, lo: int, hi: int) -> int:
     centre = 1.0 - np.abs(inner - (m - 1) / 2) / m
     score = worst * centre
     # Ties within rounding go to the middle, so the choice does not flip with scale.
-    best = score >= score.max() * (1.0 - 1e-9)
+    best = score >= score.max() * (1.0 - PARAMETER_SLACK)
     return int(inner[best][np.argmin(np.abs(inner[best] - (m - 1) / 2))])
 
 

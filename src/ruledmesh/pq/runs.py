@@ -20,10 +20,10 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..budget import MAX_BUILD_BYTES, PQ_BYTES_PER_GRID_POINT
+from ..budget import MAX_GRID_POINTS, PQ_BYTES_PER_GRID_POINT
 from ..errors import GeometryError
 from ..hop import crossing_maps
-from ..tolerances import RESTART_ANGLE_DEG, TINY, Tolerances
+from ..tolerances import INTERIOR, RESTART_ANGLE_DEG, ROUNDING, TINY, Tolerances
 from .maps import (
     ChainMaps,
     apply,
@@ -37,11 +37,8 @@ from .maps import (
 
 __all__ = ["MAX_GRID_POINTS", "Division", "Run", "carrier", "mesh_run"]
 
-# Grid points (generators x rows) above which a build is refused up front, with
-# the memory it would need, instead of running out of memory half-way: the
-# measured peak per point (ruledmesh.budget) against the one build budget.
+# The grid-point limit and the memory per point: ruledmesh.budget.
 BYTES_PER_GRID_POINT = PQ_BYTES_PER_GRID_POINT
-MAX_GRID_POINTS = MAX_BUILD_BYTES // PQ_BYTES_PER_GRID_POINT
 
 
 @dataclass(frozen=True)
@@ -87,7 +84,7 @@ class Run:
         """Increasing parameters of this run's vertices on global generator ``g`` in [0, 1]."""
         # Within rounding of the border counts as on it, so the division handed on
         # does not change with the scale of the design.
-        eps = 1e-12
+        eps = ROUNDING
         sel = (self.gen == g) & ~self.far & (self.t >= -eps) & (self.t <= 1.0 + eps)
         return np.sort(self.t[sel])
 
@@ -131,7 +128,7 @@ def _matched_rows(M: np.ndarray, div: Division, tol: Tolerances) -> np.ndarray:
         step = 2.0 / div.rows
         s0 = s1 = step
     else:
-        floor = 1e-6 / div.rows
+        floor = INTERIOR / div.rows
         s0, s1 = max(given[1] - given[0], floor), max(given[-1] - given[-2], floor)
     # Two A-row steps of margin beyond what covers the patch (a face spans two steps).
     n0 = max(math.ceil((given[0] - lo_v) / s0) + 2, 2)
@@ -190,7 +187,7 @@ def _root_b_rows(M: np.ndarray, N: np.ndarray, tau: np.ndarray, primary: int,
     sigma = np.where(has & ~bounded & np.isfinite(L) & (sigma0 <= Lf), Lf + 0.5 * (a_hi - Lf), sigma)
     sigma = np.where(has & ~bounded & np.isfinite(U) & (sigma0 >= Uf), Uf - 0.5 * (Uf - a_lo), sigma)
     # Never leave the a-rows' bracket on the primary, and keep the rows in order.
-    sigma = np.clip(sigma, a_lo + 1e-6 * (a_hi - a_lo), a_hi - 1e-6 * (a_hi - a_lo))
+    sigma = np.clip(sigma, a_lo + INTERIOR * (a_hi - a_lo), a_hi - INTERIOR * (a_hi - a_lo))
     out = tau.copy()
     out[1:-1:2] = sigma
     return out
@@ -242,7 +239,7 @@ def _grid(a: np.ndarray, d: np.ndarray, first: int, maps: ChainMaps, tau: np.nda
     roots = tau[parity[:, None] + 2 * np.arange(H)[None, :]]          # (m, H)
     num, den = propagate(maps, roots)
     glen = np.linalg.norm(d, axis=1)
-    tmax = tol.far * scale / np.maximum(glen, 1e-300)
+    tmax = tol.far * scale / np.maximum(glen, TINY)
     far = ~(np.abs(num) < tmax[:, None] * np.abs(den))
     t = np.where(far, 0.0, num / np.where(far, 1.0, den))
     X = a[:, None, :] + t[..., None] * d[:, None, :]

@@ -15,15 +15,14 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from ..tolerances import ON_BORDER, SNAP_GAP, TINY
+
 __all__ = ["ON_BORDER", "Gaps", "chains", "group_starts", "strip_paths", "zippers"]
 
-# Parameters this close to 0 or 1 are on the patch border (rounding of t).
-ON_BORDER = 1e-12
 # A vertex nearer a director curve than this share of the step to the next
 # vertex on its generator is taken as the border point of its generator.
 SNAP_STEP = 0.06
-# ... and the border it makes stays this close (share of the diagonal) to the director curve.
-SNAP_GAP = 1e-3
+# ... and the border it makes stays SNAP_GAP (tolerances) close to the director curve.
 
 
 def group_starts(keys: np.ndarray) -> np.ndarray:
@@ -230,7 +229,7 @@ def zippers(V, T, chain, gstart, strip, k0, l0, na, nb) -> np.ndarray:
     t0, t1 = T[chain[gstart[s_b]]], T[chain[gstart[s_b + 1] - 1]]
     dir_ = p1 - p0
     pb = V[B(gid_b, l0[gid_b] + lb + 1)]
-    w = np.einsum("ij,ij->i", pb - p0, dir_) / np.maximum(np.einsum("ij,ij->i", dir_, dir_), 1e-300)
+    w = np.einsum("ij,ij->i", pb - p0, dir_) / np.maximum(np.einsum("ij,ij->i", dir_, dir_), TINY)
     key_b = t0 + w * (t1 - t0)
     gid = np.concatenate([gid_a, gid_b])
     is_a = np.concatenate([np.ones(gid_a.size, bool), np.zeros(gid_b.size, bool)])

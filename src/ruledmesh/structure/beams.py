@@ -34,6 +34,7 @@ from .._validation import check_float
 from ..errors import GeometryError, ParameterError
 from ..fabricate.schedules import edge_schedule, member_schedule
 from ..mesh import FaceKind, Mesh
+from ..tolerances import MIN_HALF_ANGLE
 from ..tolerances import TINY as _TINY
 from .normals import face_edges
 from .support import SupportStructure
@@ -170,7 +171,7 @@ def edge_setbacks(structure: SupportStructure, width: float) -> np.ndarray:
     d1 -= np.einsum("ij,ij->i", d1, axes)[:, None] * axes
     d2 -= np.einsum("ij,ij->i", d2, axes)[:, None] * axes
     theta = np.arctan2(np.linalg.norm(np.cross(d1, d2), axis=1), np.einsum("ij,ij->i", d1, d2))
-    need = 0.5 * width / np.tan(np.maximum(0.5 * theta, 1e-6))
+    need = 0.5 * width / np.tan(np.maximum(0.5 * theta, MIN_HALF_ANGLE))
     out = np.zeros((len(edges), 2))
     for e, at_vertex in ((corner_edge, idx), (corner_edge[prv], idx)):
         end = (edges[e, 1] == at_vertex).astype(np.int64)

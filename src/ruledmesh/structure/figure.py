@@ -17,6 +17,7 @@ import numpy as np
 
 from ..errors import ExportError
 from ..mesh import Mesh
+from ..tolerances import DEFAULT
 from .beams import Solids
 from .support import SupportStructure
 
@@ -85,7 +86,7 @@ def render_structure(structure: SupportStructure, *, beams: Solids | None = None
                                          linewidths=1.2))
     pts = np.concatenate([v, w])
     lo, hi = pts.min(axis=0), pts.max(axis=0)
-    span = np.maximum(hi - lo, 1e-9 * max(float(np.max(hi - lo)), 1.0))
+    span = np.maximum(hi - lo, DEFAULT.degenerate * max(float(np.max(hi - lo)), 1.0))
     ax.set_xlim(lo[0], lo[0] + span[0])
     ax.set_ylim(lo[1], lo[1] + span[1])
     ax.set_zlim(lo[2], lo[2] + span[2])

@@ -26,13 +26,12 @@ import numpy as np
 import scipy.sparse as sp
 from scipy.sparse.linalg import splu
 
+from ..tolerances import KKT_REGULARISATION, ULPS
 from ..tolerances import TINY as _TINY
 
 __all__ = ["ParallelFit", "closest_parallel_offset", "edge_bases", "parallel_constraints"]
 
-# Regularisation of the KKT matrix, relative to its unit-size rows: small enough
-# that refinement converges in a few steps, large enough for a stable sparse LU.
-_DELTA = 1e-10
+_DELTA = KKT_REGULARISATION
 
 
 def edge_bases(directions: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -115,7 +114,7 @@ def _objective(normals: np.ndarray, distance_weight: float) -> sp.csr_matrix:
 
 def closest_parallel_offset(vertices: np.ndarray, edges: np.ndarray, normals: np.ndarray,
                             distance: float, *, distance_weight: float = 1.0,
-                            rtol: float = 1e-15, max_steps: int = 60) -> ParallelFit:
+                            rtol: float = ULPS, max_steps: int = 60) -> ParallelFit:
     """The parallel offset closest to ``distance * normals``.
 
     Minimises ``sum_i |P_i (X_i - d N_i)|^2`` subject to ``C X = 0``, where
