@@ -23,6 +23,7 @@ import numpy as np
 from ..budget import MAX_BUILD_BYTES, PQ_BYTES_PER_GRID_POINT
 from ..errors import GeometryError
 from ..hop import crossing_maps
+from ..kernels import wanted
 from ..tolerances import Tolerances
 from .maps import (
     ChainMaps,
@@ -240,9 +241,18 @@ def _grid(a: np.ndarray, d: np.ndarray, first: int, maps: ChainMaps, tau: np.nda
     m = len(a)
     H = len(tau) // 2
     roots = tau[parity[:, None] + 2 * np.arange(H)[None, :]]          # (m, H)
-    num, den = propagate(maps, roots)
     glen = np.linalg.norm(d, axis=1)
     tmax = tol.far * scale / np.maximum(glen, 1e-300)
+    kern = wanted(m * H, "grid")
+    if kern is not None:
+        # One pass per stage, the same arithmetic (ruledmesh.kernels.grid).
+        num, den = kern.propagate(maps.primary, maps.root, maps.fwd, maps.bwd, maps.crossing, roots)
+        Xc = crossing_maps(a[:-2], d[:-2], a[1:-1], d[1:-1], a[2:], d[2:]) if m >= 3 else None
+        X, t, far, left, right, pole, cg, failing, on_patch = kern.grid(a, d, num, den, tmax, parity, Xc,
+                                                                        first)
+        gen = np.repeat(np.arange(first, first + m), H)
+        return Run(X, t, gen, far, left, right, pole, cg, failing, on_patch)
+    num, den = propagate(maps, roots)
     far = ~(np.abs(num) < tmax[:, None] * np.abs(den))
     t = np.where(far, 0.0, num / np.where(far, 1.0, den))
     X = a[:, None, :] + t[..., None] * d[:, None, :]
