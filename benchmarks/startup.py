@@ -64,7 +64,7 @@ def startup(repeats: int) -> tuple[dict[str, float], dict[str, float]]:
 
 def generators(repeats: int) -> dict[str, float]:
     """Minimum CPU seconds of generators from the skew example's director curves."""
-    from ruledmesh.curves import curve_from_spec
+    from ruledmesh.design.curves import curve_from_spec
     from ruledmesh.rulings import between
 
     spec = tomllib.loads(SKEW.read_text(encoding="utf-8"))["curves"]
