@@ -149,3 +149,30 @@ def _cache_roundtrip(site, tmp_path) -> None:
     cache = run.stdout.strip()
     assert cache.startswith(str(tmp_path / "home")), cache
     assert any(f.endswith(".nbi") for _, _, fs in os.walk(cache) for f in fs)
+
+
+@SETTINGS
+@given(seed=st.integers(0, 2**31), m=st.integers(3, 30), rows=st.integers(1, 30),
+       twist=st.floats(0.1, 3.0), wobble=st.floats(0.0, 1.5))
+def test_strip_paths(monkeypatch, seed, m, rows, twist, wobble):
+    """The trimming's kept halves, jumps and gaps, on the inputs a real build hands it."""
+    from ruledmesh.pq import assemble, strips
+
+    seen = []
+    real = strips.strip_paths
+
+    def spy(*args):
+        seen.append(args)
+        return real(*args)
+
+    monkeypatch.setattr(assemble, "strip_paths", spy)
+    monkeypatch.setenv("RULEDMESH_KERNELS", "0")
+    a, b = design(seed, m, twist, wobble)
+    pq_mesh(a, b, rows=rows)
+    assert seen
+    for args in seen:
+        ref, got = both(monkeypatch, lambda args=args: real(*args))
+        for r, g in zip(ref[:2] + ref[3:], got[:2] + got[3:]):
+            assert same(r, g)
+        for name in ("strip", "k0", "l0", "na", "nb"):
+            assert same(getattr(ref[2], name), getattr(got[2], name)), name

@@ -2,7 +2,7 @@
 
 The mesher and the per-face measures are written in numpy; their hot stages
 also exist as numba kernels (:mod:`ruledmesh.kernels.geometry`,
-:mod:`ruledmesh.kernels.grid`) that do the same arithmetic in the same order,
+:mod:`ruledmesh.kernels.grid`, :mod:`ruledmesh.kernels.strips`) that do the same arithmetic in the same order,
 one pass per face instead of one array operation per formula term, so their
 results are bit for bit the numpy ones (the tests compare both on random
 designs).
@@ -35,7 +35,7 @@ __all__ = ["MIN_ITEMS", "wanted"]
 #: small designs stay below it, so ``ruledmesh build`` of them never imports numba.
 MIN_ITEMS = 4096
 
-_state: dict[str, ModuleType | bool | None] = {"geometry": None, "grid": None, "failed": False}
+_state: dict[str, ModuleType | bool | None] = {"geometry": None, "grid": None, "strips": None, "failed": False}
 
 
 def _cache_dir_fallback() -> None:
@@ -78,7 +78,7 @@ def _load(name: str) -> ModuleType | None:
 
 
 def _loaded() -> bool:
-    return any(isinstance(_state[k], ModuleType) for k in ("geometry", "grid")) \
+    return any(isinstance(_state[k], ModuleType) for k in ("geometry", "grid", "strips")) \
         or "ruledmesh.kernels.geometry" in sys.modules
 
 
@@ -89,7 +89,7 @@ def wanted(items: int, name: str = "geometry") -> ModuleType | None:
     ----------
     items : int
         Size of the stage (faces, grid points).
-    name : {"geometry", "grid"}
+    name : {"geometry", "grid", "strips"}
 
     Returns
     -------

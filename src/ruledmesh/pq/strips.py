@@ -15,6 +15,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from ..kernels import wanted
+
 __all__ = ["ON_BORDER", "Gaps", "chains", "group_starts", "strip_paths", "zippers"]
 
 # Parameters this close to 0 or 1 are on the patch border (rounding of t).
@@ -126,6 +128,12 @@ def strip_paths(T, chain, gstart, m, L, R, ok_l, ok_r, CG):
     that do not fit a monotone path are dropped, and every gap between the kept
     runs (and from the director curves to them) is filled by zipper steps.
     """
+    kern = wanted(len(L), "strips")
+    done = kern.strip_paths(T, chain, gstart, m, L, R, ok_l, ok_r, CG) if kern is not None else None
+    if done is not None:
+        # The same decisions in one pass per stage (ruledmesh.kernels.strips).
+        keep_l, keep_r, gaps, jump_l, jump_r = done
+        return keep_l, keep_r, Gaps(*gaps), jump_l, jump_r
     V_len = len(T)
     rank = np.full(V_len, -1, np.int64)
     rank[chain] = np.arange(len(chain)) - np.repeat(gstart[:-1], np.diff(gstart))
