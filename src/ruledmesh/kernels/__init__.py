@@ -2,17 +2,22 @@
 
 The mesher and the per-face measures are written in numpy; their hot stages
 also exist as numba kernels (:mod:`ruledmesh.kernels.geometry`,
-:mod:`ruledmesh.kernels.grid`, :mod:`ruledmesh.kernels.strips`) that do the same arithmetic in the same order,
-one pass per face instead of one array operation per formula term, so their
-results are bit for bit the numpy ones (the tests compare both on random
-designs).
+:mod:`ruledmesh.kernels.grid`, :mod:`ruledmesh.kernels.strips`) that do the
+same arithmetic in the same order, one pass per face instead of one array
+operation per formula term, so their results are bit for bit the numpy ones
+(the tests compare both on random designs).
 
-Importing numba costs about 0.45 s and the first call of a kernel on a new
-machine compiles it (a few seconds, then cached on disk): a small build is
-faster in numpy.  So the kernels are loaded only when a stage meets
-:data:`MIN_ITEMS` items (faces, grid points), and once loaded they are used for
-every size.  ``RULEDMESH_KERNELS=0`` forces numpy everywhere, ``=1`` the
-kernels everywhere (the tests use both).
+Importing numba and loading the compiled kernels from the on-disk cache costs
+about 0.9 s of CPU once per process (compiling them on a new machine, once,
+about 15 s), where a small build takes milliseconds in numpy.  So the kernels
+are loaded when one stage has :data:`MIN_ITEMS` items (a build that takes a
+good part of a second in numpy), or when the process has put :data:`MIN_WORK`
+items through the stages (a designer or a notebook rebuilding the same design
+over and over); once loaded they are used for every size.  A one-off build of a
+small design never imports numba.  An application that knows it will rebuild
+live (a server) calls :func:`load` at start instead.  ``RULEDMESH_KERNELS=0`` forces numpy
+everywhere, ``=1`` the kernels everywhere (the tests use both); the results are
+the same either way.
 
 The on-disk cache lives beside the package; where that is not writable (an
 installation owned by another user, a read-only image) it goes to
@@ -29,11 +34,14 @@ import tempfile
 from pathlib import Path
 from types import ModuleType
 
-__all__ = ["MIN_ITEMS", "wanted"]
+__all__ = ["MIN_ITEMS", "MIN_WORK", "load", "wanted"]
 
-#: Items (faces, grid points) from which a stage loads the kernels.  The bundled
-#: small designs stay below it, so ``ruledmesh build`` of them never imports numba.
-MIN_ITEMS = 4096
+#: Items (faces, grid points) from which a single stage loads the kernels.
+MIN_ITEMS = 100_000
+#: Items put through the stages of this process from which the kernels are loaded.
+MIN_WORK = 1_000_000
+
+_work = [0]
 
 _state: dict[str, ModuleType | bool | None] = {"geometry": None, "grid": None, "strips": None, "failed": False}
 
@@ -99,7 +107,22 @@ def wanted(items: int, name: str = "geometry") -> ModuleType | None:
     mode = _mode()
     if mode in ("0", "off", "numpy"):
         return None
-    if mode in ("1", "on", "numba") or items >= MIN_ITEMS or _loaded():
+    _work[0] += items
+    if mode in ("1", "on", "numba") or items >= MIN_ITEMS or _work[0] >= MIN_WORK or _loaded():
         return _load(name)
     return None
 
+
+
+def load() -> bool:
+    """Load every kernel now (a live application, before its first request).
+
+    Returns
+    -------
+    bool
+        Whether the kernels are in use (False: numba is missing, or
+        ``RULEDMESH_KERNELS=0``).
+    """
+    if _mode() in ("0", "off", "numpy"):
+        return False
+    return all(_load(name) is not None for name in ("geometry", "grid", "strips"))
