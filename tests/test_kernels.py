@@ -176,3 +176,20 @@ def test_strip_paths(monkeypatch, seed, m, rows, twist, wobble):
             assert same(r, g)
         for name in ("strip", "k0", "l0", "na", "nb"):
             assert same(getattr(ref[2], name), getattr(got[2], name)), name
+
+
+@SETTINGS
+@given(seed=st.integers(0, 2**31), n=st.integers(0, 400), m=st.integers(1, 30), upper=st.booleans(),
+       ties=st.booleans())
+def test_near_border(monkeypatch, seed, n, m, upper, ties):
+    """Which generators' nearest vertex is the border point: sorting (numpy) or two minima (kernel)."""
+    from ruledmesh.pq import strips
+
+    rng = np.random.default_rng(seed)
+    gi = rng.integers(0, m, n)
+    ti = rng.uniform(0, 1, n) ** 3 if not upper else 1 - rng.uniform(0, 1, n) ** 3
+    if ties and n:
+        ti[rng.integers(0, n, n // 3)] = ti[0]
+    rel = rng.uniform(1e-4, 2.0, m)
+    ref, got = both(monkeypatch, lambda: strips._near_border(gi, ti, m, rel, upper))
+    assert same(ref, got)

@@ -15,7 +15,7 @@ from __future__ import annotations
 import numba as nb
 import numpy as np
 
-__all__ = ["strip_paths"]
+__all__ = ["near_border", "strip_paths"]
 
 
 @nb.njit(cache=True, nogil=True)
@@ -204,3 +204,50 @@ def strip_paths(T: np.ndarray, chain: np.ndarray, gstart: np.ndarray, m: int, L:
     keep_l, keep_r, g_s, k0, l0, na, nb_, jump_l, jump_r = _strip_paths(len(T), chain, gstart, int(m), L, R,
                                                                         ok_l, ok_r, CG)
     return keep_l, keep_r, (g_s, k0, l0, na, nb_), jump_l, jump_r
+
+
+@nb.njit(cache=True, nogil=True)
+def _near_border(gi, ti, m, rel_len, upper, snap_step, snap_gap):
+    lo1 = np.full(m, np.inf)
+    lo2 = np.full(m, np.inf)
+    count = np.zeros(m, np.int64)
+    for i in range(gi.shape[0]):
+        g = gi[i]
+        t = 1.0 - ti[i] if upper else ti[i]
+        count[g] += 1
+        if t < lo1[g]:
+            lo2[g] = lo1[g]
+            lo1[g] = t
+        elif t < lo2[g]:
+            lo2[g] = t
+    out = np.zeros(m, np.bool_)
+    for g in range(m):
+        if count[g] >= 2:
+            out[g] = (lo1[g] < snap_step * (lo2[g] - lo1[g])) and (lo1[g] * rel_len[g] < snap_gap)
+    return out
+
+
+def near_border(gi: np.ndarray, ti: np.ndarray, m: int, rel_len: np.ndarray, upper: bool,
+                snap_step: float, snap_gap: float) -> np.ndarray | None:
+    """:func:`ruledmesh.pq.strips._near_border` without sorting: the two smallest per generator.
+
+    Parameters
+    ----------
+    gi : (n,) int
+        Generator of each vertex inside the patch; ``ti`` (n,) float64 its parameter.
+    m : int
+    rel_len : (m,) float64
+    upper : bool
+        Measure from ``t = 1`` instead of ``t = 0``.
+    snap_step, snap_gap : float
+
+    Returns
+    -------
+    (m,) bool, or None where a parameter is NaN (numpy's sort order then decides).
+    """
+    ti = np.ascontiguousarray(ti, dtype=np.float64)
+    if np.isnan(ti).any():
+        return None
+    return _near_border(np.ascontiguousarray(gi, dtype=np.int64), ti, int(m),
+                        np.ascontiguousarray(rel_len, dtype=np.float64), bool(upper), float(snap_step),
+                        float(snap_gap))

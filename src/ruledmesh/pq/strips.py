@@ -38,6 +38,10 @@ def _near_border(gi: np.ndarray, ti: np.ndarray, m: int, rel_len: np.ndarray,
     """(m,) bool: the generator's vertex nearest a director curve is within ``SNAP_STEP`` of
     the step to the next vertex along the generator, and within ``SNAP_GAP`` of the
     diagonal (``rel_len``: generator lengths over the diagonal) of the curve."""
+    kern = wanted(len(gi), "strips")
+    done = kern.near_border(gi, ti, m, rel_len, upper, SNAP_STEP, SNAP_GAP) if kern is not None else None
+    if done is not None:
+        return done
     t = 1.0 - ti if upper else ti
     order = np.lexsort((t, gi))
     g, t = gi[order], t[order]
