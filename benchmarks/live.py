@@ -16,8 +16,9 @@ arc length), with ``pq_mesh(a, b, rows=n, trim=True)``:
   1e5 to 3e6 faces (1e5 to 1e6 with ``--quick``);
 * ``peak_rss_bytes_per_face``: the peak resident memory of a fresh process
   that imports ruledmesh and builds 1000 x 1000 once, per face; and the same
-  less the resident memory of the process before the build, once with the
-  kernels loaded and warm (what the build itself holds).
+  less the resident memory of the process before the build; and both again in a
+  process that loaded the kernels and built once before (``warm``: what the
+  build itself holds, without the one-off cost of loading numba).
 
 Times are CPU times of this process (``time.process_time``), the least
 sensitive to other jobs on a shared machine; the load average is recorded with
@@ -44,18 +45,25 @@ if str(HERE) not in sys.path:
 from surfaces import SURFACES  # noqa: E402
 
 _CHILD = """
-import resource, sys
+import sys
 sys.path.insert(0, {here!r})
 from surfaces import SURFACES
 from ruledmesh.pq import pq_mesh
 warm = {warm!r}
 if warm:
+    try:
+        from ruledmesh.kernels import load
+        load()
+    except ImportError:
+        pass
     pq_mesh(*SURFACES["skew"].generators(100), rows=100)
 a, b = SURFACES["skew"].generators({n})
 with open("/proc/self/status") as f:
     base = int(next(l for l in f if l.startswith("VmRSS")).split()[1]) * 1024
 m = pq_mesh(a, b, rows={n}, trim=True)
-peak = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss * 1024
+# VmHWM, not ru_maxrss: the latter keeps the parent's peak across exec.
+with open("/proc/self/status") as f:
+    peak = int(next(l for l in f if l.startswith("VmHWM")).split()[1]) * 1024
 print(m.n_faces, base, peak)
 """
 
@@ -159,10 +167,10 @@ def main(argv: list[str] | None = None) -> int:
     load = os.getloadavg()
     sizes = [480, 700, 1000] if args.quick else [480, 700, 1000, 1400, 2000, 2600]
     run = {"loadavg_start": load, "kernels": os.environ.get("RULEDMESH_KERNELS", "auto")}
+    run.update(memory())
     run.update(latency(10 if args.quick else 30))
     run.update(ratio(2 if args.quick else 3))
     run.update(scaling(sizes, 1 if args.quick else 2))
-    run.update(memory())
     run["loadavg_end"] = os.getloadavg()
     for k, v in run.items():
         print(f"{k:>36}: {v}")
