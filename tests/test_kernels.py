@@ -193,3 +193,21 @@ def test_near_border(monkeypatch, seed, n, m, upper, ties):
     rel = rng.uniform(1e-4, 2.0, m)
     ref, got = both(monkeypatch, lambda: strips._near_border(gi, ti, m, rel, upper))
     assert same(ref, got)
+
+
+def test_newell_large_polygons(monkeypatch):
+    """Polygons of many corners (numpy's pairwise blocks of 8, and past 128 its halving)."""
+    from ruledmesh.mesh import Mesh
+
+    rng = np.random.default_rng(5)
+    sizes = [3, 4, 9, 17, 64, 128, 129, 130, 300]
+    ring = [np.c_[np.cos(u), np.sin(u), 0.01 * rng.standard_normal(len(u))] * 10.0 ** rng.uniform(-2, 3)
+            for u in (np.sort(rng.uniform(0, 2 * np.pi, n)) for n in sizes)]
+    V = np.concatenate(ring) + rng.uniform(-1e3, 1e3, 3)
+    off = np.r_[0, np.cumsum(sizes)]
+    mesh = Mesh.from_arrays(V, off, np.arange(len(V)))
+    ref, got = both(monkeypatch, lambda: (*faces.face_normals(mesh), faces.face_min_angles(mesh)))
+    assert all(same(r, g) for r, g in zip(ref, got))
+    small = Mesh.from_arrays(V[:off[7]], off[:8], np.arange(off[7]))
+    ref, got = both(monkeypatch, lambda: faces.face_normals(small))
+    assert all(same(r, g) for r, g in zip(ref, got))

@@ -178,8 +178,9 @@ def face_normals(mesh: Mesh) -> tuple[np.ndarray, np.ndarray]:
         Face areas (exact for planar faces).
     """
     kern = wanted(mesh.n_faces)
-    if kern is not None:
-        return kern.newell(mesh.vertices, mesh.face_indices, mesh.face_offsets)
+    done = kern.newell(mesh.vertices, mesh.face_indices, mesh.face_offsets) if kern is not None else None
+    if done is not None:
+        return done
     v = mesh.vertices
     idx = mesh.face_indices
     nxt = np.arange(idx.size) + 1

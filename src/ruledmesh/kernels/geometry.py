@@ -21,6 +21,9 @@ from ..tolerances import TINY
 __all__ = ["crossing", "min_angles", "newell", "quad_planarity"]
 
 _DEG = 180.0 / math.pi
+# numpy's pairwise sum adds up to 128 terms in one unrolled block: the Newell kernel
+# follows its order for faces of up to 129 corners (the first plus 128).
+_MAX_CORNERS = 129
 
 
 @nb.njit(cache=True, inline="always")
@@ -183,13 +186,11 @@ def _newell(V, idx, off):
     vec = np.zeros((F, 3))
     area = np.empty(F)
     normals = np.empty((F, 3))
-    cr = np.empty((3, 129))
+    cr = np.empty((3, _MAX_CORNERS))
     for f in range(F):
         lo, hi = off[f], off[f + 1]
         n = hi - lo
         o = idx[lo]
-        if n > 129:
-            cr = np.empty((3, n))
         for k in range(n):
             i = idx[lo + k]
             j = idx[lo + k + 1] if k + 1 < n else idx[lo]
@@ -209,7 +210,7 @@ def _newell(V, idx, off):
     return normals, area
 
 
-def newell(V: np.ndarray, idx: np.ndarray, off: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+def newell(V: np.ndarray, idx: np.ndarray, off: np.ndarray) -> tuple[np.ndarray, np.ndarray] | None:
     """:func:`ruledmesh.analysis.faces.face_normals` of a polygon mesh, bit for bit.
 
     Parameters
@@ -218,14 +219,17 @@ def newell(V: np.ndarray, idx: np.ndarray, off: np.ndarray) -> tuple[np.ndarray,
     idx : (N,) int
         Face corners, face after face.
     off : (F + 1,) int
-        Start of each face in ``idx``; faces of up to 129 corners take the
-        numpy order exactly (larger ones sum in blocks like numpy's up to 128).
+        Start of each face in ``idx``.
 
     Returns
     -------
     normals : (F, 3) float64
     areas : (F,) float64
+        Or None for a mesh with a face of more than :data:`_MAX_CORNERS`
+        corners (numpy sums those in recursive halves): the caller runs numpy.
     """
+    if len(off) > 1 and int(np.diff(off).max()) > _MAX_CORNERS:
+        return None
     return _newell(np.ascontiguousarray(V, dtype=np.float64), np.ascontiguousarray(idx),
                    np.ascontiguousarray(off))
 
