@@ -111,21 +111,47 @@ def _arc_sigma(curve: Curve, count: int) -> Any:
     """sigma(u) = the curve parameter at arc-length fraction u.
 
     Exact where the inverse is closed-form (lines, polylines, arcs, helices);
-    for B-splines a cubic Hermite interpolant of exact samples and slopes on
-    the dense grid (which holds the generators), so that evaluating the
-    reference surface needs no Newton solve.
+    for B-splines a cubic Hermite interpolant of exact samples and slopes as
+    dense as the dense grid (exact at the generators, see :func:`_dense_sigma`),
+    so that evaluating the reference surface needs no Newton solve.
     """
     exact = _ArcLength(curve)
     if not isinstance(curve, BSpline):
         return exact
-    grid, _ = dense_grid(count)
-    values = exact.value(grid)
+    grid, k = dense_grid(count)
+    nodes = _dense_sigma(curve, exact, grid, k)
+    grid, values = nodes if nodes is not None else (grid, exact.value(grid))
     speed = curve.speed_at(values)
     if np.all(speed > ROUNDING * curve.length()):
         return _Pchip.of(grid, values, curve.length() / speed)
     # A cusp (zero speed, e.g. a spline doubling back) has an infinite slope
     # there: use the monotone interpolant of the samples instead.
     return _Pchip.of(grid, values)
+
+
+def _dense_sigma(curve: BSpline, exact: _ArcLength, grid: np.ndarray,
+                 k: int) -> tuple[np.ndarray, np.ndarray] | None:
+    """Nodes ``(u, sigma(u))`` of the interpolant: exact inverses at the generators' ``u``
+    (every ``k``-th node of ``grid``), forward arc lengths in between.
+
+    Between two generators the parameters are spaced evenly and their arc-length
+    fractions taken from the tabulated arc length (one series evaluation each,
+    where the inverse costs a Newton solve), so the nodes are as dense as the grid
+    and the generators stay exact.  None where the table is not strictly
+    increasing there (a cusp): the caller inverts on the grid instead.
+    """
+    u_gen = grid[::k]
+    p_gen = exact.value(u_gen)
+    if k == 1:
+        return u_gen, p_gen
+    j = np.arange(1, k) / k
+    p_mid = (p_gen[:-1, None] + (p_gen[1:] - p_gen[:-1])[:, None] * j[None, :])
+    u_mid = curve.arclength(p_mid) / curve.length()
+    u = np.concatenate([np.c_[u_gen[:-1], u_mid].ravel(), u_gen[-1:]])
+    p = np.concatenate([np.c_[p_gen[:-1], p_mid].ravel(), p_gen[-1:]])
+    if not (np.all(np.diff(u) > 0) and np.all(np.diff(p) > 0)):
+        return None
+    return u, p
 
 
 @dataclass(frozen=True, eq=False)

@@ -28,7 +28,7 @@ __all__ = ["BRENTQ_XTOL", "COLLINEAR", "COLLINEAR_SQ", "CONGRUENCE_ANGLE_DEG", "
            "FLIP_MIN_GAIN_DEG", "FLOAT32_WARNING", "INTERIOR", "KKT_REGULARISATION",
            "MIN_EXTENT", "MIN_HALF_ANGLE", "MIN_RELATIVE_EXTENT", "MITRE_FLOOR", "OCCT_FACE",
            "ON_BORDER", "PARAMETER_SLACK", "PLANARITY_FLOOR", "RESTART_ANGLE_DEG", "ROOT_RTOL", "ROOT_XTOL",
-           "ROUNDING", "ROUNDING_SQ", "SAME_ROOT", "SNAP_GAP", "TINY", "ULPS", "Tolerances"]
+           "ROUNDING", "ROUNDING_SQ", "SAME_ROOT", "SETTLED", "SNAP_GAP", "TINY", "ULPS", "Tolerances"]
 
 
 @dataclass(frozen=True)
@@ -101,6 +101,9 @@ COLLINEAR_SQ = 1e-28
 #: must lie in [0, 1]: the iteration stops at about 1e-12 relative, so a
 #: thousandfold margin keeps every true in-range solution in range.
 PARAMETER_SLACK = 1e-9
+#: A Gauss-Newton step smaller than this (in parameter space) no longer moves the point:
+#: the nearest-point search of the closeness analysis stops there.
+SETTLED = 1e-13
 #: Two roots of the same equation closer than this (in parameter space) are one root.
 SAME_ROOT = 1e-8
 

@@ -11,6 +11,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from ..kernels import wanted
 from ..mesh import Mesh
 from ..tolerances import DEFAULT, ROUNDING_SQ
 from ..tolerances import TINY as _TINY
@@ -48,6 +49,9 @@ def quad_diagonal_crossing(corners: np.ndarray) -> tuple[np.ndarray, np.ndarray,
     gap : (F,) float64
         Distance between the diagonal lines (0 for a planar quad).
     """
+    kern = wanted(len(corners))
+    if kern is not None and corners.ndim == 3 and corners.shape[1:] == (4, 3):
+        return kern.crossing(corners)
     # Each quad moved to its first corner and scaled to unit size: the products of squared
     # lengths below would overflow for coordinates beyond about 1e77.
     origin = corners[:, :1]
@@ -98,6 +102,9 @@ def quad_planarity(corners: np.ndarray) -> np.ndarray:
     >>> round(float(quad_planarity(bent)[0]), 4)
     0.0352
     """
+    kern = wanted(len(corners))
+    if kern is not None and corners.ndim == 3 and corners.shape[1:] == (4, 3):
+        return kern.quad_planarity(corners)
     _, _, gap = quad_diagonal_crossing(corners)
     l1 = np.linalg.norm(corners[:, 2] - corners[:, 0], axis=1)
     l2 = np.linalg.norm(corners[:, 3] - corners[:, 1], axis=1)
@@ -152,7 +159,9 @@ def planarity(mesh: Mesh) -> np.ndarray:
     out = np.zeros(mesh.n_faces)
     qid, quads = mesh.faces_of_valence(4)
     if qid.size:
-        out[qid] = quad_planarity(mesh.vertices[quads])
+        kern = wanted(qid.size)
+        out[qid] = quad_planarity(mesh.vertices[quads]) if kern is None \
+            else kern.quad_planarity(mesh.vertices, quads)
     other = np.flatnonzero(mesh.valences > 4)
     if other.size:
         out[other] = polygon_planarity(mesh, other)
@@ -169,6 +178,10 @@ def face_normals(mesh: Mesh) -> tuple[np.ndarray, np.ndarray]:
     areas : (F,) float64
         Face areas (exact for planar faces).
     """
+    kern = wanted(mesh.n_faces)
+    done = kern.newell(mesh.vertices, mesh.face_indices, mesh.face_offsets) if kern is not None else None
+    if done is not None:
+        return done
     v = mesh.vertices
     idx = mesh.face_indices
     nxt = np.arange(idx.size) + 1
@@ -290,6 +303,9 @@ SPLINTER_DEG = 3.0
 
 def face_min_angles(mesh: Mesh) -> np.ndarray:
     """(F,) float64: the smallest interior angle of every face, degrees."""
+    kern = wanted(mesh.n_faces)
+    if kern is not None and mesh.n_faces and mesh.valences.min() > 0:
+        return kern.min_angles(mesh.vertices, mesh.face_indices, mesh.face_offsets)
     ang = corner_angles(mesh)
     if ang.size == 0:
         return np.zeros(mesh.n_faces)

@@ -14,7 +14,7 @@ from typing import Protocol
 
 import numpy as np
 
-from ..tolerances import TINY
+from ..tolerances import SETTLED, TINY
 
 # Up to this many point-sample pairs the nearest seeds are found by comparing all pairs.
 _BRUTE_FORCE = 2_000_000
@@ -96,11 +96,21 @@ class RuledReference:
 
     def _descend(self, points: np.ndarray, u: np.ndarray, t: np.ndarray,
                  iterations: int) -> tuple[np.ndarray, np.ndarray]:
-        """Gauss-Newton on ``|S(u, t) - p|^2`` from ``(u, t)``, clamped to the patch."""
+        """Gauss-Newton on ``|S(u, t) - p|^2`` from ``(u, t)``, clamped to the patch.
+
+        A point whose step no longer moves it (by more than :data:`SETTLED` in
+        ``u`` and ``t``: converged, or held at the patch border) takes no further
+        steps, so the work follows the points still moving.
+        """
+        u, t = u.copy(), t.copy()
+        live = np.arange(len(u))
         for _ in range(iterations):
-            s = self.surface.point(u, t)
-            su, st = self.surface.partials(u, t)
-            r = s - points
+            if live.size == 0:
+                break
+            uu, tt, pp = u[live], t[live], points[live]
+            s = self.surface.point(uu, tt)
+            su, st = self.surface.partials(uu, tt)
+            r = s - pp
             a = np.einsum("ij,ij->i", su, su)
             b = np.einsum("ij,ij->i", su, st)
             c = np.einsum("ij,ij->i", st, st)
@@ -110,8 +120,11 @@ class RuledReference:
             safe = np.where(np.abs(det) > TINY, det, 1.0)
             du = np.where(np.abs(det) > TINY, (c * gu - b * gt) / safe, 0.0)
             dt = np.where(np.abs(det) > TINY, (a * gt - b * gu) / safe, 0.0)
-            u = np.clip(u - du, 0.0, 1.0)
-            t = np.clip(t - dt, 0.0, 1.0)
+            nu = np.clip(uu - du, 0.0, 1.0)
+            nt = np.clip(tt - dt, 0.0, 1.0)
+            u[live], t[live] = nu, nt
+            moving = (np.abs(nu - uu) > SETTLED) | (np.abs(nt - tt) > SETTLED)
+            live = live[moving]
         return u, t
 
     def distance(self, points: np.ndarray) -> np.ndarray:

@@ -23,6 +23,7 @@ import numpy as np
 from ..budget import MAX_GRID_POINTS, PQ_BYTES_PER_GRID_POINT
 from ..errors import GeometryError
 from ..hop import crossing_maps
+from ..kernels import wanted
 from ..tolerances import INTERIOR, RESTART_ANGLE_DEG, ROUNDING, TINY, Tolerances
 from .maps import (
     ChainMaps,
@@ -237,9 +238,23 @@ def _grid(a: np.ndarray, d: np.ndarray, first: int, maps: ChainMaps, tau: np.nda
     m = len(a)
     H = len(tau) // 2
     roots = tau[parity[:, None] + 2 * np.arange(H)[None, :]]          # (m, H)
-    num, den = propagate(maps, roots)
     glen = np.linalg.norm(d, axis=1)
     tmax = tol.far * scale / np.maximum(glen, TINY)
+    kern = wanted(m * H, "grid")
+    if kern is not None:
+        # One pass per stage, the same arithmetic (ruledmesh.kernels.grid).
+        num, den = kern.propagate(maps.primary, maps.root, maps.fwd, maps.bwd, maps.crossing, roots)
+        Xc = crossing_maps(a[:-2], d[:-2], a[1:-1], d[1:-1], a[2:], d[2:]) if m >= 3 else None
+        X, t, far, left, right, pole, cg, _, _ = kern.grid(a, d, num, den, tmax, parity, Xc, first)
+        # The kernel counts bow-ties only; slivers count as failing too (numpy, as below).
+        ic = cg - first
+        hc = np.where(left[:, 0] >= 0, left[:, 0], right[:, 1]) % H
+        hl = np.where(left[:, 1] >= 0, left[:, 1], right[:, 0]) % H
+        failing, on_patch = _failing_faces(a, d, t.reshape(m, H), far.reshape(m, H), ic, hl, hc,
+                                           pole, m)
+        gen = np.repeat(np.arange(first, first + m), H)
+        return Run(X, t, gen, far, left, right, pole, cg, failing, on_patch)
+    num, den = propagate(maps, roots)
     far = ~(np.abs(num) < tmax[:, None] * np.abs(den))
     t = np.where(far, 0.0, num / np.where(far, 1.0, den))
     X = a[:, None, :] + t[..., None] * d[:, None, :]

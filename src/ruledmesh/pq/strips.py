@@ -15,6 +15,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from ..kernels import wanted
 from ..tolerances import ON_BORDER, SNAP_GAP, TINY
 
 __all__ = ["ON_BORDER", "Gaps", "chains", "group_starts", "strip_paths", "zippers"]
@@ -35,6 +36,10 @@ def _near_border(gi: np.ndarray, ti: np.ndarray, m: int, rel_len: np.ndarray,
     """(m,) bool: the generator's vertex nearest a director curve is within ``SNAP_STEP`` of
     the step to the next vertex along the generator, and within ``SNAP_GAP`` of the
     diagonal (``rel_len``: generator lengths over the diagonal) of the curve."""
+    kern = wanted(len(gi), "strips")
+    done = kern.near_border(gi, ti, m, rel_len, upper, SNAP_STEP, SNAP_GAP) if kern is not None else None
+    if done is not None:
+        return done
     t = 1.0 - ti if upper else ti
     order = np.lexsort((t, gi))
     g, t = gi[order], t[order]
@@ -125,6 +130,12 @@ def strip_paths(T, chain, gstart, m, L, R, ok_l, ok_r, CG):
     that do not fit a monotone path are dropped, and every gap between the kept
     runs (and from the director curves to them) is filled by zipper steps.
     """
+    kern = wanted(len(L), "strips")
+    done = kern.strip_paths(T, chain, gstart, m, L, R, ok_l, ok_r, CG) if kern is not None else None
+    if done is not None:
+        # The same decisions in one pass per stage (ruledmesh.kernels.strips).
+        keep_l, keep_r, gaps, jump_l, jump_r = done
+        return keep_l, keep_r, Gaps(*gaps), jump_l, jump_r
     V_len = len(T)
     rank = np.full(V_len, -1, np.int64)
     rank[chain] = np.arange(len(chain)) - np.repeat(gstart[:-1], np.diff(gstart))

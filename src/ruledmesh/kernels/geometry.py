@@ -1,0 +1,277 @@
+"""numba kernels of the per-face measures of :mod:`ruledmesh.analysis.faces`.
+
+Each kernel is the numpy function's arithmetic in the numpy function's order,
+one face per loop iteration, reading the corners through the face indices
+instead of gathering an (F, k, 3) copy first.  The order of the sums matters
+for bit-identical results and follows what numpy does: ``einsum("ij,ij->i")``
+over three components adds ``(x0 y0 + x2 y2) + x1 y1``, ``norm(axis=1)``
+adds the squares left to right, and ``add.reduceat`` adds the first row to the
+sum of the others.  The tests compare every kernel with its numpy reference.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numba as nb
+import numpy as np
+
+from ..tolerances import ROUNDING_SQ, TINY
+
+__all__ = ["crossing", "min_angles", "newell", "quad_planarity"]
+
+_DEG = 180.0 / math.pi
+# numpy's pairwise sum adds up to 128 terms in one unrolled block: the Newell kernel
+# follows its order for faces of up to 129 corners (the first plus 128).
+_MAX_CORNERS = 129
+
+
+@nb.njit(cache=True, inline="always")
+def _max(x: float, y: float) -> float:
+    """np.maximum: NaN if either is NaN."""
+    if x != x or y != y:
+        return math.nan
+    return x if x >= y else y
+
+
+@nb.njit(cache=True, inline="always")
+def _dot(x0: float, x1: float, x2: float, y0: float, y1: float, y2: float) -> float:
+    """einsum("ij,ij->i") of three components, in numpy's order."""
+    return (x0 * y0 + x2 * y2) + x1 * y1
+
+
+@nb.njit(cache=True, inline="always")
+def _norm(x0: float, x1: float, x2: float) -> float:
+    """np.linalg.norm(axis=1) of three components, in numpy's order."""
+    return math.sqrt((x0 * x0 + x1 * x1) + x2 * x2)
+
+
+@nb.njit(cache=True, inline="always")
+def _crossing_one(V, i0, i1, i2, i3, f, out_s, out_t, out_gap, out_plan):
+    """Diagonal crossing (and planarity when ``out_plan`` has rows) of quad ``f``: ``V[[i0, i1, i2, i3]]``."""
+    o0, o1, o2 = V[i0, 0], V[i0, 1], V[i0, 2]
+    scale = 0.0
+    for i in (i0, i1, i2, i3):
+        for j in range(3):
+            scale = _max(scale, abs(V[i, j] - V[i0, j]))
+    scale = _max(scale, TINY)
+    p0, p1, p2 = (V[i0, 0] - o0) / scale, (V[i0, 1] - o1) / scale, (V[i0, 2] - o2) / scale
+    q0, q1, q2 = (V[i1, 0] - o0) / scale, (V[i1, 1] - o1) / scale, (V[i1, 2] - o2) / scale
+    u0 = (V[i2, 0] - o0) / scale - p0
+    u1 = (V[i2, 1] - o1) / scale - p1
+    u2 = (V[i2, 2] - o2) / scale - p2
+    v0 = (V[i3, 0] - o0) / scale - q0
+    v1 = (V[i3, 1] - o1) / scale - q1
+    v2 = (V[i3, 2] - o2) / scale - q2
+    w0, w1, w2 = p0 - q0, p1 - q1, p2 - q2
+    a = _dot(u0, u1, u2, u0, u1, u2)
+    b = _dot(u0, u1, u2, v0, v1, v2)
+    c = _dot(v0, v1, v2, v0, v1, v2)
+    d = _dot(u0, u1, u2, w0, w1, w2)
+    e = _dot(v0, v1, v2, w0, w1, w2)
+    den = a * c - b * b
+    parallel = den <= ROUNDING_SQ * _max(a * c, TINY)
+    if parallel:
+        s = 0.0
+        t = e / _max(c, TINY)
+        x0, x1, x2 = w1 * u2 - w2 * u1, w2 * u0 - w0 * u2, w0 * u1 - w1 * u0
+        gap = _norm(x0, x1, x2) / math.sqrt(_max(a, TINY))
+    else:
+        s = (b * e - c * d) / den
+        t = (a * e - b * d) / den
+        x0, x1, x2 = u1 * v2 - u2 * v1, u2 * v0 - u0 * v2, u0 * v1 - u1 * v0
+        gap = abs(_dot(w0, w1, w2, x0, x1, x2)) / _max(_norm(x0, x1, x2), TINY)
+    gap = gap * scale
+    out_s[f] = s
+    out_t[f] = t
+    out_gap[f] = gap
+    if out_plan.shape[0]:
+        l1 = _norm(V[i2, 0] - V[i0, 0], V[i2, 1] - V[i0, 1], V[i2, 2] - V[i0, 2])
+        l2 = _norm(V[i3, 0] - V[i1, 0], V[i3, 1] - V[i1, 1], V[i3, 2] - V[i1, 2])
+        out_plan[f] = gap / _max(0.5 * (l1 + l2), TINY)
+
+
+@nb.njit(cache=True, nogil=True)
+def _crossing(V, Q, want_plan):
+    """Over quads ``V[Q]``; ``Q`` with no columns: the quads are ``V[4 f : 4 f + 4]``."""
+    F = Q.shape[0] if Q.shape[1] else V.shape[0] // 4
+    s = np.empty(F)
+    t = np.empty(F)
+    gap = np.empty(F)
+    plan = np.empty(F if want_plan else 0)
+    if Q.shape[1]:
+        for f in range(F):
+            _crossing_one(V, Q[f, 0], Q[f, 1], Q[f, 2], Q[f, 3], f, s, t, gap, plan)
+    else:
+        for f in range(F):
+            _crossing_one(V, 4 * f, 4 * f + 1, 4 * f + 2, 4 * f + 3, f, s, t, gap, plan)
+    return s, t, gap, plan
+
+
+_CORNERS = np.zeros((1, 0), np.int64)
+
+
+def _vq(V: np.ndarray, Q: np.ndarray | None) -> tuple[np.ndarray, np.ndarray]:
+    if Q is None:
+        return np.ascontiguousarray(V, dtype=np.float64).reshape(-1, 3), _CORNERS
+    return np.ascontiguousarray(V, dtype=np.float64), np.ascontiguousarray(Q, dtype=np.int64)
+
+
+def crossing(V: np.ndarray, Q: np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """:func:`ruledmesh.analysis.faces.quad_diagonal_crossing` of quads ``V[Q]``.
+
+    Parameters
+    ----------
+    V : (n, 3) float64
+        Points; (F, 4, 3) corners when ``Q`` is None.
+    Q : (F, 4) int, optional
+        Quad corners (indices into ``V``) in boundary order.
+
+    Returns
+    -------
+    s, t, gap : (F,) float64
+        As :func:`~ruledmesh.analysis.faces.quad_diagonal_crossing`, bit for bit.
+    """
+    s, t, gap, _ = _crossing(*_vq(V, Q), False)
+    return s, t, gap
+
+
+def quad_planarity(V: np.ndarray, Q: np.ndarray | None = None) -> np.ndarray:
+    """:func:`ruledmesh.analysis.faces.quad_planarity` of quads ``V[Q]``, bit for bit.
+
+    Parameters
+    ----------
+    V : (n, 3) float64
+        Points; (F, 4, 3) corners when ``Q`` is None.
+    Q : (F, 4) int, optional
+
+    Returns
+    -------
+    (F,) float64
+    """
+    return _crossing(*_vq(V, Q), True)[3]
+
+
+@nb.njit(cache=True, inline="always")
+def _pairwise(x, lo, n):
+    """numpy's pairwise sum of ``x[lo:lo + n]`` (n <= 128, the unrolled block)."""
+    if n < 8:
+        res = -0.0
+        for i in range(lo, lo + n):
+            res += x[i]
+        return res
+    r0, r1, r2, r3 = x[lo], x[lo + 1], x[lo + 2], x[lo + 3]
+    r4, r5, r6, r7 = x[lo + 4], x[lo + 5], x[lo + 6], x[lo + 7]
+    i = 8
+    while i < n - n % 8:
+        r0 += x[lo + i]
+        r1 += x[lo + i + 1]
+        r2 += x[lo + i + 2]
+        r3 += x[lo + i + 3]
+        r4 += x[lo + i + 4]
+        r5 += x[lo + i + 5]
+        r6 += x[lo + i + 6]
+        r7 += x[lo + i + 7]
+        i += 8
+    res = ((r0 + r1) + (r2 + r3)) + ((r4 + r5) + (r6 + r7))
+    while i < n:
+        res += x[lo + i]
+        i += 1
+    return res
+
+
+@nb.njit(cache=True, nogil=True)
+def _newell(V, idx, off):
+    F = off.shape[0] - 1
+    vec = np.zeros((F, 3))
+    area = np.empty(F)
+    normals = np.empty((F, 3))
+    cr = np.empty((3, _MAX_CORNERS))
+    for f in range(F):
+        lo, hi = off[f], off[f + 1]
+        n = hi - lo
+        o = idx[lo]
+        for k in range(n):
+            i = idx[lo + k]
+            j = idx[lo + k + 1] if k + 1 < n else idx[lo]
+            x0, x1, x2 = V[i, 0] - V[o, 0], V[i, 1] - V[o, 1], V[i, 2] - V[o, 2]
+            y0, y1, y2 = V[j, 0] - V[o, 0], V[j, 1] - V[o, 1], V[j, 2] - V[o, 2]
+            cr[0, k] = x1 * y2 - x2 * y1
+            cr[1, k] = x2 * y0 - x0 * y2
+            cr[2, k] = x0 * y1 - x1 * y0
+        for c in range(3):
+            if n == 0:
+                continue
+            vec[f, c] = 0.5 * (cr[c, 0] + _pairwise(cr[c], 1, n - 1)) if n > 1 else 0.5 * cr[c, 0]
+        area[f] = _norm(vec[f, 0], vec[f, 1], vec[f, 2])
+        g = _max(area[f], TINY)
+        for c in range(3):
+            normals[f, c] = vec[f, c] / g
+    return normals, area
+
+
+def newell(V: np.ndarray, idx: np.ndarray, off: np.ndarray) -> tuple[np.ndarray, np.ndarray] | None:
+    """:func:`ruledmesh.analysis.faces.face_normals` of a polygon mesh, bit for bit.
+
+    Parameters
+    ----------
+    V : (n, 3) float64
+    idx : (N,) int
+        Face corners, face after face.
+    off : (F + 1,) int
+        Start of each face in ``idx``.
+
+    Returns
+    -------
+    normals : (F, 3) float64
+    areas : (F,) float64
+        Or None for a mesh with a face of more than :data:`_MAX_CORNERS`
+        corners (numpy sums those in recursive halves): the caller runs numpy.
+    """
+    if len(off) > 1 and int(np.diff(off).max()) > _MAX_CORNERS:
+        return None
+    return _newell(np.ascontiguousarray(V, dtype=np.float64), np.ascontiguousarray(idx),
+                   np.ascontiguousarray(off))
+
+
+@nb.njit(cache=True, nogil=True)
+def _min_angles(V, idx, off):
+    F = off.shape[0] - 1
+    out = np.empty(F)
+    for f in range(F):
+        lo, hi = off[f], off[f + 1]
+        best = math.inf
+        nan = False
+        for k in range(lo, hi):
+            i = idx[k]
+            p = idx[k - 1] if k > lo else idx[hi - 1]
+            q = idx[k + 1] if k + 1 < hi else idx[lo]
+            x0, x1, x2 = V[p, 0] - V[i, 0], V[p, 1] - V[i, 1], V[p, 2] - V[i, 2]
+            y0, y1, y2 = V[q, 0] - V[i, 0], V[q, 1] - V[i, 1], V[q, 2] - V[i, 2]
+            cos = _dot(x0, x1, x2, y0, y1, y2)
+            sin = _norm(x1 * y2 - x2 * y1, x2 * y0 - x0 * y2, x0 * y1 - x1 * y0)
+            ang = math.atan2(sin, cos) * _DEG
+            if ang != ang:
+                nan = True
+            elif ang < best:
+                best = ang
+        out[f] = math.nan if nan else best
+    return out
+
+
+def min_angles(V: np.ndarray, idx: np.ndarray, off: np.ndarray) -> np.ndarray:
+    """:func:`ruledmesh.analysis.faces.face_min_angles` of a polygon mesh (degrees).
+
+    Parameters
+    ----------
+    V : (n, 3) float64
+    idx : (N,) int
+    off : (F + 1,) int
+        Every face has at least one corner.
+
+    Returns
+    -------
+    (F,) float64
+    """
+    return _min_angles(np.ascontiguousarray(V, dtype=np.float64), np.ascontiguousarray(idx),
+                       np.ascontiguousarray(off))
