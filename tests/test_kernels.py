@@ -18,7 +18,7 @@ from hypothesis import strategies as st
 
 from ruledmesh.analysis import faces
 from ruledmesh.pq import pq_mesh
-from ruledmesh.pq.runs import Division, mesh_run
+from ruledmesh.skew.pq.runs import Division, mesh_run
 from ruledmesh.tolerances import DEFAULT
 
 SETTINGS = settings(max_examples=25, deadline=None, suppress_health_check=[HealthCheck.function_scoped_fixture])
@@ -156,7 +156,7 @@ def _cache_roundtrip(site, tmp_path) -> None:
        twist=st.floats(0.1, 3.0), wobble=st.floats(0.0, 1.5))
 def test_strip_paths(monkeypatch, seed, m, rows, twist, wobble):
     """The trimming's kept halves, jumps and gaps, on the inputs a real build hands it."""
-    from ruledmesh.pq import assemble, strips
+    from ruledmesh.skew.pq import assemble, strips
 
     seen = []
     real = strips.strip_paths
@@ -183,7 +183,7 @@ def test_strip_paths(monkeypatch, seed, m, rows, twist, wobble):
        ties=st.booleans())
 def test_near_border(monkeypatch, seed, n, m, upper, ties):
     """Which generators' nearest vertex is the border point: sorting (numpy) or two minima (kernel)."""
-    from ruledmesh.pq import strips
+    from ruledmesh.skew.pq import strips
 
     rng = np.random.default_rng(seed)
     gi = rng.integers(0, m, n)

@@ -12,7 +12,7 @@ from ruledmesh.analysis.faces import face_min_angles, planarity
 from ruledmesh.design import build_design, build_file, parse_design
 from ruledmesh.mesh import FaceKind, Mesh
 from ruledmesh.pq import pq_mesh
-from ruledmesh.pq.flips import flip_triangles
+from ruledmesh.skew.pq.flips import flip_triangles
 from ruledmesh.tolerances import RESTART_ANGLE_DEG
 
 ROOT = Path(__file__).resolve().parents[1]

@@ -217,7 +217,7 @@ def _triangulated_grid(n, bend=0.0):
 
 def test_pairing_makes_quads_of_coplanar_triangle_pairs():
     from ruledmesh.analysis.faces import face_areas
-    from ruledmesh.pq.pairing import pair_triangles
+    from ruledmesh.skew.pq.pairing import pair_triangles
 
     mesh = _triangulated_grid(6)
     paired, made = pair_triangles(mesh, 1e-3)
@@ -232,7 +232,7 @@ def test_pairing_makes_quads_of_coplanar_triangle_pairs():
 
 
 def test_pairing_refuses_quads_beyond_the_tolerance():
-    from ruledmesh.pq.pairing import pair_triangles
+    from ruledmesh.skew.pq.pairing import pair_triangles
 
     mesh = _triangulated_grid(4, bend=0.05)
     loose, n_loose = pair_triangles(mesh, 0.1)

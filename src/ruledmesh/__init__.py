@@ -53,7 +53,7 @@ from .tolerances import Tolerances
 
 # name -> module that defines it; imported on first access (PEP 562).
 _LAZY = {
-    "pq_mesh": "ruledmesh.pq",
+    "pq_mesh": "ruledmesh.skew.pq",
     "hybrid_mesh": "ruledmesh.skew.hybrid",
     "planarity": "ruledmesh.analysis.faces",
 }

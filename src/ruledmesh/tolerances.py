@@ -171,7 +171,7 @@ DEPTH_BIAS = 1e-6
 #: (the figures are compared at the unit scale, where this is below any deflection asked for).
 OCCT_FACE = 1e-9
 
-# Edge flips of the triangles a PQ mesh keeps (ruledmesh.pq.flips).
+# Edge flips of the triangles a PQ mesh keeps (ruledmesh.skew.pq.flips).
 #: A flip must raise the pair's smallest angle by this much (degrees), so the rounds end.
 FLIP_MIN_GAIN_DEG = 1e-3
 #: The two triangles may bend against each other by at most this angle (degrees), before
@@ -184,7 +184,7 @@ FLIP_MAX_SAG = 2.5e-4
 FLIP_ACTIVE_DEG = 20.0
 
 # A §4.3 face whose smallest angle is below this (degrees) counts as failing: runs
-# end before such faces (ruledmesh.pq.runs).  The splinter bar of the analysis
+# end before such faces (ruledmesh.skew.pq.runs).  The splinter bar of the analysis
 # (ruledmesh.analysis.faces.SPLINTER_DEG); 4 deg cost 4 more points of triangle
 # share at 301 x 300 for 24 fewer splinters out of 200 000 faces.
 RESTART_ANGLE_DEG = 3.0

@@ -10,8 +10,8 @@ import numpy as np
 from .._validation import check_bool, check_float, check_int, check_keys, describe
 from ..budget import MAX_COUNT
 from ..errors import DesignError, GeometryError
-from ..pq import MAX_GRID_POINTS, pq_mesh
 from ..registry import BuildContext, Built, mesh_method
+from ..skew.pq import MAX_GRID_POINTS, pq_mesh
 from ..tolerances import DEFAULT, TINY
 
 __all__ = ["MESH_KEYS", "build_pq"]

@@ -1,9 +1,9 @@
-"""numba kernels of a run's grid (:mod:`ruledmesh.pq.runs`, :mod:`ruledmesh.pq.maps`).
+"""numba kernels of a run's grid (:mod:`ruledmesh.skew.pq.runs`, :mod:`ruledmesh.skew.pq.maps`).
 
 The rows are propagated hop by hop along the four chain ends exactly as
-:func:`ruledmesh.pq.maps.propagate` does (the same products, the same positive
+:func:`ruledmesh.skew.pq.maps.propagate` does (the same products, the same positive
 rescaling every eighth hop), and the vertices, half-faces, poles and the
-per-generator convexity counts of :func:`ruledmesh.pq.runs._grid` come from one
+per-generator convexity counts of :func:`ruledmesh.skew.pq.runs._grid` come from one
 pass over the grid instead of some forty array operations, each with its
 temporaries.  The results are bit for bit those of the numpy path (the tests
 compare both).
@@ -62,7 +62,7 @@ def _propagate(primary, root, fwd, bwd, C, tau):
 
 def propagate(primary: int, root: int, fwd: np.ndarray, bwd: np.ndarray, C: np.ndarray,
               tau: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """:func:`ruledmesh.pq.maps.propagate`, bit for bit.
+    """:func:`ruledmesh.skew.pq.maps.propagate`, bit for bit.
 
     Parameters
     ----------
@@ -152,7 +152,7 @@ def _faces(num, den, t, far, parity, Xc, first):
 
 def grid(a: np.ndarray, d: np.ndarray, num: np.ndarray, den: np.ndarray, tmax: np.ndarray,
          parity: np.ndarray, Xc: np.ndarray, first: int) -> tuple[np.ndarray, ...]:
-    """The arrays of :func:`ruledmesh.pq.runs._grid` from the propagated rows, bit for bit.
+    """The arrays of :func:`ruledmesh.skew.pq.runs._grid` from the propagated rows, bit for bit.
 
     Parameters
     ----------

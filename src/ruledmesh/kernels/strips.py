@@ -1,4 +1,4 @@
-"""numba kernel of the strip trimming of :func:`ruledmesh.pq.strips.strip_paths`.
+"""numba kernel of the strip trimming of :func:`ruledmesh.skew.pq.strips.strip_paths`.
 
 The same decisions in the same order: each kept PQ half-face is one step of
 its strip's monotone lattice path, a step claiming a path position already
@@ -173,7 +173,7 @@ def _all_ranked(rank_len, chain, gstart, L, R, ok_l, ok_r):
 
 def strip_paths(T: np.ndarray, chain: np.ndarray, gstart: np.ndarray, m: int, L: np.ndarray,
                 R: np.ndarray, ok_l: np.ndarray, ok_r: np.ndarray, CG: np.ndarray):
-    """:func:`ruledmesh.pq.strips.strip_paths`, the same results; None where it does not apply.
+    """:func:`ruledmesh.skew.pq.strips.strip_paths`, the same results; None where it does not apply.
 
     Parameters
     ----------
@@ -229,7 +229,7 @@ def _near_border(gi, ti, m, rel_len, upper, snap_step, snap_gap):
 
 def near_border(gi: np.ndarray, ti: np.ndarray, m: int, rel_len: np.ndarray, upper: bool,
                 snap_step: float, snap_gap: float) -> np.ndarray | None:
-    """:func:`ruledmesh.pq.strips._near_border` without sorting: the two smallest per generator.
+    """:func:`ruledmesh.skew.pq.strips._near_border` without sorting: the two smallest per generator.
 
     Parameters
     ----------

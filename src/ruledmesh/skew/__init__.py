@@ -10,8 +10,8 @@ them the way §2-§3's constructions are held in :mod:`ruledmesh.constructions`:
 * §4.2 *Compound surfaces from HP patches* -- :mod:`ruledmesh.skew.compound`:
   HP patches joined with C1 continuity, so every face is a planar quad
   (:func:`compound_net`, :func:`compound_mesh`).
-* §4.3 *General algorithm for PQ meshes on skew surfaces* -- the hop from
-  generator to generator, :func:`ruledmesh.pq.pq_mesh`.
+* §4.3 *General algorithm for PQ meshes on skew surfaces* -- :mod:`ruledmesh.skew.pq`:
+  the hop from generator to generator (:func:`pq_mesh`, also :func:`ruledmesh.pq.pq_mesh`).
 """
 
 from __future__ import annotations
@@ -25,6 +25,8 @@ from .compound import (
     compound_net,
 )
 from .hybrid import checkerboard_faces, hybrid_grid, hybrid_mesh, orient_generators
+from .pq import MAX_GRID_POINTS, pq_mesh, row_maps
 
-__all__ = ["CompoundReference", "CompoundSurface", "c1_residual", "c1_step", "checkerboard_faces",
-           "compound_mesh", "compound_net", "hybrid_grid", "hybrid_mesh", "orient_generators"]
+__all__ = ["MAX_GRID_POINTS", "CompoundReference", "CompoundSurface", "c1_residual", "c1_step",
+           "checkerboard_faces", "compound_mesh", "compound_net", "hybrid_grid", "hybrid_mesh",
+           "orient_generators", "pq_mesh", "row_maps"]

@@ -106,7 +106,7 @@ def check_limits(data: Mapping[str, Any], base_dir: Path) -> None:
     DesignError
         Naming the field and the limit.
     """
-    from ..pq import MAX_GRID_POINTS
+    from ..budget import MAX_GRID_POINTS
 
     def count_points(value: Any, field: str) -> None:
         if isinstance(value, list) and len(value) > MAX_CONTROL_POINTS:

@@ -18,7 +18,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..mesh import FaceKind, Mesh
+from ...mesh import FaceKind, Mesh
 
 __all__ = ["pair_triangles"]
 
@@ -75,7 +75,7 @@ def pair_triangles(mesh: Mesh, ptol: float, kinds: tuple[int, ...] | None = None
     int
         Number of quads made.
     """
-    from ..analysis.faces import polygon_angles, quad_diagonal_crossing, quad_planarity
+    from ...analysis.faces import polygon_angles, quad_diagonal_crossing, quad_planarity
 
     if kinds is None:
         kinds = (FaceKind.FILL, FaceKind.BORDER, FaceKind.SPLIT)

@@ -18,8 +18,8 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..mesh import FaceKind, Mesh
-from ..tolerances import FLIP_ACTIVE_DEG, FLIP_MAX_BEND_DEG, FLIP_MAX_SAG, FLIP_MIN_GAIN_DEG, TINY
+from ...mesh import FaceKind, Mesh
+from ...tolerances import FLIP_ACTIVE_DEG, FLIP_MAX_BEND_DEG, FLIP_MAX_SAG, FLIP_MIN_GAIN_DEG, TINY
 
 __all__ = ["flip_triangles"]
 
@@ -28,7 +28,7 @@ _ROUNDS = 40
 
 def _angles(P: np.ndarray) -> np.ndarray:
     """(F,) smallest interior angle, degrees, of triangles ``P`` (F, 3, 3)."""
-    from ..analysis.faces import polygon_angles
+    from ...analysis.faces import polygon_angles
 
     return polygon_angles(P).min(axis=1)
 

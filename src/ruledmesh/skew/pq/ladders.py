@@ -17,7 +17,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..tolerances import TINY
+from ...tolerances import TINY
 from .strips import Gaps
 
 __all__ = ["free_edges", "ladder_points"]

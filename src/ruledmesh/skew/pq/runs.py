@@ -20,11 +20,11 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..budget import MAX_GRID_POINTS, PQ_BYTES_PER_GRID_POINT
-from ..errors import GeometryError
-from ..hop import crossing_maps
-from ..kernels import wanted
-from ..tolerances import INTERIOR, RESTART_ANGLE_DEG, ROUNDING, TINY, Tolerances
+from ...budget import MAX_GRID_POINTS, PQ_BYTES_PER_GRID_POINT
+from ...errors import GeometryError
+from ...hop import crossing_maps
+from ...kernels import wanted
+from ...tolerances import INTERIOR, RESTART_ANGLE_DEG, ROUNDING, TINY, Tolerances
 from .maps import (
     ChainMaps,
     apply,

@@ -15,8 +15,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..hop import crossing_maps, landing_maps
-from ..tolerances import TINY
+from ...hop import crossing_maps, landing_maps
+from ...tolerances import TINY
 
 __all__ = [
     "ChainMaps",

@@ -12,8 +12,8 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..mesh import FaceKind, Mesh
-from ..tolerances import ROUNDING, Tolerances
+from ...mesh import FaceKind, Mesh
+from ...tolerances import ROUNDING, Tolerances
 from .ladders import free_edges, ladder_points
 from .runs import Run
 from .strips import ON_BORDER, Gaps, chains, strip_paths, zippers
@@ -55,7 +55,7 @@ def _join(parts: list[Run]):
 
 def _crossing_t(V, T, L, R, lo, hi, both):
     """Parameter on its generator where each face's hop diagonal crosses it (nan without both halves)."""
-    from ..analysis.faces import quad_diagonal_crossing
+    from ...analysis.faces import quad_diagonal_crossing
 
     tc = np.full(len(L), np.nan)
     f = np.flatnonzero(both)
@@ -108,7 +108,7 @@ def _strip_quads(V, chain, gstart, gaps: Gaps, ptol: float):
     use : (n_gaps,) bool
     quads : (q, 4) int64
     """
-    from ..analysis.faces import quad_diagonal_crossing, quad_planarity
+    from ...analysis.faces import quad_diagonal_crossing, quad_planarity
 
     even = (gaps.na == gaps.nb) & (gaps.na > 0)
     ge = np.flatnonzero(even)
@@ -182,7 +182,7 @@ def assemble(parts: list[Run], a, d, trim: bool, tol: Tolerances, ptol: float,
              warnings: list[str], scale: float, meet: np.ndarray | None = None,
              rows: int = 20) -> Mesh:
     """Join the runs; keep convex quads and valid halves; close the strips; add members."""
-    from ..analysis.faces import quad_diagonal_crossing
+    from ...analysis.faces import quad_diagonal_crossing
 
     m = len(a)
     if not parts:

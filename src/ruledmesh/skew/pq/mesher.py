@@ -6,12 +6,12 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .._validation import check_bool, check_float, check_int, check_points, describe
-from ..errors import GeometryError, ParameterError
-from ..hop import coplanarity
-from ..mesh import Mesh
-from ..normalise import normalised
-from ..tolerances import DEFAULT, PARAMETER_SLACK, Tolerances
+from ..._validation import check_bool, check_float, check_int, check_points, describe
+from ...errors import GeometryError, ParameterError
+from ...hop import coplanarity
+from ...mesh import Mesh
+from ...normalise import normalised
+from ...tolerances import DEFAULT, PARAMETER_SLACK, Tolerances
 from .assemble import assemble
 from .flips import flip_triangles
 from .pairing import pair_triangles
@@ -506,7 +506,7 @@ def _even_ranges(parts: list[Run], segs: list[_Segment], warnings: list[str]) ->
 def _warn_share(mesh: Mesh, warnings: list[str], torsal: int, even: list[str], restarts: int,
                 m: int, rows: int) -> None:
     """Say so when much of the area is not in quads, with the causes and what to change."""
-    from ..analysis.faces import area_shares
+    from ...analysis.faces import area_shares
 
     if mesh.n_faces == 0:
         return
@@ -538,7 +538,7 @@ def _paired(mesh: Mesh, ptol: float, tol: Tolerances) -> tuple[Mesh, int]:
 
 def _warn_splinters(mesh: Mesh, warnings: list[str], torsal: np.ndarray) -> None:
     """Say how many faces are splinters for fabrication, where, and next to what."""
-    from ..analysis.faces import SPLINTER_DEG, face_min_angles
+    from ...analysis.faces import SPLINTER_DEG, face_min_angles
 
     if mesh.n_faces == 0:
         return
@@ -577,7 +577,7 @@ def _warn_splinters(mesh: Mesh, warnings: list[str], torsal: np.ndarray) -> None
 
 def _nearly_flat(a: np.ndarray, d: np.ndarray, rows: int, ptol: float) -> np.ndarray:
     """Strips whose strip quads (a uniform division) are planar within ``ptol``."""
-    from ..analysis.faces import quad_planarity
+    from ...analysis.faces import quad_planarity
 
     t = np.linspace(0.0, 1.0, max(rows // 2, 1) + 1)
     P0 = a[:-1, None, :] + t[None, :, None] * d[:-1, None, :]

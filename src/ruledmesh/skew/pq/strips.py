@@ -15,8 +15,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..kernels import wanted
-from ..tolerances import ON_BORDER, SNAP_GAP, TINY
+from ...kernels import wanted
+from ...tolerances import ON_BORDER, SNAP_GAP, TINY
 
 __all__ = ["ON_BORDER", "Gaps", "chains", "group_starts", "strip_paths", "zippers"]
 

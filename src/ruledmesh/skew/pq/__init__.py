@@ -13,12 +13,12 @@ with one diagonal on the generator ``g_i`` and the other on a hop line that
 crosses ``g_i``: two intersecting lines, so every face is planar by
 construction, up to rounding that does not accumulate.
 
-- :mod:`~ruledmesh.pq.maps`: the rows as Moebius maps of the line parameter,
+- :mod:`~ruledmesh.skew.pq.maps`: the rows as Moebius maps of the line parameter,
   propagated hop by hop; the drift between the two chains.
-- :mod:`~ruledmesh.pq.runs`: one run's grid; chain *b* rooted where its faces
+- :mod:`~ruledmesh.skew.pq.runs`: one run's grid; chain *b* rooted where its faces
   stay convex; matched divisions for runs that meet on a generator.
-- :mod:`~ruledmesh.pq.mesher`: torsal generators, restarts, the whole mesh.
-- :mod:`~ruledmesh.pq.strips` and :mod:`~ruledmesh.pq.assemble`: trimming to
+- :mod:`~ruledmesh.skew.pq.mesher`: torsal generators, restarts, the whole mesh.
+- :mod:`~ruledmesh.skew.pq.strips` and :mod:`~ruledmesh.skew.pq.assemble`: trimming to
   the patch with every vertex on a generator, closing the strips.
 """
 
