@@ -80,7 +80,8 @@ def check_budget(points: float, bytes_per_point: int, what: str, advice: str, fi
     field : str
         The parameter or field path the message names.
     err : type
-        The error class (``ParameterError`` or ``DesignError``): called as ``err(message, field)``.
+        The error class (``ParameterError``, or the design layer's error): called as
+        ``err(message, field)``.
     """
     need = float(points) * bytes_per_point
     if need > MAX_BUILD_BYTES:
