@@ -310,7 +310,34 @@ def _failing_faces(a, d, t, far, ic, hl, hc, pole, m) -> tuple[np.ndarray, np.nd
     between = (tc - t0) * (tc - t1) < 0
     np.add.at(failing, i[on_patch & (~between | _thin(a, d, t, i, lo, c))], 1)
     np.add.at(counted, i[on_patch], 1)
+    _thin_ends(a, d, t, far, ic, hl, hc, m, failing, counted)
     return failing, counted
+
+
+def _thin_ends(a, d, t, far, ic, hl, hc, m, failing, counted) -> None:
+    """Count the notch halves on the run's end generators that are slivers (in place).
+
+    A face centred on an end generator keeps one half, which is a triangle of
+    the mesh; a sliver there counts against the generator next to the end, so
+    the run is cut before it.
+    """
+    for end, side, inner in ((0, 1, 1), (m - 1, -1, m - 2)):
+        sel = np.flatnonzero(ic == end)
+        if sel.size == 0:
+            continue
+        lo, c = hl[sel], hc[sel]
+        ok = ~far[end, lo] & ~far[end, lo + 1] & ~far[end + side, c] \
+            & (t[end, lo] >= 0.0) & (t[end, lo + 1] <= 1.0)
+        P = np.stack([a[end] + t[end, lo][:, None] * d[end],
+                      a[end + side] + t[end + side, c][:, None] * d[end + side],
+                      a[end] + t[end, lo + 1][:, None] * d[end]], axis=1)
+        u = np.roll(P, 1, axis=1) - P
+        w = np.roll(P, -1, axis=1) - P
+        cos = np.einsum("fkc,fkc->fk", u, w) / np.maximum(
+            np.linalg.norm(u, axis=2) * np.linalg.norm(w, axis=2), TINY)
+        thin = np.degrees(np.arccos(np.clip(cos, -1.0, 1.0))).min(axis=1) < RESTART_ANGLE_DEG
+        failing[inner] += int(np.count_nonzero(ok & thin))
+        counted[inner] += int(np.count_nonzero(ok))
 
 
 def _thin(a, d, t, i, lo, c) -> np.ndarray:
