@@ -1201,7 +1201,8 @@ class BSpline(Curve):
     @property
     def _knot_vector(self) -> np.ndarray:
         # __post_init__ always sets the knots; the None is only the constructor's default
-        assert self.knots is not None
+        if self.knots is None:
+            raise GeometryError("the B-spline has no knot vector")
         return self.knots
 
     @cached_property

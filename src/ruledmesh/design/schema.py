@@ -303,7 +303,8 @@ def _curve_values(reader: Any, table: _Table) -> None:
     """
     module = inspect.getmodule(reader)
     fn = ast.parse(inspect.getsource(reader)).body[0]
-    assert isinstance(fn, ast.FunctionDef)
+    if not isinstance(fn, ast.FunctionDef):
+        raise TypeError(f"curve reader {reader!r} is not a plain function: its schema cannot be read")
     t = fn.args.args[0].arg
     parents = {child: node for node in ast.walk(fn) for child in ast.iter_child_nodes(node)}
     for node in ast.walk(fn):

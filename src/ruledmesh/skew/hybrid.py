@@ -273,7 +273,9 @@ def _fan(V: np.ndarray, poly: list[int]) -> list[list[int]]:
         score = signed.min() if np.all(signed > 0) else signed.min() - 1e300
         if score > best_score:
             best, best_score = tri, score
-    assert best is not None  # every start vertex gives a fan; the first one always wins over -inf
+    if best is None:
+        # Every start vertex gives a fan and the first beats -inf, unless the corners are not finite.
+        raise GeometryError(f"a polygon of {n} corners has corners that are not finite numbers")
     return best.tolist()
 
 
