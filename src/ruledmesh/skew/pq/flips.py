@@ -20,6 +20,7 @@ import numpy as np
 
 from ...mesh import FaceKind, Mesh
 from ...tolerances import FLIP_ACTIVE_DEG, FLIP_MAX_BEND_DEG, FLIP_MAX_SAG, FLIP_MIN_GAIN_DEG, TINY
+from .pairing import adjacent_triangles
 
 __all__ = ["flip_triangles"]
 
@@ -48,25 +49,6 @@ def _edge_keys(mesh_faces: list[np.ndarray], n: int) -> np.ndarray:
     return np.unique(np.concatenate(keys)) if keys else np.zeros(0, np.int64)
 
 
-def _pairs(tri: np.ndarray, n: int):
-    """Triangles sharing a manifold edge: (t1, t2, a, b, c, d) with t1 = (b, c, a), t2 = (c, b, d)."""
-    e_from = tri.reshape(-1)
-    e_to = np.roll(tri, -1, axis=1).reshape(-1)
-    key = np.minimum(e_from, e_to) * n + np.maximum(e_from, e_to)
-    order = np.argsort(key, kind="stable")
-    ks = key[order]
-    pair = np.flatnonzero(ks[1:] == ks[:-1])
-    if len(pair) > 1:
-        single = np.r_[True, pair[1:] != pair[:-1] + 1] & np.r_[pair[:-1] + 1 != pair[1:], True]
-        pair = pair[single]
-    s1, s2 = order[pair], order[pair + 1]
-    ok = (s1 // 3 != s2 // 3) & (e_from[s1] == e_to[s2])
-    s1, s2 = s1[ok], s2[ok]
-    t1, j1, t2, j2 = s1 // 3, s1 % 3, s2 // 3, s2 % 3
-    return (t1, t2, tri[t1, (j1 + 2) % 3], tri[t1, j1], tri[t1, (j1 + 1) % 3],
-            tri[t2, (j2 + 2) % 3])
-
-
 def _round(V: np.ndarray, tri: np.ndarray, fixed: np.ndarray, scale: float) -> int:
     """One round of mutual-best flips on ``tri`` (in place); the number made.
 
@@ -74,7 +56,7 @@ def _round(V: np.ndarray, tri: np.ndarray, fixed: np.ndarray, scale: float) -> i
     left out of the rounds): a flip may not make one of those edges again.
     """
     n = len(V)
-    t1, t2, a, b, c, d = _pairs(tri, n)
+    t1, t2, a, b, c, d = adjacent_triangles(tri, n)
     if t1.size == 0:
         return 0
     A, B, C, D = V[a], V[b], V[c], V[d]
@@ -132,7 +114,7 @@ def _active(V: np.ndarray, tri: np.ndarray) -> np.ndarray:
     thin = _angles(V[tri]) < FLIP_ACTIVE_DEG
     if not thin.any():
         return thin
-    t1, t2, *_ = _pairs(tri, len(V))
+    t1, t2, *_ = adjacent_triangles(tri, len(V))
     near = thin.copy()
     near[t2[thin[t1]]] = True
     near[t1[thin[t2]]] = True

@@ -204,10 +204,7 @@ def _single_generators(a: np.ndarray, d: np.ndarray, rows: int, warnings: list[s
     second is left out, and every vertex still lies on a given generator.
     """
     m = len(a)
-    step = np.linalg.norm(d[:-1], axis=1) / max(rows, 1)
-    gap = np.max([np.linalg.norm((a[1:] + t * d[1:]) - (a[:-1] + t * d[:-1]), axis=1)
-                  for t in (0.0, 0.5, 1.0)], axis=0)
-    double = gap < _DOUBLE * step
+    double = _strip_gaps(a, d, rows) < _DOUBLE
     if not double.any():
         return np.arange(m)
     keep = np.r_[True, ~double]
@@ -249,9 +246,14 @@ def _narrow_strips(a: np.ndarray, d: np.ndarray, rows: int) -> np.ndarray:
     Indexed like the twists (strip ``k`` between generators ``k`` and ``k + 1``)
     and padded to that length.
     """
-    ends = [np.linalg.norm((a[1:] + t * d[1:]) - (a[:-1] + t * d[:-1]), axis=1) for t in (0.0, 0.5, 1.0)]
-    step = np.linalg.norm(d[:-1], axis=1) / max(rows, 1)
-    return np.max(ends, axis=0) < _NARROW * step
+    return _strip_gaps(a, d, rows) < _NARROW
+
+
+def _strip_gaps(a: np.ndarray, d: np.ndarray, rows: int) -> np.ndarray:
+    """(m - 1,) largest distance of consecutive generators (at t = 0, 1/2, 1), in row steps."""
+    gap = np.max([np.linalg.norm((a[1:] + t * d[1:]) - (a[:-1] + t * d[:-1]), axis=1)
+                  for t in (0.0, 0.5, 1.0)], axis=0)
+    return gap / (np.linalg.norm(d[:-1], axis=1) / max(rows, 1))
 
 
 def _listed(ks: np.ndarray) -> str:

@@ -20,37 +20,44 @@ import numpy as np
 
 from ...mesh import FaceKind, Mesh
 
-__all__ = ["pair_triangles"]
+__all__ = ["adjacent_triangles", "pair_triangles"]
 
 # A paired quad's diagonals must cross at least this share of each diagonal from its ends.
 _MIN_CROSSING = 0.05
 _ROUNDS = 6
 
 
-def _candidates(V: np.ndarray, tri: np.ndarray):
-    """Every pair of triangles sharing an edge, as quads (t1, t2, corners)."""
+def adjacent_triangles(tri: np.ndarray, n: int):
+    """Triangles sharing a manifold edge, consistently oriented.
+
+    Parameters
+    ----------
+    tri : (T, 3) int
+        Triangles as vertex indices below ``n``.
+    n : int
+        Number of vertices.
+
+    Returns
+    -------
+    t1, t2, a, b, c, d : (P,) int
+        Rows of the two triangles, ``t1 = (b, c, a)`` and ``t2 = (c, b, d)``:
+        ``b c`` is the shared edge, ``a`` and ``d`` the corners opposite it.
+    """
     e_from = tri.reshape(-1)
     e_to = np.roll(tri, -1, axis=1).reshape(-1)
-    lo, hi = np.minimum(e_from, e_to), np.maximum(e_from, e_to)
-    key = lo * (int(V.shape[0]) + 1) + hi
+    key = np.minimum(e_from, e_to) * (n + 1) + np.maximum(e_from, e_to)
     order = np.argsort(key, kind="stable")
     ks = key[order]
     pair = np.flatnonzero(ks[1:] == ks[:-1])
-    # An edge used by more than two triangles is not a manifold edge: never merge across it.
-    single = np.ones(len(pair), bool)
+    # An edge used by more than two triangles is not a manifold edge: never pair across it.
     if len(pair) > 1:
-        single &= np.r_[True, pair[1:] != pair[:-1] + 1] & np.r_[pair[:-1] + 1 != pair[1:], True]
-    pair = pair[single]
+        pair = pair[np.r_[True, pair[1:] != pair[:-1] + 1] & np.r_[pair[:-1] + 1 != pair[1:], True]]
     s1, s2 = order[pair], order[pair + 1]
-    t1, j1 = s1 // 3, s1 % 3
-    t2, j2 = s2 // 3, s2 % 3
-    ok = (t1 != t2) & (e_from[s1] == e_to[s2])      # opposite orientation: consistent sides
-    t1, j1, t2, j2 = t1[ok], j1[ok], t2[ok], j2[ok]
-    a = tri[t1, (j1 + 2) % 3]
-    b = tri[t1, j1]
-    c = tri[t1, (j1 + 1) % 3]
-    d = tri[t2, (j2 + 2) % 3]
-    return t1, t2, np.stack([a, b, d, c], axis=1)
+    ok = (s1 // 3 != s2 // 3) & (e_from[s1] == e_to[s2])      # opposite orientation: consistent sides
+    s1, s2 = s1[ok], s2[ok]
+    t1, j1, t2, j2 = s1 // 3, s1 % 3, s2 // 3, s2 % 3
+    return (t1, t2, tri[t1, (j1 + 2) % 3], tri[t1, j1], tri[t1, (j1 + 1) % 3],
+            tri[t2, (j2 + 2) % 3])
 
 
 def pair_triangles(mesh: Mesh, ptol: float, kinds: tuple[int, ...] | None = None) -> tuple[Mesh, int]:
@@ -85,7 +92,8 @@ def pair_triangles(mesh: Mesh, ptol: float, kinds: tuple[int, ...] | None = None
         return mesh, 0
     V = mesh.vertices
     tri = mesh.face_indices[mesh.face_offsets[ids][:, None] + np.arange(3)]
-    t1, t2, quad = _candidates(V, tri)
+    t1, t2, a, b, c, d = adjacent_triangles(tri, len(V))
+    quad = np.stack([a, b, d, c], axis=1)
     if t1.size == 0:
         return mesh, 0
     P = V[quad]

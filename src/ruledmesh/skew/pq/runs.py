@@ -331,11 +331,7 @@ def _thin_ends(a, d, t, far, ic, hl, hc, m, failing, counted) -> None:
         P = np.stack([a[end] + t[end, lo][:, None] * d[end],
                       a[end + side] + t[end + side, c][:, None] * d[end + side],
                       a[end] + t[end, lo + 1][:, None] * d[end]], axis=1)
-        u = np.roll(P, 1, axis=1) - P
-        w = np.roll(P, -1, axis=1) - P
-        cos = np.einsum("fkc,fkc->fk", u, w) / np.maximum(
-            np.linalg.norm(u, axis=2) * np.linalg.norm(w, axis=2), TINY)
-        thin = np.degrees(np.arccos(np.clip(cos, -1.0, 1.0))).min(axis=1) < RESTART_ANGLE_DEG
+        thin = _sliver(P)
         failing[inner] += int(np.count_nonzero(ok & thin))
         counted[inner] += int(np.count_nonzero(ok))
 
@@ -351,11 +347,14 @@ def _thin(a, d, t, i, lo, c) -> np.ndarray:
     P = np.stack([a[i - 1] + t[i - 1, c][:, None] * d[i - 1], a[i] + t[i, lo][:, None] * d[i],
                   a[i + 1] + t[i + 1, c][:, None] * d[i + 1], a[i] + t[i, lo + 1][:, None] * d[i]],
                  axis=1)
-    u = np.roll(P, 1, axis=1) - P
-    w = np.roll(P, -1, axis=1) - P
-    norms = np.linalg.norm(u, axis=2) * np.linalg.norm(w, axis=2)
-    cos = np.einsum("fkc,fkc->fk", u, w) / np.maximum(norms, TINY)
-    return np.degrees(np.arccos(np.clip(cos, -1.0, 1.0))).min(axis=1) < RESTART_ANGLE_DEG
+    return _sliver(P)
+
+
+def _sliver(P: np.ndarray) -> np.ndarray:
+    """(F,) bool: polygons ``P`` (F, k, 3) with a corner angle below :data:`RESTART_ANGLE_DEG`."""
+    from ...analysis.faces import polygon_angles
+
+    return polygon_angles(P).min(axis=1) < RESTART_ANGLE_DEG
 
 
 def carrier(a: np.ndarray, d: np.ndarray, first: int, t: np.ndarray) -> Run:
