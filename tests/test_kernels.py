@@ -13,6 +13,7 @@ import sys
 import textwrap
 
 import numpy as np
+from _shared import SMALL_DESIGN  # a helper module of tests/ (see conftest.py)
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
@@ -115,6 +116,40 @@ def test_small_stage_stays_numpy(monkeypatch):
     env = {k: v for k, v in os.environ.items() if k != "RULEDMESH_KERNELS"}
     run = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, env=env,
                          timeout=300, check=False)
+    assert run.returncode == 0, run.stderr[-2000:]
+
+
+def test_designer_worker_compiles_every_kernel_before_its_first_edit():
+    """Regression (CI, edit 327 of a live session): the kernels compiled inside an edit that
+    crossed MIN_WORK, took over the 20 s limit and the edit was refused.  After the worker's
+    warm-up, builds of other designs and sizes compile nothing more."""
+    code = textwrap.dedent("""
+        import numba
+        from ruledmesh import kernels
+        from ruledmesh.design import build_design, parse_design
+        from ruledmesh.web.builder import _warm_up
+        from ruledmesh.web.session import DEFAULT_DESIGN, frame_data
+
+        default = parse_design(DEFAULT_DESIGN)
+        assert _warm_up(lambda: frame_data(default.data, build_design(default)))
+
+        def compiled():
+            return {(m.__name__, k): len(v.signatures) for m in (kernels.geometry, kernels.grid,
+                    kernels.strips) for k, v in vars(m).items()
+                    if isinstance(v, numba.core.registry.CPUDispatcher)}
+
+        before = compiled()
+        assert sum(before.values()) > 0
+        for text in (%r, DEFAULT_DESIGN.replace("count = 41", "count = 90").replace("rows = 40",
+                     "rows = 7").replace('primary = "middle"', 'primary = 3')):
+            d = parse_design(text)
+            frame_data(d.data, build_design(d))
+        assert compiled() == before, {k: (before.get(k), v) for k, v in compiled().items()
+                                      if before.get(k) != v}
+    """) % (SMALL_DESIGN,)
+    env = {k: v for k, v in os.environ.items() if k != "RULEDMESH_KERNELS"}
+    run = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, env=env,
+                         timeout=600, check=False)
     assert run.returncode == 0, run.stderr[-2000:]
 
 

@@ -15,7 +15,10 @@ good part of a second in numpy), or when the process has put :data:`MIN_WORK`
 items through the stages (a designer or a notebook rebuilding the same design
 over and over); once loaded they are used for every size.  A one-off build of a
 small design never imports numba.  An application that knows it will rebuild
-live (a server) calls :func:`load` at start instead.  ``RULEDMESH_KERNELS=0`` forces numpy
+live (a server) calls :func:`load` at start and runs one build inside
+:func:`everywhere`, so that compiling (or loading from the cache) happens
+while it starts and never inside an edit that happens to cross
+:data:`MIN_WORK`.  ``RULEDMESH_KERNELS=0`` forces numpy
 everywhere, ``=1`` the kernels everywhere (the tests use both); the results are
 the same either way.
 
@@ -27,14 +30,16 @@ temporary directory.
 
 from __future__ import annotations
 
+import contextlib
 import importlib
 import os
 import sys
 import tempfile
+from collections.abc import Iterator
 from pathlib import Path
 from types import ModuleType
 
-__all__ = ["MIN_ITEMS", "MIN_WORK", "load", "wanted"]
+__all__ = ["MIN_ITEMS", "MIN_WORK", "everywhere", "load", "wanted"]
 
 #: Items (faces, grid points) from which a single stage loads the kernels.
 MIN_ITEMS = 100_000
@@ -42,6 +47,8 @@ MIN_ITEMS = 100_000
 MIN_WORK = 1_000_000
 
 _work = [0]
+# Depth of open :func:`everywhere` blocks.
+_forced = [0]
 
 _state: dict[str, ModuleType | bool | None] = {"geometry": None, "grid": None, "strips": None, "failed": False}
 
@@ -108,7 +115,7 @@ def wanted(items: int, name: str = "geometry") -> ModuleType | None:
     if mode in ("0", "off", "numpy"):
         return None
     _work[0] += items
-    if mode in ("1", "on", "numba") or items >= MIN_ITEMS or _work[0] >= MIN_WORK or _loaded():
+    if _forced[0] or mode in ("1", "on", "numba") or items >= MIN_ITEMS or _work[0] >= MIN_WORK or _loaded():
         return _load(name)
     return None
 
@@ -126,3 +133,19 @@ def load() -> bool:
     if _mode() in ("0", "off", "numpy"):
         return False
     return all(_load(name) is not None for name in ("geometry", "grid", "strips"))
+
+
+@contextlib.contextmanager
+def everywhere() -> Iterator[None]:
+    """Use the kernels for every stage inside the block, whatever its size.
+
+    numba compiles a kernel on its first call (or loads it from the on-disk
+    cache); a build of a small design inside this block does that for every
+    kernel the mesher calls, so a live application pays it at start.
+    ``RULEDMESH_KERNELS=0`` still wins: then the block changes nothing.
+    """
+    _forced[0] += 1
+    try:
+        yield
+    finally:
+        _forced[0] -= 1

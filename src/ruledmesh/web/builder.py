@@ -70,8 +70,8 @@ def _worker_main(conn) -> None:  # pragma: no cover - runs in the child process
     from .session import DEFAULT_DESIGN, frame_data
 
     load_plugins()
-    build_design(parse_design(DEFAULT_DESIGN))  # imports the mesher's modules (lazy elsewhere)
-    conn.send(("ready", None))  # the time limit counts from here
+    default = parse_design(DEFAULT_DESIGN)
+    conn.send(("ready", _warm_up(lambda: frame_data(default.data, build_design(default)))))
     while True:
         try:
             job = conn.recv()
@@ -106,6 +106,26 @@ def _worker_main(conn) -> None:  # pragma: no cover - runs in the child process
                 conn.send(("bug", f"cannot return the result: {reply[0]}"))
             except OSError:
                 return
+
+
+def _warm_up(build: Any) -> bool:
+    """Import the mesher and compile its kernels before the first edit; whether they are in use.
+
+    ``build`` builds the default design and makes its frame.  The kernels are used once a worker
+    has put :data:`~ruledmesh.kernels.MIN_WORK` items through the mesher, which
+    a designer session reaches after a few hundred edits; compiling them then
+    (about 15 s on a new installation, a second from numba's cache) would
+    happen inside that edit's time limit and refuse it.  So they compile here,
+    in the start-up time, with one build that calls every one of them.
+    """
+    from .. import kernels
+
+    build()  # imports the mesher's modules (lazy elsewhere)
+    if not kernels.load():
+        return False
+    with kernels.everywhere():
+        build()
+    return True
 
 
 def spawn_worker(ctx: Any, target: Any, name: str) -> tuple[Any, Any]:
@@ -210,19 +230,24 @@ class BuildWorker(InProcessBuilder):
         self._proc: Any = None
         self._conn: Any = None
         self._closed = False
+        #: Whether the running worker builds with the compiled kernels (known once it started).
+        self.kernels: bool | None = None
 
     # ---------------------------------------------------------------- process
     def _start(self) -> None:
         proc, parent = spawn_worker(self._ctx, _worker_main, "ruledmesh-build")
         self._proc, self._conn = proc, parent
-        # Importing numpy and scipy takes a second or more on a busy machine: not build time.
+        # Importing numpy and scipy takes a second or more on a busy machine, compiling the
+        # kernels on a new installation 15 s or more: neither is build time.
         try:
             deadline = time.monotonic() + STARTUP_SECONDS
             while not parent.poll(0.05):
                 if self._closed or time.monotonic() > deadline or not proc.is_alive():
                     raise EOFError
-            if parent.recv()[0] != "ready":
+            kind, kernels = parent.recv()
+            if kind != "ready":
                 raise EOFError
+            self.kernels = bool(kernels)
         except (EOFError, OSError):
             self._stop()
             raise RuledMeshError("the build process did not start") from None
