@@ -24,7 +24,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 __all__ = ["BRENTQ_XTOL", "COLLINEAR", "COLLINEAR_SQ", "CONGRUENCE_ANGLE_DEG", "CONVERGED",
-           "DEFAULT", "DEPTH_BIAS", "FLIP_ACTIVE_DEG", "FLIP_MAX_BEND_DEG", "FLIP_MAX_SAG",
+           "COLLAPSE_MAX_SAG", "DEFAULT", "DEPTH_BIAS", "FLIP_ACTIVE_DEG", "FLIP_MAX_BEND_DEG", "FLIP_MAX_SAG",
            "FLIP_MIN_GAIN_DEG", "FLOAT32_WARNING", "INTERIOR", "KKT_REGULARISATION",
            "MIN_EXTENT", "MIN_HALF_ANGLE", "MIN_RELATIVE_EXTENT", "MITRE_FLOOR", "OCCT_FACE",
            "ON_BORDER", "PARAMETER_SLACK", "PLANARITY_FLOOR", "RESTART_ANGLE_DEG", "ROOT_RTOL", "ROOT_XTOL",
@@ -182,6 +182,9 @@ FLIP_MAX_BEND_DEG = 20.0
 FLIP_MAX_SAG = 2.5e-4
 # Only triangles with an angle below this (and their neighbours) are worth flipping.
 FLIP_ACTIVE_DEG = 20.0
+#: A triangle-only vertex collapsed into a neighbour (ruledmesh.skew.pq.collapses) may lie
+#: at most this share of the patch diagonal off the plane of each face it leaves behind.
+COLLAPSE_MAX_SAG = 2.5e-4
 
 # A §4.3 face whose smallest angle is below this (degrees) counts as failing: runs
 # end before such faces (ruledmesh.skew.pq.runs).  The splinter bar of the analysis

@@ -13,6 +13,7 @@ from ...mesh import Mesh
 from ...normalise import normalised
 from ...tolerances import DEFAULT, PARAMETER_SLACK, Tolerances
 from .assemble import assemble
+from .collapses import collapse_splinters
 from .flips import flip_triangles
 from .pairing import pair_triangles
 from .runs import (
@@ -383,8 +384,13 @@ def _cut(a, d, rows, ptol, scale, tol, creases, crease_generators, warnings):
 
 
 def _fattened(mesh: Mesh, ptol: float, tol: Tolerances) -> tuple[Mesh, int, int]:
-    """Flip the triangles for their angles, pair them in tolerance mode, flip what is left."""
+    """Flip the triangles for their angles, collapse what flips cannot fatten, pair the
+    triangles in tolerance mode, flip what is left."""
     mesh, flips = flip_triangles(mesh)
+    mesh, collapsed = collapse_splinters(mesh)
+    if collapsed:
+        mesh, more = flip_triangles(mesh)
+        flips += more
     mesh, paired = _paired(mesh, ptol, tol)
     if paired:
         mesh, more = flip_triangles(mesh)

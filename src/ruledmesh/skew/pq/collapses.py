@@ -1,0 +1,316 @@
+"""Half-edge collapses that remove the splinters flips cannot.
+
+Where two generators nearly meet (a conoid's generators close to its director
+curve, the strips beside a torsal generator), the triangles between them are
+needles whatever their diagonals: the two rows of vertices are a small share of
+a row step apart.  A vertex that belongs to triangles only may go instead: its
+triangles are re-pointed at a neighbour (``v`` collapses into ``u``), the one or
+two triangles on the edge ``u v`` disappear, and every corner left is still a
+vertex on a generator, so every face stays planar.  Quads and their corners are
+never touched.
+
+A collapse is taken only where it raises the smallest angle of the faces around
+``v``, folds none of them (each new face's normal stays within
+:data:`~ruledmesh.tolerances.FLIP_MAX_BEND_DEG` of its old one, or of the
+area-weighted normal of the faces around ``v`` where the old one was a
+splinter), keeps the surface (``v`` lies
+within :data:`~ruledmesh.tolerances.COLLAPSE_MAX_SAG` of the diagonal from the
+faces left around it), keeps the mesh a manifold (the link condition: ``u`` and
+``v`` share no neighbour but the corners opposite their edge) and keeps the
+border where it is (a border vertex collapses only along a border edge).
+Collapses are chosen by rounds of best choice, whole arrays per round.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from ...mesh import FaceKind, Mesh, offsets_from_valences
+from ...tolerances import COLLAPSE_MAX_SAG, FLIP_MAX_BEND_DEG, FLIP_MIN_GAIN_DEG, RESTART_ANGLE_DEG, TINY
+
+__all__ = ["collapse_splinters"]
+
+_ROUNDS = 12
+
+
+def _angles(P: np.ndarray) -> np.ndarray:
+    from ...analysis.faces import polygon_angles
+
+    return polygon_angles(P)
+
+
+def _normals(P: np.ndarray) -> np.ndarray:
+    """(T, 3) unit normals of triangles ``P`` (T, 3, 3) (zero for degenerate ones)."""
+    n = np.cross(P[:, 1] - P[:, 0], P[:, 2] - P[:, 0])
+    return n / np.maximum(np.linalg.norm(n, axis=1, keepdims=True), TINY)
+
+
+def _segment_distance(p: np.ndarray, a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    """(k,) distance of points ``p`` from segments ``a b`` (all (k, 3))."""
+    ab = b - a
+    s = np.clip(np.einsum("ij,ij->i", p - a, ab) / np.maximum(np.einsum("ij,ij->i", ab, ab), TINY), 0, 1)
+    return np.linalg.norm(p - a - s[:, None] * ab, axis=1)
+
+
+def _triangle_distance(p: np.ndarray, P: np.ndarray) -> np.ndarray:
+    """(k,) distance of points ``p`` (k, 3) from triangles ``P`` (k, 3, 3)."""
+    A, B, C = P[:, 0], P[:, 1], P[:, 2]
+    n = _normals(P)
+    h = np.einsum("ij,ij->i", p - A, n)
+    q = p - h[:, None] * n
+    # Inside when q is on the inner side of all three edges.
+    inside = np.ones(len(p), bool)
+    for x, y in ((A, B), (B, C), (C, A)):
+        inside &= np.einsum("ij,ij->i", np.cross(y - x, q - x), n) >= 0
+    edge = np.minimum(np.minimum(_segment_distance(p, A, B), _segment_distance(p, B, C)),
+                      _segment_distance(p, C, A))
+    return np.where(inside, np.abs(h), edge)
+
+
+def _edge_table(mesh: Mesh) -> tuple[np.ndarray, np.ndarray]:
+    """Sorted undirected edge keys ``lo * n + hi`` of all faces, and how many faces use each."""
+    idx = mesh.face_indices
+    nxt = np.arange(idx.size) + 1
+    nxt[mesh.face_offsets[1:] - 1] = mesh.face_offsets[:-1]
+    n = np.int64(mesh.n_vertices)
+    key = np.minimum(idx, idx[nxt]) * n + np.maximum(idx, idx[nxt])
+    return np.unique(key, return_counts=True)
+
+
+def _lookup(keys: np.ndarray, table: np.ndarray) -> np.ndarray:
+    """(k,) int: position of each key in the sorted ``table``, -1 where absent."""
+    if table.size == 0:
+        return np.full(keys.shape, -1)
+    pos = np.clip(np.searchsorted(table, keys), 0, table.size - 1)
+    return np.where(table[pos] == keys, pos, -1)
+
+
+def _expand(counts: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """For groups of ``counts`` items: the group of each item and its rank within it."""
+    rep = np.repeat(np.arange(counts.size), counts)
+    start = np.cumsum(counts) - counts
+    return rep, np.arange(rep.size) - start[rep]
+
+
+class _Stars:
+    """Vertex -> incident triangles (rows of ``tri``) and vertex -> neighbours (all faces)."""
+
+    def __init__(self, tri: np.ndarray, keys: np.ndarray, n: int):
+        flat = tri.reshape(-1)
+        self.order = np.argsort(flat, kind="stable")
+        self.tri_start = np.searchsorted(flat[self.order], np.arange(n + 1))
+        lo, hi = keys // n, keys % n
+        ends = np.concatenate([lo, hi])
+        other = np.concatenate([hi, lo])
+        o = np.argsort(ends, kind="stable")
+        self.nbr = other[o]
+        self.nbr_start = np.searchsorted(ends[o], np.arange(n + 1))
+
+    def triangles(self, v: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """Per (candidate, incident triangle): candidate row, triangle row, corner of ``v``."""
+        cnt = self.tri_start[v + 1] - self.tri_start[v]
+        rep, rank = _expand(cnt)
+        pos = self.order[self.tri_start[v][rep] + rank]
+        return rep, pos // 3, pos % 3
+
+    def neighbours(self, v: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """Per (candidate, neighbour of ``v``): candidate row and neighbour."""
+        cnt = self.nbr_start[v + 1] - self.nbr_start[v]
+        rep, rank = _expand(cnt)
+        return rep, self.nbr[self.nbr_start[v][rep] + rank]
+
+
+def _directed(tri: np.ndarray, free: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Directed edges ``v -> u`` of triangles ``tri`` whose ``v`` is free, once each."""
+    v = np.concatenate([tri, np.roll(tri, -1, axis=1)], axis=0).reshape(-1)
+    u = np.concatenate([np.roll(tri, -1, axis=1), tri], axis=0).reshape(-1)
+    ok = free[v]
+    pairs = np.unique(np.stack([v[ok], u[ok]], axis=1), axis=0)
+    return pairs[:, 0], pairs[:, 1]
+
+
+def _near(mesh: Mesh, vertices: np.ndarray) -> Mesh:
+    """The faces with a corner among ``vertices`` (all vertices kept).
+
+    Every face around a candidate's two ends is there, so the edges at them,
+    their uses and the neighbours they share are those of the whole mesh.
+    """
+    mark = np.zeros(mesh.n_vertices, bool)
+    mark[vertices] = True
+    face_of = np.repeat(np.arange(mesh.n_faces), mesh.valences)
+    return mesh.select_faces(np.bincount(face_of[mark[mesh.face_indices]], minlength=mesh.n_faces) > 0)
+
+
+def _evaluate(V, tri, stars: _Stars, keys, faces_at, v, u, scale) -> tuple[np.ndarray, np.ndarray]:
+    """(C,) gain in smallest angle (degrees) of each collapse ``v -> u``, and whether it is allowed."""
+    C = v.size
+    rep, face, corner = stars.triangles(v)
+    old = tri[face]
+    new = old.copy()
+    new[np.arange(face.size), corner] = u[rep]
+    gone = (old == u[rep][:, None]).any(axis=1)          # the triangles on the edge u v
+    old_ang = _angles(V[old]).min(axis=1)
+    old_min = np.full(C, 180.0)
+    np.minimum.at(old_min, rep, old_ang)
+    keep = ~gone
+    Pn = V[new[keep]]
+    new_min = np.full(C, 180.0)
+    np.minimum.at(new_min, rep[keep], _angles(Pn).min(axis=1))
+    # Each new face keeps to its old normal; a needle's own normal is noise, so in
+    # its place the star's normal (its faces weighed by area) is the reference.
+    P0 = V[old]
+    star = np.zeros((C, 3))
+    np.add.at(star, rep, np.cross(P0[:, 1] - P0[:, 0], P0[:, 2] - P0[:, 0]))
+    star /= np.maximum(np.linalg.norm(star, axis=1, keepdims=True), TINY)
+    n_new = _normals(Pn)
+    cos = np.cos(np.radians(FLIP_MAX_BEND_DEG))
+    bend = (np.einsum("ij,ij->i", _normals(P0[keep]), n_new) >= cos) | (
+        (old_ang[keep] < RESTART_ANGLE_DEG) & (np.einsum("ij,ij->i", star[rep[keep]], n_new) >= cos))
+    bad = ~bend | (np.linalg.norm(n_new, axis=1) < 0.5)
+    ok = np.bincount(rep[keep][bad], minlength=C) == 0
+    # How far the surface moves: the removed vertex's distance from the faces left around it.
+    sag = np.full(C, np.inf)
+    np.minimum.at(sag, rep[keep], _triangle_distance(V[v[rep[keep]]], Pn))
+    ok &= sag <= COLLAPSE_MAX_SAG * scale
+    removed = np.bincount(rep[gone], minlength=C)
+    # A corner opposite the edge u v must keep a face (else it and its area would go).
+    third = np.where((old[gone] != v[rep[gone]][:, None]) & (old[gone] != u[rep[gone]][:, None]),
+                     old[gone], -1).max(axis=1)
+    ok &= np.bincount(rep[gone][faces_at[third] < 2], minlength=C) == 0
+    # Link condition: the neighbours u and v share are the corners opposite their edge.
+    n = len(V)
+    r2, w = stars.neighbours(v)
+    w_ok = w != u[r2]
+    shared = _lookup(np.minimum(u[r2], w) * n + np.maximum(u[r2], w), keys) >= 0
+    common = np.bincount(r2[w_ok & shared], minlength=C)
+    ok &= (common == removed) & (removed >= 1) & (np.bincount(rep, minlength=C) > removed)
+    return new_min - old_min, ok
+
+
+def _chosen(stars: _Stars, tri, v, gain) -> np.ndarray:
+    """Rows of the collapses to take: each the best of every vertex its triangles touch."""
+    rep, face, _ = stars.triangles(v)
+    touched_v = tri[face].reshape(-1)
+    touched_c = np.repeat(rep, 3)
+    best = np.full(int(tri.max()) + 1, -np.inf)
+    np.maximum.at(best, touched_v, gain[touched_c])
+    top = np.bincount(touched_c[gain[touched_c] < best[touched_v]], minlength=v.size) == 0
+    first = np.full(best.size, v.size)
+    np.minimum.at(first, touched_v[top[touched_c]], touched_c[top[touched_c]])
+    mine = first[touched_v] == touched_c
+    return np.flatnonzero(top & (np.bincount(touched_c[~mine], minlength=v.size) == 0))
+
+
+def _rejoined(members: np.ndarray, member_id: np.ndarray, removed: np.ndarray, n: int):
+    """Members with the removed vertices taken out of their generator chains."""
+    if members.size == 0 or not removed[members].any():
+        return members, member_id
+    m0, m1 = members[:, 0], members[:, 1]
+    # The member that continues each one along its generator: (id, start) = (id, this end).
+    key0 = member_id * n + m0
+    order = np.argsort(key0, kind="stable")
+    nxt = _lookup(member_id * n + m1, key0[order])
+    nxt = np.where(nxt >= 0, order[np.maximum(nxt, 0)], -1)
+    end = m1.copy()
+    row = np.arange(len(m1))
+    walk = removed[end] & (nxt[row] >= 0)
+    while walk.any():
+        row = np.where(walk, nxt[row], row)
+        end = np.where(walk, m1[row], end)
+        walk = removed[end] & (nxt[row] >= 0)
+    keep = ~removed[m0] & ~removed[end]
+    return np.stack([m0[keep], end[keep]], axis=1), member_id[keep]
+
+
+def _apply(mesh: Mesh, v: np.ndarray, u: np.ndarray) -> tuple[Mesh, np.ndarray]:
+    """The mesh with each ``v`` collapsed into its ``u`` and the emptied vertices dropped,
+    and the new index of each old vertex."""
+    n = mesh.n_vertices
+    remap = np.arange(n)
+    remap[v] = u
+    idx = remap[mesh.face_indices]
+    face_of = np.repeat(np.arange(mesh.n_faces), mesh.valences)
+    touched = np.bincount(face_of[np.isin(mesh.face_indices, v)], minlength=mesh.n_faces) > 0
+    kind = mesh.face_kind.copy()
+    kind[touched] = FaceKind.FILL
+    nxt = np.arange(idx.size) + 1
+    nxt[mesh.face_offsets[1:] - 1] = mesh.face_offsets[:-1]
+    ok_face = np.bincount(face_of[idx != idx[nxt]], minlength=mesh.n_faces) >= 3
+    keep = ok_face[face_of]
+    removed = np.zeros(n, bool)
+    removed[v] = True
+    members, member_id = _rejoined(mesh.members, mesh.member_id, removed, n)
+    out = Mesh(mesh.vertices, offsets_from_valences(mesh.valences[ok_face]), idx[keep],
+               kind[ok_face], members, member_id, mesh.vertex_data, mesh.info)
+    return out.compact(), np.cumsum(~removed) - 1
+
+
+def collapse_splinters(mesh: Mesh) -> tuple[Mesh, int]:
+    """Remove triangle-only vertices of splinters where that fattens the faces around them.
+
+    Parameters
+    ----------
+    mesh : Mesh
+        Any polygon mesh; only triangles whose corners are in no other face
+        change.
+
+    Returns
+    -------
+    Mesh
+        Fewer vertices and triangles; quads, their corners and the border kept;
+        changed triangles are of kind :attr:`FaceKind.FILL`; members joined
+        across the removed vertices.
+    int
+        Number of vertices removed.
+    """
+    total = 0
+    watch = None    # after the first round, the vertices whose triangles may have changed
+    for _ in range(_ROUNDS):
+        val = mesh.valences
+        if not (val == 3).any():
+            break
+        V, n = mesh.vertices, mesh.n_vertices
+        ids = np.flatnonzero(val == 3)
+        tri = mesh.face_indices[mesh.face_offsets[ids][:, None] + np.arange(3)].astype(np.int64)
+        if watch is not None:
+            tri = tri[watch[tri].any(axis=1)]
+        thin = _angles(V[tri]).min(axis=1) < RESTART_ANGLE_DEG
+        if not thin.any():
+            break
+        free = np.ones(n, bool)
+        free[mesh.face_indices[np.repeat(val != 3, val)]] = False
+        splinters = tri[thin]
+        v, u = _directed(splinters, free)
+        if v.size == 0:
+            break
+        # Only the faces around the candidates matter: a large mesh has few splinters.
+        near = _near(mesh, np.concatenate([v, u]))
+        keys, uses = _edge_table(near)
+        border_keys = keys[uses == 1]
+        border_v = np.zeros(n, bool)
+        border_v[border_keys // n] = border_v[border_keys % n] = True
+        # A border vertex collapses only along the border.
+        along = _lookup(np.minimum(v, u) * n + np.maximum(v, u), border_keys) >= 0
+        ok = ~border_v[v] | along
+        v, u = v[ok], u[ok]
+        if v.size == 0:
+            break
+        nval = near.valences
+        tri = near.face_indices[near.face_offsets[np.flatnonzero(nval == 3)][:, None]
+                                + np.arange(3)].astype(np.int64)
+        scale = float(np.linalg.norm(V.max(axis=0) - V.min(axis=0))) or 1.0
+        stars = _Stars(tri, keys, n)
+        gain, ok = _evaluate(V, tri, stars, keys, np.bincount(mesh.face_indices, minlength=n), v, u, scale)
+        ok &= gain > FLIP_MIN_GAIN_DEG
+        if not ok.any():
+            break
+        v, u, gain = v[ok], u[ok], gain[ok]
+        take = _chosen(stars, tri, v, gain)
+        if take.size == 0:
+            break
+        mesh, new_index = _apply(mesh, v[take], u[take])
+        total += int(take.size)
+        # Next round: the triangles around the collapses and the splinters left.
+        watch = np.zeros(mesh.n_vertices, bool)
+        watch[new_index[np.concatenate([u[take], splinters.reshape(-1)])]] = True
+    return mesh, total
