@@ -194,6 +194,31 @@ def test_catalogue_surfaces_build_in_the_worker_process():
         worker.close()
 
 
+def test_worker_compiles_the_kernels_when_idle_and_not_inside_an_edit():
+    """Regression (CI): a session crossing MIN_WORK compiled the kernels inside edit 327, over
+    the time limit.  Now the worker loads them after an idle second, telling the server, and
+    says with its next answer that they are in use; an edit sent meanwhile is answered."""
+    import os
+
+    from ruledmesh.web import builder
+
+    worker = builder.BuildWorker(timeout=60)
+    try:
+        s = Session(SMALL, builder=worker)
+        worker.start()
+        assert worker.kernels is None
+        time.sleep(builder.IDLE_BEFORE_WARM_UP + 0.2)   # the warm-up starts (or has ended)
+        s.edit([(["mesh", "rows"], 7)])
+        deadline = time.monotonic() + 120
+        while worker.kernels is None and time.monotonic() < deadline:
+            time.sleep(0.5)
+            s.edit([(["mesh", "rows"], 8 + int(time.monotonic() * 10) % 5)])
+        assert worker.kernels is (os.environ.get("RULEDMESH_KERNELS", "auto") not in ("0", "off", "numpy"))
+        assert s.design["mesh"]["rows"] >= 7
+    finally:
+        worker.close()
+
+
 def test_an_answer_with_the_same_faces_leaves_them_out():
     from ruledmesh.web.session import topology_key
 

@@ -121,8 +121,9 @@ def test_small_stage_stays_numpy(monkeypatch):
 
 def test_designer_worker_compiles_every_kernel_before_its_first_edit():
     """Regression (CI, edit 327 of a live session): the kernels compiled inside an edit that
-    crossed MIN_WORK, took over the 20 s limit and the edit was refused.  After the worker's
-    warm-up, builds of other designs and sizes compile nothing more."""
+    crossed MIN_WORK, took over the 20 s limit and the edit was refused.  The worker holds
+    the kernels until it is idle; after its warm-up, builds of other designs and sizes
+    compile nothing more."""
     code = textwrap.dedent("""
         import numba
         from ruledmesh import kernels
@@ -130,6 +131,9 @@ def test_designer_worker_compiles_every_kernel_before_its_first_edit():
         from ruledmesh.web.builder import _warm_up
         from ruledmesh.web.session import DEFAULT_DESIGN, frame_data
 
+        import sys
+        kernels.hold()          # as the worker does from its start
+        assert kernels.wanted(10**7) is None and "ruledmesh.kernels.geometry" not in sys.modules
         default = parse_design(DEFAULT_DESIGN)
         assert _warm_up(lambda: frame_data(default.data, build_design(default)))
 

@@ -15,9 +15,9 @@ good part of a second in numpy), or when the process has put :data:`MIN_WORK`
 items through the stages (a designer or a notebook rebuilding the same design
 over and over); once loaded they are used for every size.  A one-off build of a
 small design never imports numba.  An application that knows it will rebuild
-live (a server) calls :func:`load` at start and runs one build inside
-:func:`everywhere`, so that compiling (or loading from the cache) happens
-while it starts and never inside an edit that happens to cross
+live (a server) calls :func:`hold` at start and, when it is idle, :func:`load`
+and one build inside :func:`everywhere`, so that compiling (or loading from
+the cache) never happens inside an edit that happens to cross
 :data:`MIN_WORK`.  ``RULEDMESH_KERNELS=0`` forces numpy
 everywhere, ``=1`` the kernels everywhere (the tests use both); the results are
 the same either way.
@@ -39,7 +39,7 @@ from collections.abc import Iterator
 from pathlib import Path
 from types import ModuleType
 
-__all__ = ["MIN_ITEMS", "MIN_WORK", "everywhere", "load", "wanted"]
+__all__ = ["MIN_ITEMS", "MIN_WORK", "everywhere", "hold", "load", "wanted"]
 
 #: Items (faces, grid points) from which a single stage loads the kernels.
 MIN_ITEMS = 100_000
@@ -49,6 +49,8 @@ MIN_WORK = 1_000_000
 _work = [0]
 # Depth of open :func:`everywhere` blocks.
 _forced = [0]
+# Set by :func:`hold`: numpy for every stage until :func:`load`.
+_held = [False]
 
 _state: dict[str, ModuleType | bool | None] = {"geometry": None, "grid": None, "strips": None, "failed": False}
 
@@ -115,6 +117,8 @@ def wanted(items: int, name: str = "geometry") -> ModuleType | None:
     if mode in ("0", "off", "numpy"):
         return None
     _work[0] += items
+    if _held[0] and not _forced[0]:
+        return None
     if _forced[0] or mode in ("1", "on", "numba") or items >= MIN_ITEMS or _work[0] >= MIN_WORK or _loaded():
         return _load(name)
     return None
@@ -132,7 +136,18 @@ def load() -> bool:
     """
     if _mode() in ("0", "off", "numpy"):
         return False
+    _held[0] = False
     return all(_load(name) is not None for name in ("geometry", "grid", "strips"))
+
+
+def hold() -> None:
+    """Use numpy for every stage, whatever its size, until :func:`load` is called.
+
+    For a process with a time limit on each build (the designer's build
+    worker): compiling the kernels inside a build would count against it, so
+    the worker holds them and loads them when it is idle.
+    """
+    _held[0] = True
 
 
 @contextlib.contextmanager

@@ -38,8 +38,11 @@ MAX_BUILD_SECONDS = 20.0
 # A superseded build younger than this is left to finish (and its result dropped): a fresh
 # worker process needs about a second to import numpy and scipy, most builds take milliseconds.
 SUPERSEDE_GRACE = 0.3
-# Seconds a fresh worker process may take to import its modules.
+# Seconds a fresh worker process may take to import its modules (and later to compile
+# the kernels: not counted against the edit waiting meanwhile).
 STARTUP_SECONDS = 120.0
+# Seconds without an edit after which the worker compiles (or loads) the kernels.
+IDLE_BEFORE_WARM_UP = 1.0
 # Builds kept by design: undo, redo, a slider moved back and forth, the same design sent by
 # two tabs are answered without building again. A 100 x 100 mesh is about 1 MB.
 BUILD_CACHE = 8
@@ -65,15 +68,26 @@ class BuildTimeout(RuledMeshError):
 
 
 def _worker_main(conn) -> None:  # pragma: no cover - runs in the child process
+    from .. import kernels
     from ..design import Design, build_design, parse_design
     from ..registry import load_plugins
     from .session import DEFAULT_DESIGN, frame_data
 
     load_plugins()
+    kernels.hold()
     default = parse_design(DEFAULT_DESIGN)
-    conn.send(("ready", _warm_up(lambda: frame_data(default.data, build_design(default)))))
+    frame_data(default.data, build_design(default))  # imports the mesher's modules (lazy elsewhere)
+    conn.send(("ready", None))  # the time limit counts from here
+    warm = False
     while True:
         try:
+            if not warm and not conn.poll(IDLE_BEFORE_WARM_UP):
+                # Idle: compile the kernels now, telling the server, which does not count
+                # this time against an edit that arrives meanwhile.
+                conn.send(("busy", None))
+                conn.send(("idle", _warm_up(lambda: frame_data(default.data, build_design(default)))))
+                warm = True
+                continue
             job = conn.recv()
         except (EOFError, OSError):
             return
@@ -109,18 +123,18 @@ def _worker_main(conn) -> None:  # pragma: no cover - runs in the child process
 
 
 def _warm_up(build: Any) -> bool:
-    """Import the mesher and compile its kernels before the first edit; whether they are in use.
+    """Compile the mesher's kernels (or load them from the cache); whether they are in use.
 
-    ``build`` builds the default design and makes its frame.  The kernels are used once a worker
-    has put :data:`~ruledmesh.kernels.MIN_WORK` items through the mesher, which
-    a designer session reaches after a few hundred edits; compiling them then
-    (about 15 s on a new installation, a second from numba's cache) would
-    happen inside that edit's time limit and refuse it.  So they compile here,
-    in the start-up time, with one build that calls every one of them.
+    ``build`` builds the default design and makes its frame.  The worker
+    holds the kernels (:func:`ruledmesh.kernels.hold`) until it is idle:
+    compiling them (about 15 s on a new installation, a second from numba's
+    cache) inside an edit would count against that edit's time limit and
+    refuse it, which is what happened when a long session crossed
+    :data:`~ruledmesh.kernels.MIN_WORK`.  One build inside
+    :func:`~ruledmesh.kernels.everywhere` calls every kernel once.
     """
     from .. import kernels
 
-    build()  # imports the mesher's modules (lazy elsewhere)
     if not kernels.load():
         return False
     with kernels.everywhere():
@@ -230,8 +244,10 @@ class BuildWorker(InProcessBuilder):
         self._proc: Any = None
         self._conn: Any = None
         self._closed = False
-        #: Whether the running worker builds with the compiled kernels (known once it started).
+        #: Whether the running worker builds with the compiled kernels (None: not yet known;
+        #: the worker loads them at its first idle second and says so with its next answer).
         self.kernels: bool | None = None
+        self._paused = 0.0  # when the worker said it is compiling the kernels (0: it is not)
 
     # ---------------------------------------------------------------- process
     def _start(self) -> None:
@@ -244,10 +260,8 @@ class BuildWorker(InProcessBuilder):
             while not parent.poll(0.05):
                 if self._closed or time.monotonic() > deadline or not proc.is_alive():
                     raise EOFError
-            kind, kernels = parent.recv()
-            if kind != "ready":
+            if parent.recv()[0] != "ready":
                 raise EOFError
-            self.kernels = bool(kernels)
         except (EOFError, OSError):
             self._stop()
             raise RuledMeshError("the build process did not start") from None
@@ -255,6 +269,7 @@ class BuildWorker(InProcessBuilder):
     def _stop(self) -> None:
         stop_worker(self._proc, self._conn)
         self._proc = self._conn = None
+        self._paused = 0.0
 
     def start(self) -> None:
         """Start the worker process now (so the first edit does not wait for it)."""
@@ -302,18 +317,36 @@ class BuildWorker(InProcessBuilder):
         started = time.monotonic()
         try:
             self._conn.send(job)
-            while not self._conn.poll(0.02):
-                elapsed = time.monotonic() - started
+            while True:
+                if self._conn.poll(0.02):
+                    kind, value = self._conn.recv()
+                    if kind == "busy":          # compiling the kernels: not this edit's time
+                        self._paused = time.monotonic()
+                        continue
+                    if kind == "idle":
+                        started += time.monotonic() - max(self._paused, started)
+                        self._paused = 0.0
+                        self.kernels = bool(value)
+                        continue
+                    break
+                now = time.monotonic()
+                if self._paused:
+                    if now - self._paused > STARTUP_SECONDS:
+                        raise EOFError
+                    elapsed = max(self._paused, started) - started
+                else:
+                    elapsed = now - started
                 if elapsed > self.timeout:
                     self._stop()
                     raise BuildTimeout(f"the build took longer than {self.timeout:g} s and was "
                                        "stopped; reduce the generator count or the rows")
-                if self._closed or (elapsed > SUPERSEDE_GRACE and self.superseded(generation)):
+                # Not while the kernels compile: a new worker would compile them again.
+                if self._closed or (not self._paused and now - started > SUPERSEDE_GRACE
+                                    and self.superseded(generation)):
                     self._stop()
                     raise Superseded("superseded by a newer edit")
                 if not self._proc.is_alive():
                     raise EOFError
-            kind, value = self._conn.recv()
         except (EOFError, OSError):
             self._stop()
             raise RuledMeshError("the build process stopped unexpectedly (out of memory?); "

@@ -352,13 +352,13 @@ def pq_mesh(a, b, rows: int = 20, primary: int | str = "middle", option: int = 0
     even = _even_ranges(parts, segs, warnings)
     meet = np.r_[flat, False] | np.r_[False, flat]      # generators of a coplanar pair
     mesh = assemble(parts, a, d, args.trim, tol, ptol, warnings, scale, meet, rows=rows)
-    mesh, flips, paired = _fattened(mesh, ptol, tol)
+    mesh, flips, collapsed, paired = _fattened(mesh, ptol, tol)
     _warn_share(mesh, warnings, torsal.size, even, restarts, m, rows)
     _warn_splinters(mesh, warnings, torsal)
     if kept.size < m_given:
         mesh = _renumbered(mesh, kept)
     return mesh.with_info(runs=len(parts), restarts=restarts, planarity_tolerance=ptol, paired=paired,
-                          flips=flips)
+                          flips=flips, collapsed=collapsed)
 
 
 def _cut(a, d, rows, ptol, scale, tol, creases, crease_generators, warnings):
@@ -383,7 +383,7 @@ def _cut(a, d, rows, ptol, scale, tol, creases, crease_generators, warnings):
     return flat, torsal, cg, segs
 
 
-def _fattened(mesh: Mesh, ptol: float, tol: Tolerances) -> tuple[Mesh, int, int]:
+def _fattened(mesh: Mesh, ptol: float, tol: Tolerances) -> tuple[Mesh, int, int, int]:
     """Flip the triangles for their angles, collapse what flips cannot fatten, pair the
     triangles in tolerance mode, flip what is left."""
     mesh, flips = flip_triangles(mesh)
@@ -395,7 +395,7 @@ def _fattened(mesh: Mesh, ptol: float, tol: Tolerances) -> tuple[Mesh, int, int]
     if paired:
         mesh, more = flip_triangles(mesh)
         flips += more
-    return mesh, flips, paired
+    return mesh, flips, collapsed, paired
 
 
 @dataclass(frozen=True)
