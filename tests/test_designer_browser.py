@@ -173,6 +173,34 @@ def test_slider_changes_mesh_and_picture(page, designer):
     assert server_reaches(lambda: designer.session.design["rulings"]["count"] == previous)
 
 
+def test_updates_compile_no_shaders_and_log_no_errors(page, designer):
+    """Updates redraw the handles and the construction without compiling a shader again.
+
+    The layers' old materials are freed after the new ones are drawn: freed first, three
+    deleted the shader programs and compiled them again on every update (tens of
+    milliseconds each in a software renderer).  The buffers' bounding spheres are finite
+    (a NaN one made three log an error on every update).
+    """
+    logged = []
+    page.on("console", lambda m: logged.append(m.text) if m.type == "error" else None)
+    slider = page.locator('input[type=range][data-path="mesh.rows"]')
+    slider.focus()
+    page.keyboard.press("ArrowRight")
+    v = wait_version(page, page.evaluate("window.designer.version"))
+    page.evaluate("() => new Promise(requestAnimationFrame)")
+    programs = page.evaluate("window.designer.programs()")
+    kept = dict(page.evaluate("window.designer.kept"))
+    for rows in (14, 15, 16):
+        page.keyboard.press("ArrowRight")
+        v = wait_version(page, v)
+        page.wait_for_function(f"window.designer.design().mesh.rows === {rows}")
+        page.evaluate("() => new Promise(requestAnimationFrame)")
+    # the construction was drawn again (the division of the primary generator has new rows)
+    assert page.evaluate("window.designer.kept").get("construction", 0) < kept.get("construction", 0) + 3
+    assert sorted(page.evaluate("window.designer.programs()")) == sorted(programs)
+    assert not logged, logged
+
+
 def test_dragging_a_control_point_changes_mesh_and_picture(page, designer):
     before = picture(page)
     mesh_before = designer.session.built.mesh

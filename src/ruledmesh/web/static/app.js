@@ -1957,6 +1957,8 @@ window.designer = {
     requestAnimationFrame(() => resolve(performance.now() - t0));
   }),
   selection: () => [...selection],
+  // The shader programs in use (their ids: a program compiled again gets a new one).
+  programs: () => renderer.info.programs.map((p) => p.id),
   // Milliseconds of one render of the scene as it is (nothing new to upload), the minimum of
   // n; reading a pixel back waits until the renderer has drawn every pixel of it.
   renderMs: (n = 5) => {
