@@ -331,6 +331,9 @@ def test_update_latency_100_by_100(browser, tmp_path):
         kept = pg.evaluate("window.designer.kept")
         # the page alone: the last answer decoded and drawn again, to the next frame
         replays = [pg.evaluate("window.designer.replay()") for _ in range(12)]
+        draws = pg.evaluate("window.designer.drawTimes")
+        # one render of the scene to its last pixel (a pixel read back waits for it)
+        render = pg.evaluate("window.designer.renderMs(5)")
     finally:
         pg.close()
         proc.terminate()
@@ -347,7 +350,10 @@ def test_update_latency_100_by_100(browser, tmp_path):
           f"{med(move_steps, 'page'):.0f} ms, min {min(moves):.0f} ms, buffers reused "
           f"{sum(reused)}/{len(reused)}, frames without the faces {same}, layers kept {kept}); "
           f"page alone (decode, draw, frame): median {statistics.median(replays):.0f} ms, "
-          f"min {min(replays):.0f} ms; load {load:.1f}")
+          f"min {min(replays):.0f} ms (last: " + ", ".join(f"{k} {v:.0f}" for k, v in draws.items())
+          + f" ms); one render to the last pixel {render:.0f} ms; server done to frame arrived: "
+          f"median {statistics.median(r['arrived'] - r['server'] for r in steps + move_steps):.0f} ms"
+          f"; load {load:.1f}")
     assert faces > 5000 and len(frames) == 12 and len(moves) == 12
     # Each measured frame shows the value asked for: its design has it, and what is drawn is
     # the mesh ruledmesh builds from that design (face count, triangles, vertices).
