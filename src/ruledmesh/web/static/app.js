@@ -705,7 +705,9 @@ function drawGrid() {
 function drawScene() {
   const { header, arrays } = current;
   const [lo, hi] = header.bbox;
-  size = Math.hypot(hi[0] - lo[0], hi[1] - lo[1], hi[2] - lo[2]) || 1;
+  // Three digits: the handles' radius, the dashes and the construction's extent do not
+  // follow the last digits of the box, which move with every row count (the layers stay).
+  size = Number((Math.hypot(hi[0] - lo[0], hi[1] - lo[1], hi[2] - lo[2]) || 1).toPrecision(3));
   // Buffers of the same size are written in place (no new GPU buffers, no garbage): a
   // moved point or a continuous slider mostly keeps the face and edge counts.
   // How long each part of drawing takes (window.designer.drawTimes, for the speed figures).
