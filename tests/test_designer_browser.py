@@ -173,6 +173,34 @@ def test_slider_changes_mesh_and_picture(page, designer):
     assert server_reaches(lambda: designer.session.design["rulings"]["count"] == previous)
 
 
+def test_updates_compile_no_shaders_and_log_no_errors(page, designer):
+    """Updates redraw the handles and the construction without compiling a shader again.
+
+    The layers' old materials are freed after the new ones are drawn: freed first, three
+    deleted the shader programs and compiled them again on every update (tens of
+    milliseconds each in a software renderer).  The buffers' bounding spheres are finite
+    (a NaN one made three log an error on every update).
+    """
+    logged = []
+    page.on("console", lambda m: logged.append(m.text) if m.type == "error" else None)
+    slider = page.locator('input[type=range][data-path="mesh.rows"]')
+    slider.focus()
+    page.keyboard.press("ArrowRight")
+    v = wait_version(page, page.evaluate("window.designer.version"))
+    page.evaluate("() => new Promise(requestAnimationFrame)")
+    programs = page.evaluate("window.designer.programs()")
+    kept = dict(page.evaluate("window.designer.kept"))
+    for rows in (14, 15, 16):
+        page.keyboard.press("ArrowRight")
+        v = wait_version(page, v)
+        page.wait_for_function(f"window.designer.design().mesh.rows === {rows}")
+        page.evaluate("() => new Promise(requestAnimationFrame)")
+    # the construction was drawn again (the division of the primary generator has new rows)
+    assert page.evaluate("window.designer.kept").get("construction", 0) < kept.get("construction", 0) + 3
+    assert sorted(page.evaluate("window.designer.programs()")) == sorted(programs)
+    assert not logged, logged
+
+
 def test_dragging_a_control_point_changes_mesh_and_picture(page, designer):
     before = picture(page)
     mesh_before = designer.session.built.mesh
@@ -303,6 +331,9 @@ def test_update_latency_100_by_100(browser, tmp_path):
         kept = pg.evaluate("window.designer.kept")
         # the page alone: the last answer decoded and drawn again, to the next frame
         replays = [pg.evaluate("window.designer.replay()") for _ in range(12)]
+        draws = pg.evaluate("window.designer.drawTimes")
+        # one render of the scene to its last pixel (a pixel read back waits for it)
+        render = pg.evaluate("window.designer.renderMs(5)")
     finally:
         pg.close()
         proc.terminate()
@@ -319,7 +350,10 @@ def test_update_latency_100_by_100(browser, tmp_path):
           f"{med(move_steps, 'page'):.0f} ms, min {min(moves):.0f} ms, buffers reused "
           f"{sum(reused)}/{len(reused)}, frames without the faces {same}, layers kept {kept}); "
           f"page alone (decode, draw, frame): median {statistics.median(replays):.0f} ms, "
-          f"min {min(replays):.0f} ms; load {load:.1f}")
+          f"min {min(replays):.0f} ms (last: " + ", ".join(f"{k} {v:.0f}" for k, v in draws.items())
+          + f" ms); one render to the last pixel {render:.0f} ms; server done to frame arrived: "
+          f"median {statistics.median(r['arrived'] - r['server'] for r in steps + move_steps):.0f} ms"
+          f"; load {load:.1f}")
     assert faces > 5000 and len(frames) == 12 and len(moves) == 12
     # Each measured frame shows the value asked for: its design has it, and what is drawn is
     # the mesh ruledmesh builds from that design (face count, triangles, vertices).

@@ -80,21 +80,24 @@ def _refined(rulings, mesh, options: dict):
     """
     from dataclasses import replace
 
-    from ..analysis.faces import area_shares
     from ..rulings import dense_grid
 
     surface = getattr(rulings, "surface", None)
     if surface is None or rulings.info.get("distribution") == "lines":
         return rulings, mesh
     grid, _ = dense_grid(len(rulings.u))
-    best = (area_shares(mesh)["quads"], rulings, mesh)
+    # The face areas of each mesh are measured once: the quad share decides whether a
+    # round is kept, the strips' shares where the next one adds generators.
+    best = (*_measured(mesh), rulings, mesh)
     user = len(rulings.u) - int(rulings.info.get("inserted", 0))
     start = len(rulings.u)
     for _ in range(_REFINE_ROUNDS):
-        cur_rulings, cur_mesh = best[1], best[2]
+        share, area, cur_rulings, cur_mesh = best
+        if share >= 0.97:
+            break
         u = np.asarray(cur_rulings.u)
-        strips = _trouble_strips(cur_mesh, len(u))
-        if strips.size == 0 or best[0] >= 0.97:
+        strips = _trouble_strips(cur_mesh, len(u), area)
+        if strips.size == 0:
             break
         lo = np.searchsorted(grid, u[strips], side="right")
         hi = np.searchsorted(grid, u[strips + 1], side="left") - 1
@@ -112,11 +115,11 @@ def _refined(rulings, mesh, options: dict):
             cand_mesh = _mesh(candidate, options)
         except GeometryError:
             break
-        share = area_shares(cand_mesh)["quads"]
-        if share <= best[0] + 0.005:
+        cand_share, cand_area = _measured(cand_mesh)
+        if cand_share <= share + 0.005:
             break
-        best = (share, candidate, cand_mesh)
-    rulings, mesh = best[1], best[2]
+        best = (cand_share, cand_area, candidate, cand_mesh)
+    rulings, mesh = best[2], best[3]
     added = len(rulings.u) - start
     if added <= 0:
         return rulings, mesh
@@ -125,24 +128,34 @@ def _refined(rulings, mesh, options: dict):
     return rulings, mesh.with_info(warnings=list(mesh.info.get("warnings", [])) + [note])
 
 
-def _trouble_strips(mesh, m: int) -> np.ndarray:
-    """Strips (between generators i and i + 1) whose area is mostly outside quads."""
+def _measured(mesh) -> tuple[float, np.ndarray]:
+    """The share of the area in quads (as :func:`~ruledmesh.analysis.faces.area_shares`) and the (F,) face areas."""
     from ..analysis.faces import face_normals
 
+    _, area = face_normals(mesh)
+    total = float(area.sum()) or 1.0
+    return float(area[mesh.valences == 4].sum() / total), area
+
+
+def _trouble_strips(mesh, m: int, area: np.ndarray) -> np.ndarray:
+    """Strips (between generators i and i + 1) whose area is mostly outside quads.
+
+    ``area`` : (F,) the face areas of ``mesh``.
+    """
     gen = np.asarray(mesh.vertex_data["generator"])
     if mesh.n_faces == 0 or m < 2:
         return np.zeros(0, np.int64)
-    _, area = face_normals(mesh)
     g = gen[mesh.face_indices]
     g0 = np.minimum.reduceat(g, mesh.face_offsets[:-1])
     g1 = np.maximum.reduceat(g, mesh.face_offsets[:-1])
     span = np.maximum(g1 - g0, 1)
-    total = np.zeros(m - 1)
-    other = np.zeros(m - 1)
     off = mesh.valences != 4
-    for k in range(int(span.max())):        # faces span one or two strips
-        sel = k < span
-        s = np.clip(g0[sel] + k, 0, m - 2)
-        np.add.at(total, s, area[sel] / span[sel])
-        np.add.at(other, s, np.where(off[sel], area[sel] / span[sel], 0.0))
+    # Faces span one or two strips: each adds its share to the strips it spans, in the
+    # order of the spans (one bincount, summed as np.add.at would).
+    ks = [np.flatnonzero(k < span) for k in range(int(span.max()))]
+    sel = np.concatenate(ks)
+    s = np.clip(g0[sel] + np.repeat(np.arange(len(ks)), [len(k) for k in ks]), 0, m - 2)
+    w = area[sel] / span[sel]
+    total = np.bincount(s, weights=w, minlength=m - 1)
+    other = np.bincount(s, weights=np.where(off[sel], w, 0.0), minlength=m - 1)
     return np.flatnonzero(other > _TROUBLE_SHARE * np.maximum(total, TINY))

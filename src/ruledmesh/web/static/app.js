@@ -176,6 +176,7 @@ function render() {
   renderPending = false;
   fadeEdges();
   renderer.render(scene, camera);
+  freeRetired();
   if (layers.labels.visible) drawLabels();
   window.designer.frames += 1;
 }
@@ -193,14 +194,22 @@ function resize() {
 }
 window.addEventListener('resize', resize);
 
+// Geometries and materials of removed objects, freed after the next render: three deletes a
+// shader program when the last material using it is freed, so freeing the old handles' and
+// construction's materials before their replacements are drawn would compile the same
+// programs again on every update (tens of milliseconds each in a software renderer).
+const retired = [];
 function clearGroup(group) {
   for (const child of [...group.children]) {
     group.remove(child);
     child.traverse((o) => {
-      if (o.geometry) o.geometry.dispose();
-      if (o.material) o.material.dispose();
+      if (o.geometry) retired.push(o.geometry);
+      if (o.material) retired.push(o.material);
     });
   }
+}
+function freeRetired() {
+  for (const r of retired.splice(0)) r.dispose();
 }
 
 // ------------------------------------------------------------------ colours
@@ -374,25 +383,85 @@ function faceInfo(f) {
            cls: classes ? classes[f] : null };
 }
 
-// Writes `data` into the geometry's buffer when it is large enough (only the used part is
-// uploaded), else makes a buffer with a quarter of headroom, so the next updates of a drag
-// or a slider (whose counts change a little) are written in place. Returns true if reused.
-function fitBuffer(geom, name, data, itemSize) {
+// The geometry's buffer `name` to write `length` numbers into: the one drawn until now when
+// it is large enough (and not far too large), else a new one with a quarter of headroom (a
+// whole number of items), so the next updates of a drag or a slider (whose counts change a
+// little) are written in place. `reused` says which; `written` then uploads the used part.
+function bufferFor(geom, name, length, Type, itemSize) {
   const attr = name === 'index' ? geom.index : geom.getAttribute(name);
-  if (attr && attr.array.length >= data.length && attr.array.length <= 2 * data.length + 64) {
-    attr.array.set(data);
-    attr.clearUpdateRanges();
-    attr.addUpdateRange(0, data.length);
-    attr.needsUpdate = true;
-    return true;
+  if (attr && attr.array.length >= length && attr.array.length <= 2 * length + 64
+      && attr.array.constructor === Type) {
+    return { array: attr.array, reused: true };
   }
-  const big = new data.constructor(Math.ceil(1.25 * data.length) + 16);
-  big.set(data);
-  const fresh = new THREE.BufferAttribute(big, itemSize);
+  const fresh = new THREE.BufferAttribute(new Type(itemSize * (Math.ceil(1.25 * length / itemSize) + 16)),
+                                          itemSize);
   if (name === 'index') geom.setIndex(fresh); else geom.setAttribute(name, fresh);
-  return false;
+  return { array: fresh.array, reused: false };
+}
+function written(geom, name, length) {
+  const attr = name === 'index' ? geom.index : geom.getAttribute(name);
+  attr.clearUpdateRanges();
+  attr.addUpdateRange(0, length);
+  attr.needsUpdate = true;
+}
+// `data` copied into the geometry's buffer `name` (see bufferFor); returns true if reused.
+function fitBuffer(geom, name, data, itemSize) {
+  const buf = bufferFor(geom, name, data.length, data.constructor, itemSize);
+  buf.array.set(data);
+  written(geom, name, data.length);
+  return buf.reused;
+}
+// The bounding sphere from the state's bounding box (every vertex is inside it): no pass over
+// the buffers, whose unused tail holds what an earlier, larger mesh left there.
+function boxSphere(geom) {
+  const [lo, hi] = current.header.bbox;
+  const box = new THREE.Box3(new THREE.Vector3(...lo), new THREE.Vector3(...hi));
+  geom.boundingSphere = box.getBoundingSphere(geom.boundingSphere || new THREE.Sphere());
 }
 const setAttribute = fitBuffer;
+
+// The faces' material: three's Lambert shading (the scene's hemisphere light and the suns
+// that follow the cameras, the same formulas) evaluated per vertex instead of per pixel. The
+// faces are flat (every corner of a face has the face's normal), so the colour is the same
+// as Lambert's per-pixel one, but a software renderer (SwiftShader) shades each of the
+// million pixels with a copy instead of a lighting loop: a third of its frame time.
+const FACE_VERTEX = `
+#include <common>
+#include <lights_pars_begin>
+varying vec3 vFront;
+varying vec3 vBack;
+vec3 lambert(vec3 n, vec3 albedo) {
+  vec3 irradiance = getAmbientLightIrradiance(ambientLightColor);
+  #if NUM_HEMI_LIGHTS > 0
+  for (int i = 0; i < NUM_HEMI_LIGHTS; i++) irradiance += getHemisphereLightIrradiance(hemisphereLights[i], n);
+  #endif
+  #if NUM_DIR_LIGHTS > 0
+  for (int i = 0; i < NUM_DIR_LIGHTS; i++) {
+    irradiance += saturate(dot(n, directionalLights[i].direction)) * directionalLights[i].color;
+  }
+  #endif
+  return irradiance * BRDF_Lambert(albedo);
+}
+void main() {
+  vec3 n = normalize(normalMatrix * normal);
+  vFront = lambert(n, color);
+  vBack = lambert(-n, color);
+  gl_Position = projectionMatrix * modelViewMatrix * vec4(position, 1.0);
+}`;
+const FACE_FRAGMENT = `
+varying vec3 vFront;
+varying vec3 vBack;
+void main() {
+  gl_FragColor = vec4(gl_FrontFacing ? vFront : vBack, 1.0);
+  #include <tonemapping_fragment>
+  #include <colorspace_fragment>
+}`;
+function faceMaterial() {
+  return new THREE.ShaderMaterial({
+    uniforms: THREE.UniformsUtils.clone(THREE.UniformsLib.lights), lights: true,
+    vertexShader: FACE_VERTEX, fragmentShader: FACE_FRAGMENT, vertexColors: true,
+    side: THREE.DoubleSide, polygonOffset: true, polygonOffsetFactor: 1, polygonOffsetUnits: 1 });
+}
 
 // The faces drawn as one indexed mesh with a vertex per face corner (so each face has its
 // own colour and flat normal), written into the buffers drawn until now where they fit (the
@@ -401,8 +470,18 @@ const setAttribute = fitBuffer;
 function drawFaces(sameFaces = false) {
   const { vertices: V, face_offsets: off, face_indices: idx } = current.arrays;
   const nf = off.length - 1, nc = idx.length;
-  const pos = new Float32Array(3 * nc), nor = new Float32Array(3 * nc), col = new Float32Array(3 * nc);
   const fc = faceColours($('colour').value);
+  let mesh = layers.faces.children[0];
+  if (!mesh) {
+    mesh = new THREE.Mesh(new THREE.BufferGeometry(), faceMaterial());
+    layers.faces.add(mesh);
+  }
+  const geom = mesh.geometry;
+  // Written straight into the buffers drawn until now (no arrays made and copied per update).
+  const posBuf = bufferFor(geom, 'position', 3 * nc, Float32Array, 3);
+  const pos = posBuf.array;
+  const nor = bufferFor(geom, 'normal', 3 * nc, Float32Array, 3).array;
+  const col = bufferFor(geom, 'color', 3 * nc, Float32Array, 3).array;
   for (let c = 0; c < nc; c++) {
     const v = 3 * idx[c];
     pos[3 * c] = V[v]; pos[3 * c + 1] = V[v + 1]; pos[3 * c + 2] = V[v + 2];
@@ -425,35 +504,24 @@ function drawFaces(sameFaces = false) {
       col[c] = r; col[c + 1] = g; col[c + 2] = b;
     }
   }
-  let mesh = layers.faces.children[0];
-  if (!mesh) {
-    const mat = new THREE.MeshLambertMaterial({
-      vertexColors: true, side: THREE.DoubleSide, polygonOffset: true,
-      polygonOffsetFactor: 1, polygonOffsetUnits: 1 });
-    mesh = new THREE.Mesh(new THREE.BufferGeometry(), mat);
-    layers.faces.add(mesh);
-  }
-  const geom = mesh.geometry;
-  const reused = fitBuffer(geom, 'position', pos, 3);
-  fitBuffer(geom, 'normal', nor, 3);
-  fitBuffer(geom, 'color', col, 3);
+  for (const name of ['position', 'normal', 'color']) written(geom, name, 3 * nc);
   const nt = current.arrays.triangle_face.length;
   if (!sameFaces || !geom.index || geom.userData.faces !== current.arrays.face_offsets) {
     // Fan triangles of each face in corner numbers, in the server's order (so a picked
     // triangle's face is triangle_face[triangle]).
-    const tri = new Uint32Array(3 * nt);
+    const tri = bufferFor(geom, 'index', 3 * nt, Uint32Array, 1).array;
     let t = 0;
     for (let f = 0; f < nf; f++) {
       for (let c = off[f] + 1; c < off[f + 1] - 1; c++, t += 3) {
         tri[t] = off[f]; tri[t + 1] = c; tri[t + 2] = c + 1;
       }
     }
-    fitBuffer(geom, 'index', tri, 1);
+    written(geom, 'index', 3 * nt);
     geom.userData.faces = current.arrays.face_offsets;
   }
   geom.setDrawRange(0, 3 * nt);
-  geom.computeBoundingSphere();
-  window.designer.reused = reused;
+  boxSphere(geom);
+  window.designer.reused = posBuf.reused;
   window.designer.legend = drawLegend($('colour').value);
 }
 
@@ -488,7 +556,7 @@ function drawEdges(sameFaces = false) {
   fitBuffer(seg.geometry, 'position', V, 3);
   if (!sameFaces || !seg.geometry.index) fitBuffer(seg.geometry, 'index', E, 1);  // the same edges
   seg.geometry.setDrawRange(0, E.length);
-  seg.geometry.computeBoundingSphere();
+  boxSphere(seg.geometry);
   // The faces' median width (area / longest edge, of up to 2,000 faces): the spacing of the
   // edges across the faces, also for long thin ones; fadeEdges dims dense meshes by it.
   const { face_offsets: off, face_indices: idx } = current.arrays;
@@ -637,7 +705,9 @@ function drawGrid() {
 function drawScene() {
   const { header, arrays } = current;
   const [lo, hi] = header.bbox;
-  size = Math.hypot(hi[0] - lo[0], hi[1] - lo[1], hi[2] - lo[2]) || 1;
+  // Three digits: the handles' radius, the dashes and the construction's extent do not
+  // follow the last digits of the box, which move with every row count (the layers stay).
+  size = Number((Math.hypot(hi[0] - lo[0], hi[1] - lo[1], hi[2] - lo[2]) || 1).toPrecision(3));
   // Buffers of the same size are written in place (no new GPU buffers, no garbage): a
   // moved point or a continuous slider mostly keeps the face and edge counts.
   // How long each part of drawing takes (window.designer.drawTimes, for the speed figures).
@@ -1889,6 +1959,21 @@ window.designer = {
     requestAnimationFrame(() => resolve(performance.now() - t0));
   }),
   selection: () => [...selection],
+  // The shader programs in use (their ids: a program compiled again gets a new one).
+  programs: () => renderer.info.programs.map((p) => p.id),
+  // Milliseconds of one render of the scene as it is (nothing new to upload), the minimum of
+  // n; reading a pixel back waits until the renderer has drawn every pixel of it.
+  renderMs: (n = 5) => {
+    let best = Infinity;
+    for (let k = 0; k < n; k++) {
+      const t = performance.now();
+      renderer.render(scene, camera);
+      const gl = renderer.getContext();
+      gl.readPixels(0, 0, 1, 1, gl.RGBA, gl.UNSIGNED_BYTE, new Uint8Array(4));
+      best = Math.min(best, performance.now() - t);
+    }
+    return best;
+  },
   design: () => current?.header.design,
   // What the GPU buffers hold now: faces and triangles drawn, and the vertices written into
   // the face edges' position buffer (their count and sum), to check a frame against a build.
