@@ -42,6 +42,7 @@ from typing import Any
 
 import numpy as np
 
+from ._arrays import unique
 from ._validation import (
     check_float,
     check_int,
@@ -237,7 +238,7 @@ class LevelSet:
     """
 
     def __init__(self, g: Callable, dg: Callable, grid: np.ndarray, tol: float):
-        grid = np.unique(np.concatenate([[0.0, 1.0], np.clip(grid, 0.0, 1.0)]))
+        grid = unique(np.concatenate([[0.0, 1.0], np.clip(grid, 0.0, 1.0)]))
         a, b = grid[:-1], grid[1:]
         # one-sided derivatives just inside each interval, so kinks at nodes
         # never fake a critical point inside an interval
@@ -258,7 +259,7 @@ class LevelSet:
                 crit.append(brentq(slope, lo, hi, xtol=ROOT_XTOL, rtol=ROOT_RTOL))
         self.g, self.dg = g, dg
         self.tol = float(tol)
-        self.nodes = np.unique(np.concatenate([grid, crit]))
+        self.nodes = unique(np.concatenate([grid, crit]))
         self.values = np.asarray(g(self.nodes), dtype=np.float64)
 
     @property
@@ -1288,7 +1289,7 @@ class BSpline(Curve):
 
     def _breaks(self):
         t0, t1 = self._domain
-        k = np.unique(self._knot_vector)
+        k = unique(self._knot_vector)
         k = k[(k >= t0) & (k <= t1)]
         u = (k - t0) / (t1 - t0)
         u[0], u[-1] = 0.0, 1.0

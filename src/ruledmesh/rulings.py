@@ -42,6 +42,7 @@ from typing import Any
 
 import numpy as np
 
+from ._arrays import unique
 from ._validation import (
     check_choice,
     check_int,
@@ -275,7 +276,7 @@ class RuledSurface:
         n = check_int(n, "n", lo=1)
         x, w = np.polynomial.legendre.leggauss(n)
         x, w = 0.5 * (x + 1.0), 0.5 * w
-        br = np.unique(np.concatenate([[0.0, 1.0], self.breaks]))
+        br = unique(np.concatenate([[0.0, 1.0], self.breaks]))
         lo, hi = br[:-1], br[1:]
         uu = (lo[:, None] + (hi - lo)[:, None] * x[None, :]).ravel()
         wu = ((hi - lo)[:, None] * w[None, :]).ravel()
@@ -533,7 +534,7 @@ class _PencilAngle:
         return np.hypot(x, y)
 
     def level(self, curve: Curve, name: str, tol: Tolerances) -> LevelSet:
-        grid = np.unique(np.concatenate([curve.level_grid(), curve.breaks()]))
+        grid = unique(np.concatenate([curve.level_grid(), curve.breaks()]))
         # the closest approach to d, polished between the neighbours of the
         # nearest sample (there the pencil angle jumps by pi)
         i = int(np.argmin(self.radius(curve.point_at(grid))))
@@ -559,7 +560,7 @@ class _PencilAngle:
             ref = np.unwrap(self.raw(pts))
             if np.max(np.abs(np.diff(ref))) < 0.5:
                 break
-            grid = np.unique(np.concatenate([grid, 0.5 * (grid[:-1] + grid[1:])]))
+            grid = unique(np.concatenate([grid, 0.5 * (grid[:-1] + grid[1:])]))
         else:
             raise GeometryError(
                 f"linear-directrix: {name} winds around the directrix d too closely to follow")

@@ -18,7 +18,7 @@ import numpy as np
 
 from ..tolerances import ROUNDING_SQ, TINY
 
-__all__ = ["crossing", "min_angles", "newell", "quad_planarity"]
+__all__ = ["crossing", "min_angles", "newell", "polygon_angles", "quad_planarity"]
 
 _DEG = 180.0 / math.pi
 # numpy's pairwise sum adds up to 128 terms in one unrolled block: the Newell kernel
@@ -275,3 +275,35 @@ def min_angles(V: np.ndarray, idx: np.ndarray, off: np.ndarray) -> np.ndarray:
     """
     return _min_angles(np.ascontiguousarray(V, dtype=np.float64), np.ascontiguousarray(idx),
                        np.ascontiguousarray(off))
+
+
+@nb.njit(cache=True, nogil=True)
+def _polygon_angles(P):
+    F, k = P.shape[0], P.shape[1]
+    out = np.empty((F, k))
+    for f in range(F):
+        for j in range(k):
+            p = j - 1 if j > 0 else k - 1
+            q = j + 1 if j + 1 < k else 0
+            x0, x1, x2 = P[f, p, 0] - P[f, j, 0], P[f, p, 1] - P[f, j, 1], P[f, p, 2] - P[f, j, 2]
+            y0, y1, y2 = P[f, q, 0] - P[f, j, 0], P[f, q, 1] - P[f, j, 1], P[f, q, 2] - P[f, j, 2]
+            # einsum("fkc,fkc->fk") accumulates onto a zero: a sum of negative zeros is +0.
+            cos = 0.0 + _dot(x0, x1, x2, y0, y1, y2)
+            sin = _norm(x1 * y2 - x2 * y1, x2 * y0 - x0 * y2, x0 * y1 - x1 * y0)
+            out[f, j] = math.atan2(sin, cos) * _DEG
+    return out
+
+
+def polygon_angles(corners: np.ndarray) -> np.ndarray:
+    """:func:`ruledmesh.analysis.faces.polygon_angles`, bit for bit, without the (F, k, 3) temporaries.
+
+    Parameters
+    ----------
+    corners : (F, k, 3) float64, k >= 1
+
+    Returns
+    -------
+    (F, k) float64
+        Interior angles, degrees.
+    """
+    return _polygon_angles(np.ascontiguousarray(corners, dtype=np.float64))
