@@ -36,8 +36,12 @@ def _max(x: float, y: float) -> float:
 
 @nb.njit(cache=True, inline="always")
 def _dot(x0: float, x1: float, x2: float, y0: float, y1: float, y2: float) -> float:
-    """einsum("ij,ij->i") of three components, in numpy's order."""
-    return (x0 * y0 + x2 * y2) + x1 * y1
+    """einsum("ij,ij->i") of three components, in numpy's order.
+
+    einsum accumulates onto a zero, so a sum of negative zeros is +0 (and the
+    sign of a zero cosine decides between 0 and 180 degrees in ``atan2``).
+    """
+    return 0.0 + ((x0 * y0 + x2 * y2) + x1 * y1)
 
 
 @nb.njit(cache=True, inline="always")
@@ -287,8 +291,7 @@ def _polygon_angles(P):
             q = j + 1 if j + 1 < k else 0
             x0, x1, x2 = P[f, p, 0] - P[f, j, 0], P[f, p, 1] - P[f, j, 1], P[f, p, 2] - P[f, j, 2]
             y0, y1, y2 = P[f, q, 0] - P[f, j, 0], P[f, q, 1] - P[f, j, 1], P[f, q, 2] - P[f, j, 2]
-            # einsum("fkc,fkc->fk") accumulates onto a zero: a sum of negative zeros is +0.
-            cos = 0.0 + _dot(x0, x1, x2, y0, y1, y2)
+            cos = _dot(x0, x1, x2, y0, y1, y2)
             sin = _norm(x1 * y2 - x2 * y1, x2 * y0 - x0 * y2, x0 * y1 - x1 * y0)
             out[f, j] = math.atan2(sin, cos) * _DEG
     return out
