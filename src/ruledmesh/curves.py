@@ -147,10 +147,17 @@ _ALTERNATING = (-1.0) ** np.arange(_GL_NODES + 2)
 
 def _clenshaw(coef: np.ndarray, xi: np.ndarray) -> np.ndarray:
     """(N,) values of Legendre series with per-point coefficients ``coef (N, n)`` at ``xi``."""
-    b1 = np.zeros_like(xi)
-    b2 = np.zeros_like(xi)
-    for j in range(coef.shape[1] - 1, 0, -1):
+    n = coef.shape[1]
+    if n == 1:
+        return coef[:, 0] + xi * 0.0 - 0.0
+    # The first two steps with their zero terms left out: adding a product with a zero
+    # b (or subtracting +0) changes no value but the sign of an exact zero.
+    b2 = coef[:, n - 1]
+    b1 = coef[:, n - 2] + (2 * n - 3) / (n - 1) * xi * b2 if n > 2 else b2
+    for j in range(n - 3, 0, -1):
         b1, b2 = coef[:, j] + (2 * j + 1) / (j + 1) * xi * b1 - (j + 1) / (j + 2) * b2, b1
+    if n == 2:
+        return coef[:, 0] + xi * b1
     return coef[:, 0] + xi * b1 - 0.5 * b2
 
 
@@ -203,15 +210,16 @@ def _de_boor(knots: np.ndarray, control: np.ndarray, degree: int, x: np.ndarray)
     n = len(control)
     flat = x.ravel()
     span = np.clip(np.searchsorted(knots, flat, side="right") - 1, degree, n - 1)
-    d = [control[span - degree + j] for j in range(degree + 1)]
+    # d[:, j] is the triangle's entry j; each step updates the entries r..degree at once
+    # (from the previous step's values, as the classic loop from j = degree down does).
+    d = control[span[:, None] + np.arange(-degree, 1)]  # (N, degree + 1, dim)
+    j = np.arange(degree + 1)
     for r in range(1, degree + 1):
-        for j in range(degree, r - 1, -1):
-            left = knots[span + j - degree]
-            right = knots[span + j + 1 - r]
-            denom = right - left
-            alpha = np.divide(flat - left, denom, out=np.zeros_like(flat), where=denom > 0)
-            d[j] = (1.0 - alpha)[:, None] * d[j - 1] + alpha[:, None] * d[j]
-    return d[degree].reshape(x.shape + (control.shape[1],))
+        left = knots[span[:, None] + (j[r:] - degree)]
+        denom = knots[span[:, None] + (j[r:] + 1 - r)] - left
+        alpha = np.divide(flat[:, None] - left, denom, out=np.zeros(denom.shape), where=denom > 0)
+        d[:, r:] = (1.0 - alpha)[..., None] * d[:, r - 1:-1] + alpha[..., None] * d[:, r:]
+    return d[:, degree].reshape(x.shape + (control.shape[1],))
 
 
 # --------------------------------------------------------------------------
