@@ -4,7 +4,7 @@ Each kernel is the numpy function's arithmetic in the numpy function's order,
 one face per loop iteration, reading the corners through the face indices
 instead of gathering an (F, k, 3) copy first.  The order of the sums matters
 for bit-identical results and follows what numpy does: ``einsum("ij,ij->i")``
-over three components adds ``(x0 y0 + x2 y2) + x1 y1``, ``norm(axis=1)``
+over three components adds ``(x0 y0 + x2 y2) + x1 y1`` onto +0, ``norm(axis=1)``
 adds the squares left to right, and ``add.reduceat`` adds the first row to the
 sum of the others.  The tests compare every kernel with its numpy reference.
 """
