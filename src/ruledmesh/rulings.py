@@ -193,6 +193,11 @@ class _CurveTrack:
     def deriv(self, u):
         return self.curve.tangent_at(self.sigma.value(u)) * self.sigma.deriv(u)[..., None]
 
+    def value_deriv(self, u):
+        """``(value(u), deriv(u))`` with the correspondence evaluated once."""
+        sigma = self.sigma.value(u)
+        return self.curve.point_at(sigma), self.curve.tangent_at(sigma) * self.sigma.deriv(u)[..., None]
+
 
 @dataclass(frozen=True, eq=False)
 class _SplineTrack:
@@ -223,6 +228,11 @@ class _ConoidTrack:
     def deriv(self, u):
         s = self.base.deriv(u) @ self.n / (self.e @ self.n)
         return s[..., None] * self.e
+
+
+def _value_deriv(rail: Any, u: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    both = getattr(rail, "value_deriv", None)
+    return both(u) if both is not None else (rail.value(u), rail.deriv(u))
 
 
 @dataclass(frozen=True, eq=False)
@@ -264,6 +274,15 @@ class RuledSurface:
         su = da + t[..., None] * (db - da)
         st = self.rail_b.value(u) - self.rail_a.value(u)
         return su, st
+
+    def point_partials(self, u: Any, t: Any) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """``(S, S_u, S_t)``, each (..., 3): :meth:`point` and :meth:`partials` with each rail
+        evaluated once (a closest-point step needs all three)."""
+        u, t = np.broadcast_arrays(np.asarray(u, dtype=np.float64), np.asarray(t, dtype=np.float64))
+        a, da = _value_deriv(self.rail_a, u)
+        b, db = _value_deriv(self.rail_b, u)
+        st = b - a
+        return a + t[..., None] * st, da + t[..., None] * (db - da), st
 
     def area(self, n: int = 16) -> float:
         """Area of the patch: composite Gauss-Legendre of ``|S_u x S_t|``.

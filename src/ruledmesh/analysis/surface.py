@@ -113,12 +113,16 @@ class RuledReference:
         """
         u, t = u.copy(), t.copy()
         live = np.arange(len(u))
+        both = getattr(self.surface, "point_partials", None)
         for _ in range(iterations):
             if live.size == 0:
                 break
             uu, tt, pp = u[live], t[live], points[live]
-            s = self.surface.point(uu, tt)
-            su, st = self.surface.partials(uu, tt)
+            if both is not None:        # the rails evaluated once for the point and its partials
+                s, su, st = both(uu, tt)
+            else:
+                s = self.surface.point(uu, tt)
+                su, st = self.surface.partials(uu, tt)
             r = s - pp
             a = np.einsum("ij,ij->i", su, su)
             b = np.einsum("ij,ij->i", su, st)
