@@ -24,8 +24,8 @@ SRC = Path(__file__).resolve().parents[1] / "src" / "ruledmesh"
 #: Bottom to top. Entries are modules or packages relative to ``ruledmesh``; a module belongs to
 #: the longest entry that prefixes its name. "" is the package's top level (``__init__``).
 LAYERS: list[tuple[str, list[str]]] = [
-    ("foundation", ["errors", "_version", "tolerances", "_validation", "units", "progress", "_files", "roots",
-                    "budget", "normalise", "kernels"]),
+    ("foundation", ["errors", "_version", "tolerances", "_validation", "_arrays", "units", "progress",
+                    "_files", "roots", "budget", "normalise", "kernels"]),
     # Per-face measures and the distance to the smooth patch are geometry of a mesh that the
     # meshers check their own output with; they depend on the mesh only.
     ("core", ["mesh", "notebook", "registry", "curves", "triangulate", "hop", "surfaces", "labels",

@@ -3,8 +3,8 @@
 numpy 2.3+ finds the unique values of a plain ``np.unique(x)`` through a hash
 table and sorts them afterwards; on arrays of a million edge keys or vertex
 indices that is 30-70 times slower than sorting first (the table misses the
-cache at every insertion), and every call imports ``numpy.ma`` (about 20 ms of
-start-up) to ask whether the array is masked.  :func:`unique` is numpy's own
+cache at every insertion), and its first call imports ``numpy.ma`` (about 20 ms)
+to ask whether the array is masked.  :func:`unique` is numpy's own
 sorting method, so its result is the same array.
 """
 
