@@ -18,7 +18,9 @@ arc length), with ``pq_mesh(a, b, rows=n, trim=True)``:
   that imports ruledmesh and builds 1000 x 1000 once, per face; and the same
   less the resident memory of the process before the build; and both again in a
   process that loaded the kernels and built once before (``warm``: what the
-  build itself holds, without the one-off cost of loading numba).
+  build itself holds, without the one-off cost of loading numba), and in a fresh
+  process in numpy only (``numpy``, ``RULEDMESH_KERNELS=0``: whether numba's
+  runtime is the floor).
 
 Times are CPU times of this process (``time.process_time``), the least
 sensitive to other jobs on a shared machine; the load average is recorded with
@@ -144,12 +146,14 @@ def scaling(sizes: list[int], repeats: int) -> dict:
 
 def memory(n: int = 1000) -> dict:
     out = {}
-    for warm in (False, True):
+    for key, warm, kernels in (("fresh", False, None), ("warm", True, None), ("numpy", False, "0")):
         code = _CHILD.format(here=str(HERE), warm=warm, n=n)
+        env = dict(os.environ)
+        if kernels is not None:
+            env["RULEDMESH_KERNELS"] = kernels
         run = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True,
-                             timeout=1800)
+                             timeout=1800, env=env)
         faces, base, peak = (int(x) for x in run.stdout.split())
-        key = "warm" if warm else "fresh"
         out[f"peak_rss_{key}_bytes"] = peak
         out[f"base_rss_{key}_bytes"] = base
         out[f"peak_rss_{key}_bytes_per_face"] = peak / faces

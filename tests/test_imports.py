@@ -24,8 +24,8 @@ SRC = Path(__file__).resolve().parents[1] / "src" / "ruledmesh"
 #: Bottom to top. Entries are modules or packages relative to ``ruledmesh``; a module belongs to
 #: the longest entry that prefixes its name. "" is the package's top level (``__init__``).
 LAYERS: list[tuple[str, list[str]]] = [
-    ("foundation", ["errors", "_version", "tolerances", "_validation", "units", "progress", "_files", "roots",
-                    "budget", "normalise", "kernels"]),
+    ("foundation", ["errors", "_version", "tolerances", "_validation", "_arrays", "units", "progress",
+                    "_files", "roots", "budget", "normalise", "kernels"]),
     # Per-face measures and the distance to the smooth patch are geometry of a mesh that the
     # meshers check their own output with; they depend on the mesh only.
     ("core", ["mesh", "notebook", "registry", "curves", "triangulate", "hop", "surfaces", "labels",
@@ -178,8 +178,8 @@ def test_only_public_names_cross_units():
         private = [n for n in names if n.startswith("_") and not n.startswith("__")]
         hidden = [p for p in target.split(".") if p.startswith("_") and not p.startswith("__")]
         # a private module of a unit is private to it; the top-level helpers (_validation,
-        # _version, _files) are the package's shared foundation
-        if hidden and _unit(target) not in ("_validation", "_version", "_files"):
+        # _version, _files, _arrays) are the package's shared foundation
+        if hidden and _unit(target) not in ("_validation", "_version", "_files", "_arrays"):
             private.append(target)
         if private:
             wrong.append(f"ruledmesh.{source}:{line} uses {', '.join(private)} of ruledmesh.{target}")

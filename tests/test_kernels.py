@@ -68,6 +68,19 @@ def test_quad_crossing_and_planarity(monkeypatch, seed, n, spread):
 
 
 @SETTINGS
+@given(seed=st.integers(0, 2**31), n=st.integers(1, 300), k=st.integers(3, 7), spread=st.floats(-3, 6))
+def test_polygon_angles(monkeypatch, seed, n, k, spread):
+    """Corner angles of polygons (the flips' and the slivers' measure), repeated corners included."""
+    rng = np.random.default_rng(seed)
+    C = rng.standard_normal((n, k, 3)) * 10.0 ** spread + rng.uniform(-1e4, 1e4, (n, 1, 3))
+    C[: n // 3, 1] = C[: n // 3, 0]                          # a zero edge: zero dot products
+    if n > 2:
+        C[-1, 1, 0] = np.nan
+    ref, got = both(monkeypatch, lambda: faces.polygon_angles(C))
+    assert same(ref, got)
+
+
+@SETTINGS
 @given(seed=st.integers(0, 2**31), m=st.integers(3, 40), rows=st.integers(1, 40),
        twist=st.floats(0.1, 3.0), wobble=st.floats(0.0, 1.5), option=st.integers(0, 1))
 def test_run_grid(monkeypatch, seed, m, rows, twist, wobble, option):

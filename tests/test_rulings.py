@@ -329,3 +329,20 @@ def test_spec_errors_name_the_field(spec, message):
 def test_reference_surface_does_not_depend_on_the_generator_count(dist, kw):
     areas = [between(C1, C2, count, dist, **kw).surface.area() for count in (3, 17, 60)]
     assert np.ptp(areas) <= 1e-10 * areas[0]
+
+
+@pytest.mark.parametrize("make", [
+    lambda: between(C1, C2, 11, "arc-length"),
+    lambda: between(C1, Polyline([[0, 2, 4], [3, 4, 5], [6, 3, 3], [10, 3, 4]]), 9, "director-plane",
+                    director_plane=[1, 0, 0]),
+    lambda: conoid(ARC, LINE_D, np.array([1.0, 0.0, 0.0]), 7),
+    lambda: from_lines(np.stack([np.column_stack([np.linspace(0, 1, 9), np.zeros(9), np.zeros(9)]),
+                                 np.column_stack([np.linspace(0, 1, 9), np.ones(9), np.linspace(0, 1, 9) ** 2])], 1)),
+])
+def test_point_partials_is_point_and_partials(make):
+    """The closest-point steps' combined evaluation is bit for bit the two separate ones."""
+    s = make().surface
+    u, t = np.linspace(0, 1, 23), np.linspace(0, 1, 23)[::-1]
+    p, su, st = s.point_partials(u, t)
+    qu, qt = s.partials(u, t)
+    assert np.array_equal(p, s.point(u, t)) and np.array_equal(su, qu) and np.array_equal(st, qt)

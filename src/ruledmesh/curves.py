@@ -42,6 +42,7 @@ from typing import Any
 
 import numpy as np
 
+from ._arrays import unique
 from ._validation import (
     check_float,
     check_int,
@@ -146,10 +147,17 @@ _ALTERNATING = (-1.0) ** np.arange(_GL_NODES + 2)
 
 def _clenshaw(coef: np.ndarray, xi: np.ndarray) -> np.ndarray:
     """(N,) values of Legendre series with per-point coefficients ``coef (N, n)`` at ``xi``."""
-    b1 = np.zeros_like(xi)
-    b2 = np.zeros_like(xi)
-    for j in range(coef.shape[1] - 1, 0, -1):
+    n = coef.shape[1]
+    if n == 1:
+        return coef[:, 0] + xi * 0.0 - 0.0
+    # The first two steps with their zero terms left out: adding a product with a zero
+    # b (or subtracting +0) changes no value but the sign of an exact zero.
+    b2 = coef[:, n - 1]
+    b1 = coef[:, n - 2] + (2 * n - 3) / (n - 1) * xi * b2 if n > 2 else b2
+    for j in range(n - 3, 0, -1):
         b1, b2 = coef[:, j] + (2 * j + 1) / (j + 1) * xi * b1 - (j + 1) / (j + 2) * b2, b1
+    if n == 2:
+        return coef[:, 0] + xi * b1
     return coef[:, 0] + xi * b1 - 0.5 * b2
 
 
@@ -202,15 +210,16 @@ def _de_boor(knots: np.ndarray, control: np.ndarray, degree: int, x: np.ndarray)
     n = len(control)
     flat = x.ravel()
     span = np.clip(np.searchsorted(knots, flat, side="right") - 1, degree, n - 1)
-    d = [control[span - degree + j] for j in range(degree + 1)]
+    # d[:, j] is the triangle's entry j; each step updates the entries r..degree at once
+    # (from the previous step's values, as the classic loop from j = degree down does).
+    d = control[span[:, None] + np.arange(-degree, 1)]  # (N, degree + 1, dim)
+    j = np.arange(degree + 1)
     for r in range(1, degree + 1):
-        for j in range(degree, r - 1, -1):
-            left = knots[span + j - degree]
-            right = knots[span + j + 1 - r]
-            denom = right - left
-            alpha = np.divide(flat - left, denom, out=np.zeros_like(flat), where=denom > 0)
-            d[j] = (1.0 - alpha)[:, None] * d[j - 1] + alpha[:, None] * d[j]
-    return d[degree].reshape(x.shape + (control.shape[1],))
+        left = knots[span[:, None] + (j[r:] - degree)]
+        denom = knots[span[:, None] + (j[r:] + 1 - r)] - left
+        alpha = np.divide(flat[:, None] - left, denom, out=np.zeros(denom.shape), where=denom > 0)
+        d[:, r:] = (1.0 - alpha)[..., None] * d[:, r - 1:-1] + alpha[..., None] * d[:, r:]
+    return d[:, degree].reshape(x.shape + (control.shape[1],))
 
 
 # --------------------------------------------------------------------------
@@ -237,7 +246,7 @@ class LevelSet:
     """
 
     def __init__(self, g: Callable, dg: Callable, grid: np.ndarray, tol: float):
-        grid = np.unique(np.concatenate([[0.0, 1.0], np.clip(grid, 0.0, 1.0)]))
+        grid = unique(np.concatenate([[0.0, 1.0], np.clip(grid, 0.0, 1.0)]))
         a, b = grid[:-1], grid[1:]
         # one-sided derivatives just inside each interval, so kinks at nodes
         # never fake a critical point inside an interval
@@ -258,7 +267,7 @@ class LevelSet:
                 crit.append(brentq(slope, lo, hi, xtol=ROOT_XTOL, rtol=ROOT_RTOL))
         self.g, self.dg = g, dg
         self.tol = float(tol)
-        self.nodes = np.unique(np.concatenate([grid, crit]))
+        self.nodes = unique(np.concatenate([grid, crit]))
         self.values = np.asarray(g(self.nodes), dtype=np.float64)
 
     @property
@@ -1288,7 +1297,7 @@ class BSpline(Curve):
 
     def _breaks(self):
         t0, t1 = self._domain
-        k = np.unique(self._knot_vector)
+        k = unique(self._knot_vector)
         k = k[(k >= t0) & (k <= t1)]
         u = (k - t0) / (t1 - t0)
         u[0], u[-1] = 0.0, 1.0

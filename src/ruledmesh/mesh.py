@@ -18,6 +18,7 @@ from typing import Any
 
 import numpy as np
 
+from ._arrays import unique
 from ._validation import check_points
 from .errors import ParameterError
 from .tolerances import ROUNDING, TINY
@@ -275,7 +276,7 @@ class Mesh:
         if lo.size == 0:
             return np.zeros((0, 2), np.int64)
         # One packed int64 key per edge: a 1-D unique is several times faster than axis=0.
-        key = np.unique(lo * np.int64(self.n_vertices) + hi)
+        key = unique(lo * np.int64(self.n_vertices) + hi)
         return np.stack([key // self.n_vertices, key % self.n_vertices], axis=1)
 
     def bounding_box(self) -> np.ndarray:

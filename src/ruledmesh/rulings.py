@@ -42,6 +42,7 @@ from typing import Any
 
 import numpy as np
 
+from ._arrays import unique
 from ._validation import (
     check_choice,
     check_int,
@@ -192,6 +193,11 @@ class _CurveTrack:
     def deriv(self, u):
         return self.curve.tangent_at(self.sigma.value(u)) * self.sigma.deriv(u)[..., None]
 
+    def value_deriv(self, u):
+        """``(value(u), deriv(u))`` with the correspondence evaluated once."""
+        sigma = self.sigma.value(u)
+        return self.curve.point_at(sigma), self.curve.tangent_at(sigma) * self.sigma.deriv(u)[..., None]
+
 
 @dataclass(frozen=True, eq=False)
 class _SplineTrack:
@@ -222,6 +228,11 @@ class _ConoidTrack:
     def deriv(self, u):
         s = self.base.deriv(u) @ self.n / (self.e @ self.n)
         return s[..., None] * self.e
+
+
+def _value_deriv(rail: Any, u: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    both = getattr(rail, "value_deriv", None)
+    return both(u) if both is not None else (rail.value(u), rail.deriv(u))
 
 
 @dataclass(frozen=True, eq=False)
@@ -264,6 +275,15 @@ class RuledSurface:
         st = self.rail_b.value(u) - self.rail_a.value(u)
         return su, st
 
+    def point_partials(self, u: Any, t: Any) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """``(S, S_u, S_t)``, each (..., 3): :meth:`point` and :meth:`partials` with each rail
+        evaluated once (a closest-point step needs all three)."""
+        u, t = np.broadcast_arrays(np.asarray(u, dtype=np.float64), np.asarray(t, dtype=np.float64))
+        a, da = _value_deriv(self.rail_a, u)
+        b, db = _value_deriv(self.rail_b, u)
+        st = b - a
+        return a + t[..., None] * st, da + t[..., None] * (db - da), st
+
     def area(self, n: int = 16) -> float:
         """Area of the patch: composite Gauss-Legendre of ``|S_u x S_t|``.
 
@@ -275,7 +295,7 @@ class RuledSurface:
         n = check_int(n, "n", lo=1)
         x, w = np.polynomial.legendre.leggauss(n)
         x, w = 0.5 * (x + 1.0), 0.5 * w
-        br = np.unique(np.concatenate([[0.0, 1.0], self.breaks]))
+        br = unique(np.concatenate([[0.0, 1.0], self.breaks]))
         lo, hi = br[:-1], br[1:]
         uu = (lo[:, None] + (hi - lo)[:, None] * x[None, :]).ravel()
         wu = ((hi - lo)[:, None] * w[None, :]).ravel()
@@ -533,7 +553,7 @@ class _PencilAngle:
         return np.hypot(x, y)
 
     def level(self, curve: Curve, name: str, tol: Tolerances) -> LevelSet:
-        grid = np.unique(np.concatenate([curve.level_grid(), curve.breaks()]))
+        grid = unique(np.concatenate([curve.level_grid(), curve.breaks()]))
         # the closest approach to d, polished between the neighbours of the
         # nearest sample (there the pencil angle jumps by pi)
         i = int(np.argmin(self.radius(curve.point_at(grid))))
@@ -559,7 +579,7 @@ class _PencilAngle:
             ref = np.unwrap(self.raw(pts))
             if np.max(np.abs(np.diff(ref))) < 0.5:
                 break
-            grid = np.unique(np.concatenate([grid, 0.5 * (grid[:-1] + grid[1:])]))
+            grid = unique(np.concatenate([grid, 0.5 * (grid[:-1] + grid[1:])]))
         else:
             raise GeometryError(
                 f"linear-directrix: {name} winds around the directrix d too closely to follow")

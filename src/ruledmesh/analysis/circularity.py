@@ -21,6 +21,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from .._arrays import unique
 from ..mesh import Mesh
 from ..tolerances import COLLINEAR_SQ, DEFAULT, Tolerances
 from ..tolerances import TINY as _TINY
@@ -116,7 +117,7 @@ def circularity(mesh: Mesh) -> np.ndarray:
     qid, quads = mesh.faces_of_valence(4)
     if qid.size:
         out[qid] = quad_circularity(mesh.vertices[quads])
-    for k in np.unique(mesh.valences[mesh.valences > 4]):
+    for k in unique(mesh.valences[mesh.valences > 4]):
         ids, faces = mesh.faces_of_valence(int(k))
         pts = mesh.vertices[faces]
         center, normal, radius = circle_through(pts[:, 0], pts[:, k // 3], pts[:, (2 * k) // 3])

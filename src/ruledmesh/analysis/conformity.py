@@ -13,6 +13,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from .._arrays import unique
 from ..mesh import Mesh
 from ..tolerances import DEFAULT, TINY
 
@@ -70,7 +71,7 @@ def t_junctions(mesh: Mesh, tol: float = DEFAULT.degenerate) -> np.ndarray:
     edges = _single_edges(mesh)
     # A vertex hanging on a border edge is itself on the border (the end of two
     # border edges of the faces beside it): only border vertices are candidates.
-    used = np.unique(edges)
+    used = unique(edges)
     if edges.size == 0 or used.size == 0:
         return np.zeros((0, 3), np.int64)
     v = mesh.vertices

@@ -11,6 +11,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from .._arrays import unique
 from ..kernels import wanted
 from ..mesh import Mesh
 from ..tolerances import DEFAULT, ROUNDING_SQ
@@ -215,6 +216,11 @@ def polygon_angles(corners: np.ndarray) -> np.ndarray:
     corners : (F, k, 3) float64
         Corners in order around each polygon.
     """
+    corners = np.asarray(corners)
+    if corners.ndim == 3 and corners.shape[1] and corners.shape[2] == 3 and corners.dtype == np.float64:
+        kern = wanted(corners.shape[0] * corners.shape[1])
+        if kern is not None:
+            return kern.polygon_angles(corners)
     e1 = np.roll(corners, 1, axis=1) - corners
     e2 = np.roll(corners, -1, axis=1) - corners
     cosang = np.einsum("fkc,fkc->fk", e1, e2)
@@ -328,7 +334,7 @@ def area_shares(mesh: Mesh) -> dict:
     val = mesh.valences
     by_kind = np.bincount(mesh.face_kind, weights=area, minlength=len(FaceKind))
     return {
-        "by_kind": {FaceKind(k).label: float(by_kind[k] / total) for k in np.unique(mesh.face_kind)},
+        "by_kind": {FaceKind(k).label: float(by_kind[k] / total) for k in unique(mesh.face_kind)},
         "quads": float(area[val == 4].sum() / total),
         "triangles": float(area[val == 3].sum() / total),
         "polygons": float(area[val > 4].sum() / total),

@@ -29,6 +29,7 @@ from typing import Any
 
 import numpy as np
 
+from .._arrays import unique
 from ..errors import GeometryError
 from ..mesh import FaceKind, Mesh
 from ..progress import Progress, stages
@@ -292,7 +293,7 @@ def _closeness(mesh: Mesh, reference, mesh_area: float) -> dict[str, Any]:
     """Closeness to the smooth patch and coverage of it (relative to the diagonal)."""
     diag = mesh.diagonal() or 1.0
     dc = reference.distance(F.face_centroids(mesh)) / diag
-    dv = reference.distance(mesh.vertices[np.unique(mesh.face_indices)]) / diag
+    dv = reference.distance(mesh.vertices[unique(mesh.face_indices)]) / diag
     out: dict[str, Any] = {"closeness": {
         "vertices_max": float(dv.max()) if dv.size else 0.0,
         "centroids_max": float(dc.max()) if dc.size else 0.0,

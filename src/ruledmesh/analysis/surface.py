@@ -18,6 +18,8 @@ from ..tolerances import SETTLED, TINY
 
 # Up to this many point-sample pairs the nearest seeds are found by comparing all pairs.
 _BRUTE_FORCE = 2_000_000
+# Points per block of that comparison.
+_BLOCK = 64
 
 __all__ = ["RuledReference"]
 
@@ -57,10 +59,17 @@ class RuledReference:
             # coordinates the expanded squares would round the distances away.
             centre = pts.mean(axis=0)
             p, q = points - centre, pts - centre
-            d = (np.einsum("ij,ij->i", p, p)[:, None] - 2.0 * p @ q.T
-                 + np.einsum("ij,ij->i", q, q)[None, :])
-            return np.argpartition(d, k - 1, axis=1)[:, :k] if k < len(pts) else \
-                np.broadcast_to(np.arange(len(pts)), (len(points), len(pts)))
+            if k >= len(pts):
+                return np.broadcast_to(np.arange(len(pts)), (len(points), len(pts)))
+            pp, qq, qt = np.einsum("ij,ij->i", p, p), np.einsum("ij,ij->i", q, q)[None, :], q.T
+            out = np.empty((len(points), k), dtype=np.int64)
+            # In blocks of rows: the block's distances stay in the cache (the whole matrix
+            # is 16 MB at the limit) and each row's selection is the same.
+            for lo in range(0, len(points), _BLOCK):
+                d = pp[lo:lo + _BLOCK, None] - 2.0 * p[lo:lo + _BLOCK] @ qt
+                d += qq
+                out[lo:lo + _BLOCK] = np.argpartition(d, k - 1, axis=1)[:, :k]
+            return out
         if "tree" not in self._cache:
             from scipy.spatial import cKDTree
 
@@ -104,12 +113,16 @@ class RuledReference:
         """
         u, t = u.copy(), t.copy()
         live = np.arange(len(u))
+        both = getattr(self.surface, "point_partials", None)
         for _ in range(iterations):
             if live.size == 0:
                 break
             uu, tt, pp = u[live], t[live], points[live]
-            s = self.surface.point(uu, tt)
-            su, st = self.surface.partials(uu, tt)
+            if both is not None:        # the rails evaluated once for the point and its partials
+                s, su, st = both(uu, tt)
+            else:
+                s = self.surface.point(uu, tt)
+                su, st = self.surface.partials(uu, tt)
             r = s - pp
             a = np.einsum("ij,ij->i", su, su)
             b = np.einsum("ij,ij->i", su, st)

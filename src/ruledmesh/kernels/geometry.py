@@ -4,7 +4,7 @@ Each kernel is the numpy function's arithmetic in the numpy function's order,
 one face per loop iteration, reading the corners through the face indices
 instead of gathering an (F, k, 3) copy first.  The order of the sums matters
 for bit-identical results and follows what numpy does: ``einsum("ij,ij->i")``
-over three components adds ``(x0 y0 + x2 y2) + x1 y1``, ``norm(axis=1)``
+over three components adds ``(x0 y0 + x2 y2) + x1 y1`` onto +0, ``norm(axis=1)``
 adds the squares left to right, and ``add.reduceat`` adds the first row to the
 sum of the others.  The tests compare every kernel with its numpy reference.
 """
@@ -18,7 +18,7 @@ import numpy as np
 
 from ..tolerances import ROUNDING_SQ, TINY
 
-__all__ = ["crossing", "min_angles", "newell", "quad_planarity"]
+__all__ = ["crossing", "min_angles", "newell", "polygon_angles", "quad_planarity"]
 
 _DEG = 180.0 / math.pi
 # numpy's pairwise sum adds up to 128 terms in one unrolled block: the Newell kernel
@@ -36,8 +36,12 @@ def _max(x: float, y: float) -> float:
 
 @nb.njit(cache=True, inline="always")
 def _dot(x0: float, x1: float, x2: float, y0: float, y1: float, y2: float) -> float:
-    """einsum("ij,ij->i") of three components, in numpy's order."""
-    return (x0 * y0 + x2 * y2) + x1 * y1
+    """einsum("ij,ij->i") of three components, in numpy's order.
+
+    einsum accumulates onto a zero, so a sum of negative zeros is +0 (and the
+    sign of a zero cosine decides between 0 and 180 degrees in ``atan2``).
+    """
+    return 0.0 + ((x0 * y0 + x2 * y2) + x1 * y1)
 
 
 @nb.njit(cache=True, inline="always")
@@ -275,3 +279,34 @@ def min_angles(V: np.ndarray, idx: np.ndarray, off: np.ndarray) -> np.ndarray:
     """
     return _min_angles(np.ascontiguousarray(V, dtype=np.float64), np.ascontiguousarray(idx),
                        np.ascontiguousarray(off))
+
+
+@nb.njit(cache=True, nogil=True)
+def _polygon_angles(P):
+    F, k = P.shape[0], P.shape[1]
+    out = np.empty((F, k))
+    for f in range(F):
+        for j in range(k):
+            p = j - 1 if j > 0 else k - 1
+            q = j + 1 if j + 1 < k else 0
+            x0, x1, x2 = P[f, p, 0] - P[f, j, 0], P[f, p, 1] - P[f, j, 1], P[f, p, 2] - P[f, j, 2]
+            y0, y1, y2 = P[f, q, 0] - P[f, j, 0], P[f, q, 1] - P[f, j, 1], P[f, q, 2] - P[f, j, 2]
+            cos = _dot(x0, x1, x2, y0, y1, y2)
+            sin = _norm(x1 * y2 - x2 * y1, x2 * y0 - x0 * y2, x0 * y1 - x1 * y0)
+            out[f, j] = math.atan2(sin, cos) * _DEG
+    return out
+
+
+def polygon_angles(corners: np.ndarray) -> np.ndarray:
+    """:func:`ruledmesh.analysis.faces.polygon_angles`, bit for bit, without the (F, k, 3) temporaries.
+
+    Parameters
+    ----------
+    corners : (F, k, 3) float64, k >= 1
+
+    Returns
+    -------
+    (F, k) float64
+        Interior angles, degrees.
+    """
+    return _polygon_angles(np.ascontiguousarray(corners, dtype=np.float64))

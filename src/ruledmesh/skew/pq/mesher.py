@@ -6,6 +6,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from ..._arrays import unique
 from ..._validation import check_bool, check_float, check_int, check_points, describe
 from ...errors import GeometryError, ParameterError
 from ...hop import coplanarity
@@ -572,7 +573,7 @@ def _warn_splinters(mesh: Mesh, warnings: list[str], torsal: np.ndarray) -> None
                          ((~quads & ~border & ~near_torsal).sum(), "between runs of rows")):
         if count:
             where.append(f"{count} {label}")
-    gs = np.unique(g0)
+    gs = unique(g0)
     cuts = np.flatnonzero(np.diff(gs) > 1)
     spans = [f"{lo}-{hi}" if hi > lo else f"{lo}" for lo, hi in
              zip(gs[np.r_[0, cuts + 1]].tolist(), gs[np.r_[cuts, gs.size - 1]].tolist())]
