@@ -18,6 +18,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from ..._arrays import unique
 from ...mesh import FaceKind, Mesh
 from ...tolerances import FLIP_ACTIVE_DEG, FLIP_MAX_BEND_DEG, FLIP_MAX_SAG, FLIP_MIN_GAIN_DEG, TINY
 from .pairing import adjacent_triangles
@@ -46,19 +47,41 @@ def _edge_keys(mesh_faces: list[np.ndarray], n: int) -> np.ndarray:
         if len(F):
             a, b = F.reshape(-1), np.roll(F, -1, axis=1).reshape(-1)
             keys.append(np.minimum(a, b) * n + np.maximum(a, b))
-    return np.unique(np.concatenate(keys)) if keys else np.zeros(0, np.int64)
+    return unique(np.concatenate(keys)) if keys else np.zeros(0, np.int64)
 
 
-def _round(V: np.ndarray, tri: np.ndarray, fixed: np.ndarray, scale: float) -> int:
-    """One round of mutual-best flips on ``tri`` (in place); the number made.
+def _ring(t1: np.ndarray, t2: np.ndarray, mark: np.ndarray) -> np.ndarray:
+    """``mark`` (T,) bool and the triangles sharing an edge with a marked one."""
+    out = mark.copy()
+    out[t2[mark[t1]]] = True
+    out[t1[mark[t2]]] = True
+    return out
+
+
+def _round(V: np.ndarray, tri: np.ndarray, fixed: np.ndarray, scale: float,
+           changed: np.ndarray | None) -> np.ndarray:
+    """One round of mutual-best flips on ``tri`` (in place); (T,) bool, the triangles it changed.
 
     ``fixed`` holds the sorted edge keys of every other face (quads, triangles
     left out of the rounds): a flip may not make one of those edges again.
+    ``changed`` marks the triangles the previous round changed (None: the
+    first round).  Only pairs near them can have gained or lost their best
+    choice, so the round weighs the pairs touching them, their neighbours and
+    the neighbours' neighbours (every pair of a triangle whose choice may have
+    changed, so each such triangle's best is exact), and takes only pairs with
+    a triangle that changed or borders one: the flips every pair would give.
     """
     n = len(V)
     t1, t2, a, b, c, d = adjacent_triangles(tri, n)
+    done = np.zeros(len(tri), bool)
     if t1.size == 0:
-        return 0
+        return done
+    near: np.ndarray | None = None
+    if changed is not None:
+        near = _ring(t1, t2, changed)              # choices that may have changed
+        weigh = _ring(t1, t2, near)                # their partners: exact best choices
+        sel = np.flatnonzero(weigh[t1] | weigh[t2])
+        t1, t2, a, b, c, d = t1[sel], t2[sel], a[sel], b[sel], c[sel], d[sel]
     A, B, C, D = V[a], V[b], V[c], V[d]
     old = np.minimum(_angles(V[tri[t1]]), _angles(V[tri[t2]]))
     new = np.minimum(_angles(np.stack([A, B, D], 1)), _angles(np.stack([A, D, C], 1)))
@@ -72,14 +95,17 @@ def _round(V: np.ndarray, tri: np.ndarray, fixed: np.ndarray, scale: float) -> i
     ok = (new > old + FLIP_MIN_GAIN_DEG) & (np.einsum("ij,ij->i", n1, n2) >= bend) \
         & (np.einsum("ij,ij->i", m1, m2) >= bend) & (np.einsum("ij,ij->i", m1, mean) >= bend) \
         & (np.einsum("ij,ij->i", m2, mean) >= bend) & (sag <= FLIP_MAX_SAG * scale) & (a != d)
+    if near is not None:
+        # Pairs away from every change keep the choice they had: not taken then, nor now.
+        ok &= near[t1] | near[t2]
     if not ok.any():
-        return 0
+        return done
     # The new diagonal must not be an edge already (it would join three faces).
     new_key = np.minimum(a, d) * n + np.maximum(a, d)
     ok &= ~(_member(new_key, fixed) | _member(new_key, _edge_keys([tri], n)))
     cand = np.flatnonzero(ok)
     if cand.size == 0:
-        return 0
+        return done
     gain = new - old
     best = np.full(len(tri), -np.inf)
     np.maximum.at(best, t1[cand], gain[cand])
@@ -94,7 +120,8 @@ def _round(V: np.ndarray, tri: np.ndarray, fixed: np.ndarray, scale: float) -> i
     take = take[keep]
     tri[t1[take]] = np.stack([a[take], b[take], d[take]], axis=1)
     tri[t2[take]] = np.stack([a[take], d[take], c[take]], axis=1)
-    return int(take.size)
+    done[t1[take]] = done[t2[take]] = True
+    return done
 
 
 def _member(keys: np.ndarray, sorted_keys: np.ndarray) -> np.ndarray:
@@ -154,15 +181,17 @@ def flip_triangles(mesh: Mesh) -> tuple[Mesh, int]:
     if not live.any():
         return mesh, 0
     others = [tri_all[~live]]
-    for k in np.unique(val[~is_tri]).tolist():
+    for k in unique(val[~is_tri]).tolist():
         f = np.flatnonzero(val == k)
         others.append(mesh.face_indices[mesh.face_offsets[f][:, None] + np.arange(k)])
     fixed = _edge_keys(others, n)
     tri = tri_all[live]
     before = tri.copy()
     flips = 0
+    changed = None
     for _ in range(_ROUNDS):
-        made = _round(V, tri, fixed, scale)
+        changed = _round(V, tri, fixed, scale, changed)
+        made = int(changed.sum()) // 2
         flips += made
         if made == 0:
             break
