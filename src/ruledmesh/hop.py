@@ -18,6 +18,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from ._arrays import cross as _cross
 from .tolerances import ROUNDING, TINY
 
 __all__ = ["hop", "landing_maps", "crossing_maps", "coplanarity", "apply_map"]
@@ -25,18 +26,6 @@ __all__ = ["hop", "landing_maps", "crossing_maps", "coplanarity", "apply_map"]
 
 def _dot(x: np.ndarray, y: np.ndarray) -> np.ndarray:
     return np.einsum("...i,...i->...", x, y)
-
-
-def _cross(x: np.ndarray, y: np.ndarray) -> np.ndarray:
-    """``np.cross`` of (..., 3) arrays: the same products and differences, without its
-    axis handling (which costs more than the arithmetic on the few generators of a hop)."""
-    x0, x1, x2 = x[..., 0], x[..., 1], x[..., 2]
-    y0, y1, y2 = y[..., 0], y[..., 1], y[..., 2]
-    out = np.empty(np.broadcast_shapes(x.shape, y.shape), dtype=np.result_type(x, y))
-    np.subtract(x1 * y2, x2 * y1, out=out[..., 0])
-    np.subtract(x2 * y0, x0 * y2, out=out[..., 1])
-    np.subtract(x0 * y1, x1 * y0, out=out[..., 2])
-    return out
 
 
 def hop(points: np.ndarray, a1: np.ndarray, d1: np.ndarray, a2: np.ndarray, d2: np.ndarray,

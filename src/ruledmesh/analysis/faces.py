@@ -11,7 +11,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from .._arrays import unique
+from .._arrays import cross, unique
 from ..kernels import wanted
 from ..mesh import Mesh
 from ..tolerances import DEFAULT, ROUNDING_SQ
@@ -72,11 +72,11 @@ def quad_diagonal_crossing(corners: np.ndarray) -> tuple[np.ndarray, np.ndarray,
     safe = np.where(parallel, 1.0, den)
     s = np.where(parallel, 0.0, (b * e - c * d) / safe)
     t = np.where(parallel, e / np.maximum(c, _TINY), (a * e - b * d) / safe)
-    cross = np.cross(d1, d2)
-    ncross = np.linalg.norm(cross, axis=1)
-    gap_skew = np.abs(np.einsum("ij,ij->i", w, cross)) / np.maximum(ncross, _TINY)
+    normal = cross(d1, d2)
+    ncross = np.linalg.norm(normal, axis=1)
+    gap_skew = np.abs(np.einsum("ij,ij->i", w, normal)) / np.maximum(ncross, _TINY)
     # Parallel diagonals: distance from q to the line of d1.
-    gap_par = np.linalg.norm(np.cross(w, d1), axis=1) / np.sqrt(np.maximum(a, _TINY))
+    gap_par = np.linalg.norm(cross(w, d1), axis=1) / np.sqrt(np.maximum(a, _TINY))
     gap = np.where(parallel, gap_par, gap_skew)
     return s, t, gap * scale
 
@@ -190,7 +190,7 @@ def face_normals(mesh: Mesh) -> tuple[np.ndarray, np.ndarray]:
     # Relative to each face's first corner: cross products of site coordinates
     # (1e6 and more) would cancel catastrophically.
     origin = v[idx[np.repeat(mesh.face_offsets[:-1], mesh.valences)]]
-    cr = np.cross(v[idx] - origin, v[idx[nxt]] - origin)
+    cr = cross(v[idx] - origin, v[idx[nxt]] - origin)
     vec = 0.5 * np.add.reduceat(cr, mesh.face_offsets[:-1], axis=0) if idx.size else np.zeros((0, 3))
     area = np.linalg.norm(vec, axis=1)
     normals = vec / np.maximum(area, _TINY)[:, None]
@@ -224,7 +224,7 @@ def polygon_angles(corners: np.ndarray) -> np.ndarray:
     e1 = np.roll(corners, 1, axis=1) - corners
     e2 = np.roll(corners, -1, axis=1) - corners
     cosang = np.einsum("fkc,fkc->fk", e1, e2)
-    sinang = np.linalg.norm(np.cross(e1, e2), axis=2)
+    sinang = np.linalg.norm(cross(e1, e2), axis=2)
     return np.degrees(np.arctan2(sinang, cosang))
 
 
@@ -240,7 +240,7 @@ def corner_angles(mesh: Mesh) -> np.ndarray:
     e1 = v[idx[prv]] - v[idx]
     e2 = v[idx[nxt]] - v[idx]
     cosang = np.einsum("ij,ij->i", e1, e2)
-    sinang = np.linalg.norm(np.cross(e1, e2), axis=1)
+    sinang = np.linalg.norm(cross(e1, e2), axis=1)
     return np.degrees(np.arctan2(sinang, cosang))
 
 
@@ -268,7 +268,7 @@ def convexity(mesh: Mesh, tol: float = DEFAULT.convexity) -> np.ndarray:
         rows = np.arange(len(other))[:, None]
         e1 = pts - pts[rows, prv]
         e2 = pts[rows, nxt] - pts
-        turn = np.einsum("fki,fi->fk", np.cross(e1, e2), normals[other])
+        turn = np.einsum("fki,fi->fk", cross(e1, e2), normals[other])
         scale = (np.linalg.norm(e1, axis=2) * np.linalg.norm(e2, axis=2))
         ok[other] = np.all((turn >= -tol * scale) | ~mask, axis=1)
     return ok

@@ -25,6 +25,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from ..._arrays import cross
 from ...mesh import FaceKind, Mesh, offsets_from_valences
 from ...tolerances import COLLAPSE_MAX_SAG, FLIP_MAX_BEND_DEG, FLIP_MIN_GAIN_DEG, RESTART_ANGLE_DEG, TINY
 
@@ -41,7 +42,7 @@ def _angles(P: np.ndarray) -> np.ndarray:
 
 def _normals(P: np.ndarray) -> np.ndarray:
     """(T, 3) unit normals of triangles ``P`` (T, 3, 3) (zero for degenerate ones)."""
-    n = np.cross(P[:, 1] - P[:, 0], P[:, 2] - P[:, 0])
+    n = cross(P[:, 1] - P[:, 0], P[:, 2] - P[:, 0])
     return n / np.maximum(np.linalg.norm(n, axis=1, keepdims=True), TINY)
 
 
@@ -61,7 +62,7 @@ def _triangle_distance(p: np.ndarray, P: np.ndarray) -> np.ndarray:
     # Inside when q is on the inner side of all three edges.
     inside = np.ones(len(p), bool)
     for x, y in ((A, B), (B, C), (C, A)):
-        inside &= np.einsum("ij,ij->i", np.cross(y - x, q - x), n) >= 0
+        inside &= np.einsum("ij,ij->i", cross(y - x, q - x), n) >= 0
     edge = np.minimum(np.minimum(_segment_distance(p, A, B), _segment_distance(p, B, C)),
                       _segment_distance(p, C, A))
     return np.where(inside, np.abs(h), edge)
@@ -160,7 +161,7 @@ def _evaluate(V, tri, stars: _Stars, keys, faces_at, v, u, scale) -> tuple[np.nd
     # its place the star's normal (its faces weighed by area) is the reference.
     P0 = V[old]
     star = np.zeros((C, 3))
-    np.add.at(star, rep, np.cross(P0[:, 1] - P0[:, 0], P0[:, 2] - P0[:, 0]))
+    np.add.at(star, rep, cross(P0[:, 1] - P0[:, 0], P0[:, 2] - P0[:, 0]))
     star /= np.maximum(np.linalg.norm(star, axis=1, keepdims=True), TINY)
     n_new = _normals(Pn)
     cos = np.cos(np.radians(FLIP_MAX_BEND_DEG))

@@ -18,7 +18,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..._arrays import unique
+from ..._arrays import cross, unique
 from ...mesh import FaceKind, Mesh
 from ...tolerances import FLIP_ACTIVE_DEG, FLIP_MAX_BEND_DEG, FLIP_MAX_SAG, FLIP_MIN_GAIN_DEG, TINY
 from .pairing import adjacent_triangles
@@ -36,7 +36,7 @@ def _angles(P: np.ndarray) -> np.ndarray:
 
 
 def _unit_normals(p, q, r) -> np.ndarray:
-    n = np.cross(q - p, r - p)
+    n = cross(q - p, r - p)
     return n / np.maximum(np.linalg.norm(n, axis=1, keepdims=True), TINY)
 
 
