@@ -264,15 +264,31 @@ class Mesh:
         """(k,) int64: vertex indices of face ``f``."""
         return self.face_indices[self.face_offsets[f]:self.face_offsets[f + 1]]
 
+    def next_corners(self) -> np.ndarray:
+        """(N,) int64: for each entry of ``face_indices``, the position of the next corner of its face."""
+        nxt = np.arange(self.face_indices.size) + 1
+        nxt[self.face_offsets[1:] - 1] = self.face_offsets[:-1]
+        return nxt
+
+    def edge_uses(self) -> tuple[np.ndarray, np.ndarray]:
+        """Sorted undirected edge keys ``low * n_vertices + high`` and how many faces use each.
+
+        Returns
+        -------
+        keys : (E,) int64
+        uses : (E,) int64
+            1 on the border, 2 inside a manifold, more where faces fold together.
+        """
+        idx = self.face_indices
+        nxt = idx[self.next_corners()]
+        return np.unique(np.minimum(idx, nxt) * np.int64(self.n_vertices) + np.maximum(idx, nxt),
+                         return_counts=True)
+
     def edges(self) -> np.ndarray:
         """(E, 2) int64: unique undirected edges, each as (low, high)."""
-        val = self.valences
-        nxt = np.arange(self.face_indices.size) + 1
-        ends = self.face_offsets[1:] - 1
-        nxt[ends] = self.face_offsets[:-1]
+        nxt = self.next_corners()
         lo = np.minimum(self.face_indices, self.face_indices[nxt])
         hi = np.maximum(self.face_indices, self.face_indices[nxt])
-        del val
         if lo.size == 0:
             return np.zeros((0, 2), np.int64)
         # One packed int64 key per edge: a 1-D unique is several times faster than axis=0.
@@ -389,9 +405,7 @@ class Mesh:
         merged corners disappears); members between merged vertices go too.
         """
         idx = self.face_indices
-        nxt = np.arange(idx.size) + 1
-        nxt[self.face_offsets[1:] - 1] = self.face_offsets[:-1]
-        keep = idx != idx[nxt]
+        keep = idx != idx[self.next_corners()]
         if keep.all() and np.all(self.members[:, 0] != self.members[:, 1]):
             return self
         face_of = np.repeat(np.arange(self.n_faces), self.valences)

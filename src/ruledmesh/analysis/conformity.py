@@ -22,13 +22,9 @@ __all__ = ["t_junctions"]
 
 def _single_edges(mesh: Mesh) -> np.ndarray:
     """(B, 2) int64: the edges used by exactly one face."""
-    nxt = np.arange(mesh.face_indices.size) + 1
-    nxt[mesh.face_offsets[1:] - 1] = mesh.face_offsets[:-1]
-    lo = np.minimum(mesh.face_indices, mesh.face_indices[nxt])
-    hi = np.maximum(mesh.face_indices, mesh.face_indices[nxt])
-    if lo.size == 0:
+    if mesh.face_indices.size == 0:
         return np.zeros((0, 2), np.int64)
-    key, count = np.unique(lo * np.int64(mesh.n_vertices) + hi, return_counts=True)
+    key, count = mesh.edge_uses()
     key = key[count == 1]
     return np.stack([key // mesh.n_vertices, key % mesh.n_vertices], axis=1)
 

@@ -26,8 +26,9 @@ from __future__ import annotations
 import numpy as np
 
 from ..._arrays import cross
-from ...mesh import FaceKind, Mesh, offsets_from_valences
+from ...mesh import FaceKind, Mesh
 from ...tolerances import COLLAPSE_MAX_SAG, FLIP_MAX_BEND_DEG, FLIP_MIN_GAIN_DEG, RESTART_ANGLE_DEG, TINY
+from .flips import _member, _unit_normals
 
 __all__ = ["collapse_splinters"]
 
@@ -42,8 +43,7 @@ def _angles(P: np.ndarray) -> np.ndarray:
 
 def _normals(P: np.ndarray) -> np.ndarray:
     """(T, 3) unit normals of triangles ``P`` (T, 3, 3) (zero for degenerate ones)."""
-    n = cross(P[:, 1] - P[:, 0], P[:, 2] - P[:, 0])
-    return n / np.maximum(np.linalg.norm(n, axis=1, keepdims=True), TINY)
+    return _unit_normals(P[:, 0], P[:, 1], P[:, 2])
 
 
 def _segment_distance(p: np.ndarray, a: np.ndarray, b: np.ndarray) -> np.ndarray:
@@ -66,16 +66,6 @@ def _triangle_distance(p: np.ndarray, P: np.ndarray) -> np.ndarray:
     edge = np.minimum(np.minimum(_segment_distance(p, A, B), _segment_distance(p, B, C)),
                       _segment_distance(p, C, A))
     return np.where(inside, np.abs(h), edge)
-
-
-def _edge_table(mesh: Mesh) -> tuple[np.ndarray, np.ndarray]:
-    """Sorted undirected edge keys ``lo * n + hi`` of all faces, and how many faces use each."""
-    idx = mesh.face_indices
-    nxt = np.arange(idx.size) + 1
-    nxt[mesh.face_offsets[1:] - 1] = mesh.face_offsets[:-1]
-    n = np.int64(mesh.n_vertices)
-    key = np.minimum(idx, idx[nxt]) * n + np.maximum(idx, idx[nxt])
-    return np.unique(key, return_counts=True)
 
 
 def _lookup(keys: np.ndarray, table: np.ndarray) -> np.ndarray:
@@ -182,7 +172,7 @@ def _evaluate(V, tri, stars: _Stars, keys, faces_at, v, u, scale) -> tuple[np.nd
     n = len(V)
     r2, w = stars.neighbours(v)
     w_ok = w != u[r2]
-    shared = _lookup(np.minimum(u[r2], w) * n + np.maximum(u[r2], w), keys) >= 0
+    shared = _member(np.minimum(u[r2], w) * n + np.maximum(u[r2], w), keys)
     common = np.bincount(r2[w_ok & shared], minlength=C)
     ok &= (common == removed) & (removed >= 1) & (np.bincount(rep, minlength=C) > removed)
     return new_min - old_min, ok
@@ -229,20 +219,15 @@ def _apply(mesh: Mesh, v: np.ndarray, u: np.ndarray) -> tuple[Mesh, np.ndarray]:
     n = mesh.n_vertices
     remap = np.arange(n)
     remap[v] = u
-    idx = remap[mesh.face_indices]
-    face_of = np.repeat(np.arange(mesh.n_faces), mesh.valences)
-    touched = np.bincount(face_of[np.isin(mesh.face_indices, v)], minlength=mesh.n_faces) > 0
-    kind = mesh.face_kind.copy()
-    kind[touched] = FaceKind.FILL
-    nxt = np.arange(idx.size) + 1
-    nxt[mesh.face_offsets[1:] - 1] = mesh.face_offsets[:-1]
-    ok_face = np.bincount(face_of[idx != idx[nxt]], minlength=mesh.n_faces) >= 3
-    keep = ok_face[face_of]
     removed = np.zeros(n, bool)
     removed[v] = True
+    face_of = np.repeat(np.arange(mesh.n_faces), mesh.valences)
+    kind = mesh.face_kind.copy()
+    kind[face_of[removed[mesh.face_indices]]] = FaceKind.FILL
     members, member_id = _rejoined(mesh.members, mesh.member_id, removed, n)
-    out = Mesh(mesh.vertices, offsets_from_valences(mesh.valences[ok_face]), idx[keep],
-               kind[ok_face], members, member_id, mesh.vertex_data, mesh.info)
+    # The triangles on each edge u v now repeat u: they go with the repeated corner.
+    out = Mesh(mesh.vertices, mesh.face_offsets, remap[mesh.face_indices], kind, members, member_id,
+               mesh.vertex_data, mesh.info).drop_repeated_corners()
     return out.compact(), np.cumsum(~removed) - 1
 
 
@@ -286,12 +271,12 @@ def collapse_splinters(mesh: Mesh) -> tuple[Mesh, int]:
             break
         # Only the faces around the candidates matter: a large mesh has few splinters.
         near = _near(mesh, np.concatenate([v, u]))
-        keys, uses = _edge_table(near)
+        keys, uses = near.edge_uses()
         border_keys = keys[uses == 1]
         border_v = np.zeros(n, bool)
         border_v[border_keys // n] = border_v[border_keys % n] = True
         # A border vertex collapses only along the border.
-        along = _lookup(np.minimum(v, u) * n + np.maximum(v, u), border_keys) >= 0
+        along = _member(np.minimum(v, u) * n + np.maximum(v, u), border_keys)
         ok = ~border_v[v] | along
         v, u = v[ok], u[ok]
         if v.size == 0:
