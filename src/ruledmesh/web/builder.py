@@ -247,7 +247,6 @@ class BuildWorker(InProcessBuilder):
         #: Whether the running worker builds with the compiled kernels (None: not yet known;
         #: the worker loads them at its first idle second and says so with its next answer).
         self.kernels: bool | None = None
-        self._paused = 0.0  # when the worker said it is compiling the kernels (0: it is not)
 
     # ---------------------------------------------------------------- process
     def _start(self) -> None:
@@ -269,7 +268,6 @@ class BuildWorker(InProcessBuilder):
     def _stop(self) -> None:
         stop_worker(self._proc, self._conn)
         self._proc = self._conn = None
-        self._paused = 0.0
 
     def start(self) -> None:
         """Start the worker process now (so the first edit does not wait for it)."""
@@ -315,25 +313,28 @@ class BuildWorker(InProcessBuilder):
 
     def _wait(self, generation: int, job: tuple) -> Any:
         started = time.monotonic()
+        # When the worker said it is compiling the kernels (0: it is not).  It says "busy" and
+        # "idle" before it reads the next job, so both arrive while one edit waits.
+        paused = 0.0
         try:
             self._conn.send(job)
             while True:
                 if self._conn.poll(0.02):
                     kind, value = self._conn.recv()
                     if kind == "busy":          # compiling the kernels: not this edit's time
-                        self._paused = time.monotonic()
+                        paused = time.monotonic()
                         continue
                     if kind == "idle":
-                        started += time.monotonic() - max(self._paused, started)
-                        self._paused = 0.0
+                        started += time.monotonic() - max(paused, started)
+                        paused = 0.0
                         self.kernels = bool(value)
                         continue
                     break
                 now = time.monotonic()
-                if self._paused:
-                    if now - self._paused > STARTUP_SECONDS:
+                if paused:
+                    if now - paused > STARTUP_SECONDS:
                         raise EOFError
-                    elapsed = max(self._paused, started) - started
+                    elapsed = max(paused, started) - started
                 else:
                     elapsed = now - started
                 if elapsed > self.timeout:
@@ -341,7 +342,7 @@ class BuildWorker(InProcessBuilder):
                     raise BuildTimeout(f"the build took longer than {self.timeout:g} s and was "
                                        "stopped; reduce the generator count or the rows")
                 # Not while the kernels compile: a new worker would compile them again.
-                if self._closed or (not self._paused and now - started > SUPERSEDE_GRACE
+                if self._closed or (not paused and now - started > SUPERSEDE_GRACE
                                     and self.superseded(generation)):
                     self._stop()
                     raise Superseded("superseded by a newer edit")
