@@ -31,8 +31,8 @@ def caught(monkeypatch):
     calls: list[tuple] = []
     real = collapses.collapse_splinters
 
-    def spy(mesh):
-        out, n = real(mesh)
+    def spy(mesh, *args):
+        out, n = real(mesh, *args)
         calls.append((mesh, out, n))
         return out, n
 

@@ -74,10 +74,11 @@ def test_random_director_curves_exact_and_mostly_quads(y1, y2, count, rows):
     assert share >= 0.7 or said
     if share < 0.7:
         assert f"{1 - share:.0%}" in said[0]
-    # Splinters are rare: runs end before slivers, the fill is flipped for its angles (the
-    # mesher before measured 0.6-8 % of the faces below 3 degrees on such surfaces).
+    # Splinters are rare: runs end before slivers, the fill is flipped for its angles, the
+    # quads walling a splinter in are opened (the mesher measured 0.6-8 % of the faces below
+    # 3 degrees on such surfaces, then 77 faces on 25 of them, now 7, 19 of 25 with none).
     thin = face_min_angles(built.mesh) < 3.0
-    assert thin.mean() <= 0.05, f"{thin.sum()} of {thin.size} faces below 3 degrees"
+    assert thin.sum() <= 4, f"{thin.sum()} of {thin.size} faces below 3 degrees"
 
 
 @settings(max_examples=10, deadline=None, suppress_health_check=[HealthCheck.too_slow])
@@ -120,10 +121,12 @@ def test_coplanar_generators_carry_exact_strip_quads():
 # for their smallest angle: a few points of share traded for far fewer splinters.
 REGRESSIONS = [
     ("skew.toml", 0.08, 3.0),                    # was 19 %, 0.19 deg (two crease bands)
-    ("fig10-skew-surface.toml", 0.12, 0.1),      # was 20 %, 0.03 deg
-    ("right-conoid-arc.toml", 0.20, 0.005),      # was 30 %, then 20 % with 109 splinters (now 43)
+    ("fig10-skew-surface.toml", 0.12, 3.0),      # was 20 %, 0.03 deg; then 11 % with 5 splinters
+    # was 30 %, then 20 % with 109 splinters, 18 % with 24 (0.01 deg): opening the quads
+    # around them costs 3 points
+    ("right-conoid-arc.toml", 0.22, 3.0),
     ("conoidal-director-plane.toml", 0.22, 1.0),  # was 33 %, then 16 % with 59 splinters, 0.11 deg
-    ("three-directrices.toml", 0.12, 0.1),       # was 20 %
+    ("three-directrices.toml", 0.12, 3.0),       # was 20 %, then 10 % at 0.19 deg
     ("parameter-distribution.toml", 0.13, 3.0),  # was 18 %, then 10 % with 17 splinters
 ]
 
@@ -153,7 +156,7 @@ def test_two_bspline_director_curves_51_by_30():
     built = build_design(parse_design(text))
     check_exact(built)
     assert 1.0 - area_shares(built.mesh)["quads"] <= 0.25
-    assert np.count_nonzero(face_min_angles(built.mesh) < 3.0) <= 30       # was 220, then 107
+    assert np.count_nonzero(face_min_angles(built.mesh) < 3.0) == 0        # was 220, 107, then 10
     assert built.rulings.info["inserted"] > 0
     assert any("generators of the smooth surface added" in w for w in built.mesh.info["warnings"])
     given = build_design(parse_design(text.replace("rows = 30", "rows = 30\nrefine = false")))

@@ -13,7 +13,7 @@ from __future__ import annotations
 import numpy as np
 
 from ...mesh import FaceKind, Mesh
-from ...tolerances import ROUNDING, Tolerances
+from ...tolerances import RESTART_ANGLE_DEG, ROUNDING, Tolerances
 from .ladders import free_edges, ladder_points
 from .runs import Run
 from .strips import ON_BORDER, Gaps, chains, strip_paths, zippers
@@ -182,7 +182,7 @@ def assemble(parts: list[Run], a, d, trim: bool, tol: Tolerances, ptol: float,
              warnings: list[str], scale: float, meet: np.ndarray | None = None,
              rows: int = 20) -> Mesh:
     """Join the runs; keep convex quads and valid halves; close the strips; add members."""
-    from ...analysis.faces import quad_diagonal_crossing
+    from ...analysis.faces import polygon_angles, quad_diagonal_crossing
 
     m = len(a)
     if not parts:
@@ -230,9 +230,13 @@ def assemble(parts: list[Run], a, d, trim: bool, tol: Tolerances, ptol: float,
     sq, tq, _ = quad_diagonal_crossing(V[quads])
     eps = tol.convexity
     convex = (sq > eps) & (sq < 1 - eps) & (tq > eps) & (tq < 1 - eps)
+    # A quad with a splinter's corner is kept as its two halves too: the flips and
+    # collapses may fatten triangles (with their fill neighbours), never a quad.
+    sliver = convex & (polygon_angles(V[quads]).min(axis=1) < RESTART_ANGLE_DEG)
+    nsplit = int(np.count_nonzero(~convex))
+    convex &= ~sliver
     whole = np.zeros(len(L), bool)
     whole[np.flatnonzero(both)[convex]] = True
-    nsplit = int(np.count_nonzero(~convex))
     interior = (L[:, 0] >= 0) & (R[:, 0] >= 0)
     kind_half = np.where(interior, np.where(both, FaceKind.SPLIT, FaceKind.BORDER),
                          FaceKind.FILL).astype(np.uint8)

@@ -231,7 +231,7 @@ def _apply(mesh: Mesh, v: np.ndarray, u: np.ndarray) -> tuple[Mesh, np.ndarray]:
     return out.compact(), np.cumsum(~removed) - 1
 
 
-def collapse_splinters(mesh: Mesh) -> tuple[Mesh, int]:
+def collapse_splinters(mesh: Mesh, removable: np.ndarray | None = None) -> tuple[Mesh, int]:
     """Remove triangle-only vertices of splinters where that fattens the faces around them.
 
     Parameters
@@ -239,6 +239,8 @@ def collapse_splinters(mesh: Mesh) -> tuple[Mesh, int]:
     mesh : Mesh
         Any polygon mesh; only triangles whose corners are in no other face
         change.
+    removable : (V,) bool, optional
+        The vertices that may go (default: every vertex only triangles use).
 
     Returns
     -------
@@ -263,7 +265,7 @@ def collapse_splinters(mesh: Mesh) -> tuple[Mesh, int]:
         thin = _angles(V[tri]).min(axis=1) < RESTART_ANGLE_DEG
         if not thin.any():
             break
-        free = np.ones(n, bool)
+        free = np.ones(n, bool) if removable is None else removable.copy()
         free[mesh.face_indices[np.repeat(val != 3, val)]] = False
         splinters = tri[thin]
         v, u = _directed(splinters, free)
@@ -295,6 +297,12 @@ def collapse_splinters(mesh: Mesh) -> tuple[Mesh, int]:
         if take.size == 0:
             break
         mesh, new_index = _apply(mesh, v[take], u[take])
+        if removable is not None:
+            gone = np.zeros(n, bool)
+            gone[v[take]] = True
+            removable = removable[~gone]
+            if removable.size != mesh.n_vertices:     # compaction dropped others: stop here
+                removable = np.zeros(mesh.n_vertices, bool)
         total += int(take.size)
         # Next round: the triangles around the collapses and the splinters left.
         watch = np.zeros(mesh.n_vertices, bool)

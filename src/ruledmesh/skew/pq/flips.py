@@ -152,13 +152,15 @@ def _active(V: np.ndarray, tri: np.ndarray) -> np.ndarray:
     return out
 
 
-def flip_triangles(mesh: Mesh) -> tuple[Mesh, int]:
+def flip_triangles(mesh: Mesh, changeable: np.ndarray | None = None) -> tuple[Mesh, int]:
     """Re-cut pairs of adjacent triangles for a larger smallest angle.
 
     Parameters
     ----------
     mesh : Mesh
         Any polygon mesh; only its triangles are changed.
+    changeable : (F,) bool, optional
+        The faces that may change (default: every triangle).
 
     Returns
     -------
@@ -178,6 +180,8 @@ def flip_triangles(mesh: Mesh) -> tuple[Mesh, int]:
     ids = np.flatnonzero(is_tri)
     tri_all = mesh.face_indices[mesh.face_offsets[ids][:, None] + np.arange(3)].astype(np.int64)
     live = _active(V, tri_all)
+    if changeable is not None:
+        live &= changeable[ids]
     if not live.any():
         return mesh, 0
     others = [tri_all[~live]]

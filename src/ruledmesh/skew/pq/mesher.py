@@ -25,6 +25,7 @@ from .runs import (
     carrier,
     mesh_run,
 )
+from .splinters import open_walled_splinters, snap_to_border
 
 __all__ = ["pq_mesh"]
 
@@ -353,13 +354,12 @@ def pq_mesh(a, b, rows: int = 20, primary: int | str = "middle", option: int = 0
     even = _even_ranges(parts, segs, warnings)
     meet = np.r_[flat, False] | np.r_[False, flat]      # generators of a coplanar pair
     mesh = assemble(parts, a, d, args.trim, tol, ptol, warnings, scale, meet, rows=rows)
-    mesh, flips, collapsed, paired = _fattened(mesh, ptol, tol)
+    mesh, fattening = _fattened(mesh, ptol, tol)
     _warn_share(mesh, warnings, torsal.size, even, restarts, m, rows)
     _warn_splinters(mesh, warnings, torsal)
     if kept.size < m_given:
         mesh = _renumbered(mesh, kept)
-    return mesh.with_info(runs=len(parts), restarts=restarts, planarity_tolerance=ptol, paired=paired,
-                          flips=flips, collapsed=collapsed)
+    return mesh.with_info(runs=len(parts), restarts=restarts, planarity_tolerance=ptol, **fattening)
 
 
 def _cut(a, d, rows, ptol, scale, tol, creases, crease_generators, warnings):
@@ -384,9 +384,11 @@ def _cut(a, d, rows, ptol, scale, tol, creases, crease_generators, warnings):
     return flat, torsal, cg, segs
 
 
-def _fattened(mesh: Mesh, ptol: float, tol: Tolerances) -> tuple[Mesh, int, int, int]:
+def _fattened(mesh: Mesh, ptol: float, tol: Tolerances) -> tuple[Mesh, dict[str, int]]:
     """Flip the triangles for their angles, collapse what flips cannot fatten, pair the
-    triangles in tolerance mode, flip what is left."""
+    triangles in tolerance mode, flip what is left; then the splinters left: corners a
+    sliver from the border snapped onto it, quads walling a splinter in opened."""
+    mesh, snapped = snap_to_border(mesh)
     mesh, flips = flip_triangles(mesh)
     mesh, collapsed = collapse_splinters(mesh)
     if collapsed:
@@ -396,7 +398,29 @@ def _fattened(mesh: Mesh, ptol: float, tol: Tolerances) -> tuple[Mesh, int, int,
     if paired:
         mesh, more = flip_triangles(mesh)
         flips += more
-    return mesh, flips, collapsed, paired
+    mesh, opened = open_walled_splinters(mesh, _reflipped)
+    if opened:
+        mesh, more = _paired(mesh, ptol, tol)
+        paired += more
+    return mesh, {"flips": flips, "collapsed": collapsed, "paired": paired, "snapped": snapped,
+                  "opened": opened}
+
+
+def _reflipped(mesh: Mesh, frozen: np.ndarray) -> Mesh:
+    """Flips, collapses and flips again on an opened region of splinters.
+
+    ``frozen`` (V,) bool marks, by ``vertex_data["_id"]``, the vertices that faces
+    outside the region also have: faces at them stay, and they stay.
+    """
+    def changeable(m: Mesh) -> np.ndarray:
+        at = frozen[np.asarray(m.vertex_data["_id"])][m.face_indices]
+        return np.bincount(np.repeat(np.arange(m.n_faces), m.valences)[at], minlength=m.n_faces) == 0
+
+    mesh, _ = flip_triangles(mesh, changeable(mesh))
+    mesh, collapsed = collapse_splinters(mesh, ~frozen[np.asarray(mesh.vertex_data["_id"])])
+    if collapsed:
+        mesh, _ = flip_triangles(mesh, changeable(mesh))
+    return mesh
 
 
 @dataclass(frozen=True)
@@ -537,12 +561,15 @@ def _warn_share(mesh: Mesh, warnings: list[str], torsal: int, even: list[str], r
 
 
 def _paired(mesh: Mesh, ptol: float, tol: Tolerances) -> tuple[Mesh, int]:
-    """Tolerance mode: triangle pairs planar within the tolerance become quads."""
-    if ptol <= tol.planarity:
-        return mesh, 0
+    """Triangle pairs planar within the tolerance become quads.
+
+    In exact mode that is within the exact bar: two halves of one planar quad
+    that the cuts kept apart, or a notch half and a border triangle that happen
+    to share a plane (a helicoid's border teeth, by its symmetry).
+    """
     # A margin below the stated tolerance, so that rounding in another reader's
     # measure cannot push a paired quad over it.
-    return pair_triangles(mesh, _PAIRING_MARGIN * ptol)
+    return pair_triangles(mesh, _PAIRING_MARGIN * max(ptol, tol.planarity))
 
 
 def _warn_splinters(mesh: Mesh, warnings: list[str], torsal: np.ndarray) -> None:

@@ -82,7 +82,7 @@ def pair_triangles(mesh: Mesh, ptol: float, kinds: tuple[int, ...] | None = None
     int
         Number of quads made.
     """
-    from ...analysis.faces import polygon_angles, quad_diagonal_crossing, quad_planarity
+    from ...analysis.faces import SPLINTER_DEG, polygon_angles, quad_diagonal_crossing, quad_planarity
 
     if kinds is None:
         kinds = (FaceKind.FILL, FaceKind.BORDER, FaceKind.SPLIT)
@@ -102,7 +102,7 @@ def pair_triangles(mesh: Mesh, ptol: float, kinds: tuple[int, ...] | None = None
     tri_min = polygon_angles(V[tri]).min(axis=1)
     ok = (quad_planarity(P) <= ptol) & (sq > _MIN_CROSSING) & (sq < 1 - _MIN_CROSSING) \
         & (tq > _MIN_CROSSING) & (tq < 1 - _MIN_CROSSING) \
-        & (ang >= np.minimum(tri_min[t1], tri_min[t2]))
+        & (ang >= np.minimum(tri_min[t1], tri_min[t2])) & (ang >= SPLINTER_DEG)
     t1, t2, quad, score = t1[ok], t2[ok], quad[ok], ang[ok]
     taken = np.zeros(len(tri), bool)
     chosen = np.zeros(len(t1), bool)

@@ -1,0 +1,393 @@
+"""The splinters the flips and collapses leave: border snaps and opened quads.
+
+Two patterns account for most of what remains after
+:func:`~ruledmesh.skew.pq.flips.flip_triangles` and
+:func:`~ruledmesh.skew.pq.collapses.collapse_splinters`:
+
+- **A corner a sliver away from the border.**  A row that meets a generator
+  just inside the patch leaves a quad corner a hair from the generator's end
+  point, and the two triangles on that short edge are needles.  The corner may
+  slide along its generator when it is the end of a generator *diagonal* of
+  every quad it belongs to: the diagonal stays on the generator, the other
+  diagonal still crosses it, so the quad stays planar (to rounding) and
+  convex.  The corner moves onto the end point; the needles disappear.
+- **A splinter walled in by quads.**  Its edges are quad edges, so no flip can
+  reach it.  The quads beside it are cut into triangles along their better
+  diagonal and the neighbourhood is flipped and collapsed again; the cut quads
+  that end up unchanged are joined again.  The result is kept only if fewer
+  faces are splinters (or the smallest angle grows): a few quads become
+  well-shaped triangles where one splinter was.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from dataclasses import replace
+
+import numpy as np
+
+from ...analysis.faces import face_min_angles
+from ...mesh import FaceKind, Mesh
+from ...tolerances import ON_BORDER, RESTART_ANGLE_DEG
+from .collapses import _apply
+from .pairing import _rebuilt
+
+__all__ = ["open_walled_splinters", "snap_to_border"]
+
+# Rounds of opening the quads beside the splinters left ...
+_OPEN_ROUNDS = 5
+# ... each kept only if it moves at most this share of the area out of quads per
+# splinter it removes.
+_OPEN_MAX_SHARE = 0.006
+
+
+def _splinter_edges(mesh: Mesh, amin: np.ndarray) -> np.ndarray:
+    """Sorted undirected edge keys of the triangles below the splinter bar."""
+    n = np.int64(mesh.n_vertices)
+    idx = mesh.face_indices
+    nxt = idx[mesh.next_corners()]
+    face_of = np.repeat(np.arange(mesh.n_faces), mesh.valences)
+    bad = ((amin < RESTART_ANGLE_DEG) & (mesh.valences == 3))[face_of]
+    return np.unique(np.minimum(idx, nxt)[bad] * n + np.maximum(idx, nxt)[bad])
+
+
+def snap_to_border(mesh: Mesh) -> tuple[Mesh, int]:
+    """Move quad corners that make needles with a generator's end point onto it.
+
+    Parameters
+    ----------
+    mesh : Mesh
+        A PQ mesh with ``vertex_data`` ``t`` and ``generator``.
+
+    Returns
+    -------
+    Mesh
+        Moved corners merged into the end points; the faces on each short edge
+        gone, quads that now reach the border of kind :attr:`FaceKind.BORDER`.
+    int
+        Number of corners moved.
+    """
+    if "t" not in mesh.vertex_data or mesh.n_faces == 0:
+        return mesh, 0
+    t = np.asarray(mesh.vertex_data["t"])
+    gen = np.asarray(mesh.vertex_data["generator"])
+    n = np.int64(mesh.n_vertices)
+    amin = _triangle_min_angles(mesh)
+    keys = _splinter_edges(mesh, amin)
+    if keys.size == 0:
+        return mesh, 0
+    p, q = keys // n, keys % n
+    end = (t <= ON_BORDER) | (t >= 1.0 - ON_BORDER)
+    same = gen[p] == gen[q]
+    # v: the inner corner, b: the end point of the same generator.
+    v = np.where(end[p], q, p)
+    b = np.where(end[p], p, q)
+    ok = same & (end[p] ^ end[q])
+    v, b = v[ok], b[ok]
+    if v.size == 0:
+        return mesh, 0
+    # v may slide only if it ends a generator diagonal in every polygon it is in:
+    # the corner two places on lies on its generator, and no other polygon has it.
+    idx = mesh.face_indices
+    val = np.repeat(mesh.valences, mesh.valences)
+    nxt = mesh.next_corners()
+    opposite = idx[nxt[nxt]]
+    blocked = np.zeros(mesh.n_vertices, bool)
+    blocked[idx[(val > 4) | ((val == 4) & (gen[opposite] != gen[idx]))]] = True
+    ok = ~blocked[v]
+    v, b = v[ok], b[ok]
+    # One move per vertex and per end point.
+    _, first = np.unique(v, return_index=True)
+    v, b = v[first], b[first]
+    _, first = np.unique(b, return_index=True)
+    v, b = v[first], b[first]
+    if v.size == 0:
+        return mesh, 0
+    _, gain = _snapped(_around(mesh, np.concatenate([v, b])), v, b)
+    keep = gain > 0
+    v, b = v[keep], b[keep]
+    if v.size == 0:
+        return mesh, 0
+    moved, _ = _snapped(mesh, v, b, measure=False)
+    return moved, int(v.size)
+
+
+def _triangle_min_angles(mesh: Mesh) -> np.ndarray:
+    """(F,) smallest corner angle of the triangles, degrees (180 for other faces)."""
+    from ...analysis.faces import polygon_angles
+
+    out = np.full(mesh.n_faces, 180.0)
+    f, F = mesh.faces_of_valence(3)
+    out[f] = polygon_angles(mesh.vertices[F]).min(axis=1)
+    return out
+
+
+def _around(mesh: Mesh, vertices: np.ndarray) -> Mesh:
+    """The faces with a corner among ``vertices`` (all vertices and members kept)."""
+    mark = np.zeros(mesh.n_vertices, bool)
+    mark[vertices] = True
+    face_of = np.repeat(np.arange(mesh.n_faces), mesh.valences)
+    return mesh.select_faces(np.bincount(face_of[mark[mesh.face_indices]], minlength=mesh.n_faces) > 0)
+
+
+def _snapped(mesh: Mesh, v: np.ndarray, b: np.ndarray, measure: bool = True) -> tuple[Mesh, np.ndarray]:
+    """The mesh with each ``v`` merged into its ``b``, and (k,) the change of the smallest
+    angle around each ``b`` (the faces of ``v`` and ``b`` before, of ``b`` after)."""
+    out, new_index = _apply(mesh, v, b)
+    # The merge marks the faces it changed as fill; the quads among them reach the border.
+    kind = out.face_kind.copy()
+    kind[(kind == FaceKind.FILL) & (out.valences == 4)] = FaceKind.BORDER
+    out = replace(out, face_kind=kind)
+    if not measure:
+        return out, np.zeros(v.size)
+    before = _around_min(mesh, [v, b])
+    after = _around_min(out, [new_index[b]])
+    return out, after - before
+
+
+def _around_min(mesh: Mesh, groups: list[np.ndarray]) -> np.ndarray:
+    """(k,) the smallest angle of the faces at any of ``groups[j][i]``, per ``i``."""
+    slot = np.full(mesh.n_vertices, -1)
+    for g in groups:
+        slot[g] = np.arange(g.size)
+    face_of = np.repeat(np.arange(mesh.n_faces), mesh.valences)
+    s = slot[mesh.face_indices]
+    out = np.full(groups[0].size, 180.0)
+    np.minimum.at(out, s[s >= 0], face_min_angles(mesh)[face_of[s >= 0]])
+    return out
+
+
+def _cut_quads(mesh: Mesh, which: np.ndarray) -> tuple[Mesh, np.ndarray, np.ndarray]:
+    """The quads marked in ``which`` (F,) cut along their fatter diagonal.
+
+    Returns the mesh, the cut quads (k, 4) and their kinds (k,).
+    """
+    from ...analysis.faces import polygon_angles
+
+    qid, Q = mesh.faces_of_valence(4)
+    sel = which[qid]
+    Q = Q[sel]
+    V = mesh.vertices
+
+    def fat(T):
+        return polygon_angles(V[T]).min(axis=1)
+
+    a1, a2, b1, b2 = Q[:, [0, 1, 2]], Q[:, [0, 2, 3]], Q[:, [0, 1, 3]], Q[:, [1, 2, 3]]
+    use = np.minimum(fat(a1), fat(a2)) >= np.minimum(fat(b1), fat(b2))
+    tris = np.concatenate([np.where(use[:, None], a1, b1), np.where(use[:, None], a2, b2)])
+    keep = np.ones(mesh.n_faces, bool)
+    keep[qid[sel]] = False
+    cut = _rebuilt(mesh, keep, np.zeros((0, 4), np.int64), np.zeros(0, np.uint8))
+    cut = _with_triangles(cut, tris, FaceKind.SPLIT)
+    return cut, Q, mesh.face_kind[qid[sel]]
+
+
+def _with_triangles(mesh: Mesh, tris: np.ndarray, kind: int) -> Mesh:
+    """``mesh`` with triangles ``tris`` (k, 3) of one kind appended."""
+    off = np.concatenate([mesh.face_offsets, mesh.face_offsets[-1] + 3 * np.arange(1, len(tris) + 1)])
+    return Mesh(mesh.vertices, off, np.concatenate([mesh.face_indices, tris.reshape(-1)]),
+                np.concatenate([mesh.face_kind, np.full(len(tris), kind, np.uint8)]), mesh.members,
+                mesh.member_id, mesh.vertex_data, mesh.info)
+
+
+def _joined_again(mesh: Mesh, quads: np.ndarray, kinds: np.ndarray) -> Mesh:
+    """The cut quads whose two triangles are both still faces, joined again."""
+    tid, T = mesh.faces_of_valence(3)
+    if not len(quads) or not len(tid):
+        return mesh
+    n = np.int64(mesh.n_vertices)
+
+    def key(X):
+        X = np.sort(X, axis=1)
+        return (X[:, 0] * n + X[:, 1]) * n + X[:, 2]
+
+    have = key(T)
+    order = np.argsort(have)
+    table = have[order]
+
+    def find(X):
+        pos = np.clip(np.searchsorted(table, key(X)), 0, len(table) - 1)
+        return pos, table[pos] == key(X)
+
+    keep = np.ones(mesh.n_faces, bool)
+    back = np.zeros(len(quads), bool)
+    for first, second in (([0, 1, 2], [0, 2, 3]), ([0, 1, 3], [1, 2, 3])):
+        pa, ha = find(quads[:, first])
+        pb, hb = find(quads[:, second])
+        both = ha & hb & ~back
+        keep[tid[order[pa[both]]]] = False
+        keep[tid[order[pb[both]]]] = False
+        back |= both
+    if not back.any():
+        return mesh
+    return _rebuilt(mesh, keep, quads[back], kinds[back])
+
+
+def _short_edges(mesh: Mesh, bad: np.ndarray) -> np.ndarray:
+    """(k, 2) the shortest edge of each triangle marked in ``bad`` (F,)."""
+    tid, T = mesh.faces_of_valence(3)
+    T = T[bad[tid]]
+    P = mesh.vertices[T]
+    length = np.linalg.norm(P - np.roll(P, -1, axis=1), axis=2)
+    k = np.argmin(length, axis=1)
+    r = np.arange(len(T))
+    return np.stack([T[r, k], T[r, (k + 1) % 3]], axis=1)
+
+
+def _rings(mesh: Mesh, faces: np.ndarray, k: int) -> np.ndarray:
+    """(F,) bool: ``faces`` and the faces within ``k`` vertex rings of them."""
+    face_of = np.repeat(np.arange(mesh.n_faces), mesh.valences)
+    out = faces.copy()
+    for _ in range(k):
+        mark = np.zeros(mesh.n_vertices, bool)
+        mark[mesh.face_indices[out[face_of]]] = True
+        out = np.bincount(face_of[mark[mesh.face_indices]], minlength=mesh.n_faces) > 0
+    return out
+
+
+def open_walled_splinters(mesh: Mesh,
+                          fatten: Callable[[Mesh, np.ndarray], Mesh]) -> tuple[Mesh, int]:
+    """Cut the quads beside the splinters left into triangles and fatten again.
+
+    Only a neighbourhood of the splinters is re-cut: the faces within two
+    vertex rings of the opened quads and the splinters (the region); faces
+    with a corner that a face outside the region also has stay as they are.
+    Each connected piece of the region is kept as re-cut only if it has fewer
+    faces below the splinter bar (or as many, with a larger smallest angle)
+    and moved at most :data:`_OPEN_MAX_SHARE` of the area out of quads per
+    splinter removed.
+
+    Parameters
+    ----------
+    mesh : Mesh
+    fatten : callable
+        (Mesh, frozen vertices (V,) bool) -> Mesh: the flips and collapses to run
+        on the opened region, leaving the faces at frozen vertices alone.  The
+        region mesh numbers its vertices in ``mesh`` by ``vertex_data["_id"]``.
+
+    Returns
+    -------
+    Mesh
+    int
+        Number of quads opened (net of those joined again).
+    """
+    opened = 0
+    amin = face_min_angles(mesh)
+    total = _quad_area(mesh, every=True)
+    for k in range(_OPEN_ROUNDS):
+        bad = (amin < RESTART_ANGLE_DEG) & (mesh.valences == 3)
+        if not bad.any():
+            break
+        # The quads on a splinter's edges first; then also those at its shortest edge.
+        beside = _beside(mesh, amin, bad, ends=k > 0)
+        if not beside.any():
+            continue
+        region = _rings(mesh, beside | bad, 2)
+        face_of = np.repeat(np.arange(mesh.n_faces), mesh.valences)
+        frozen = np.zeros(mesh.n_vertices, bool)
+        frozen[mesh.face_indices[~region[face_of]]] = True
+        sub = Mesh(mesh.vertices, mesh.face_offsets, mesh.face_indices, mesh.face_kind, mesh.members,
+                   mesh.member_id, {**mesh.vertex_data, "_id": np.arange(mesh.n_vertices)},
+                   mesh.info).select_faces(region)
+        cut, quads, kinds = _cut_quads(sub, beside[region])
+        done = fatten(cut, frozen)
+        # The collapses renumber the vertices: the cut quads in the new numbers.
+        new_of = np.full(mesh.n_vertices, -1)
+        new_of[np.asarray(done.vertex_data["_id"])] = np.arange(done.n_vertices)
+        quads = new_of[quads]
+        whole = (quads >= 0).all(axis=1)
+        done = _joined_again(done, quads[whole], kinds[whole])
+        mesh, amin, n_open = _kept_pieces(mesh, amin, region, done, total)
+        opened += n_open
+    return mesh, opened
+
+
+def _kept_pieces(mesh: Mesh, amin: np.ndarray, region: np.ndarray, done: Mesh,
+                 total: float) -> tuple[Mesh, np.ndarray, int]:
+    """``mesh`` with the pieces of ``region`` where ``done`` (its re-cut faces) is better.
+
+    Returns the mesh, its (F,) smallest face angles and the number of quads opened.
+    """
+    from scipy.sparse import coo_matrix
+    from scipy.sparse.csgraph import connected_components
+
+    from ...analysis.faces import face_normals
+
+    n = mesh.n_vertices
+    idx = mesh.face_indices
+    face_of = np.repeat(np.arange(mesh.n_faces), mesh.valences)
+    inner = region[face_of]
+    a, b = idx[inner], idx[mesh.next_corners()][inner]
+    _, label = connected_components(coo_matrix((np.ones(a.size), (a, b)), shape=(n, n)), directed=False)
+    ids = np.asarray(done.vertex_data["_id"])
+    old_piece = label[idx[mesh.face_offsets[:-1]]]
+    new_piece = label[ids[done.face_indices[done.face_offsets[:-1]]]] if done.n_faces else np.zeros(0, int)
+    k = int(label.max()) + 1
+    new_min = face_min_angles(done)
+    _, old_area = face_normals(mesh)
+    _, new_area = face_normals(done)
+
+    def per_piece(piece, values, faces):
+        return np.bincount(piece[faces], weights=values[faces], minlength=k)
+
+    old_r = np.flatnonzero(region)
+    was = per_piece(old_piece, (amin < RESTART_ANGLE_DEG).astype(float), old_r)
+    now = np.bincount(new_piece, weights=(new_min < RESTART_ANGLE_DEG).astype(float), minlength=k)
+    lo_old = np.full(k, 180.0)
+    np.minimum.at(lo_old, old_piece[old_r], amin[old_r])
+    lo_new = np.full(k, 180.0)
+    np.minimum.at(lo_new, new_piece, new_min)
+    lost = per_piece(old_piece, np.where(mesh.valences == 4, old_area, 0.0), old_r) - np.bincount(
+        new_piece, weights=np.where(done.valences == 4, new_area, 0.0), minlength=k)
+    better = (now < was) | ((now == was) & (lo_new > lo_old))
+    take = better & (lost <= _OPEN_MAX_SHARE * np.maximum(was - now, 0) * total)
+    if not take.any():
+        return mesh, amin, 0
+    swap = region & take[old_piece]
+    part = done.select_faces(take[new_piece])
+    out = _spliced(mesh, swap, part)
+    n_open = int((mesh.valences[swap] == 4).sum() - (part.valences == 4).sum())
+    return out, face_min_angles(out), n_open
+
+
+def _quad_area(mesh: Mesh, every: bool = False) -> float:
+    """Area of the quads (of every face with ``every``)."""
+    from ...analysis.faces import face_normals
+
+    _, area = face_normals(mesh)
+    return float(area.sum() if every else area[mesh.valences == 4].sum())
+
+
+def _beside(mesh: Mesh, amin: np.ndarray, bad: np.ndarray, ends: bool = True) -> np.ndarray:
+    """(F,) bool: the quads sharing an edge with a splinter or a corner with its shortest edge."""
+    keys = _splinter_edges(mesh, amin)
+    n = np.int64(mesh.n_vertices)
+    idx = mesh.face_indices
+    nxt = idx[mesh.next_corners()]
+    edge = np.minimum(idx, nxt) * n + np.maximum(idx, nxt)
+    pos = np.clip(np.searchsorted(keys, edge), 0, keys.size - 1)
+    face_of = np.repeat(np.arange(mesh.n_faces), mesh.valences)
+    beside = np.zeros(mesh.n_faces, bool)
+    beside[face_of[keys[pos] == edge]] = True
+    # With the quads at the ends of a splinter's shortest edge open, a collapse may
+    # remove that edge.
+    if ends:
+        at = np.zeros(mesh.n_vertices, bool)
+        at[_short_edges(mesh, bad)] = True
+        beside[face_of[at[idx]]] = True
+    return beside & (mesh.valences == 4)
+
+
+def _spliced(mesh: Mesh, replaced: np.ndarray, part: Mesh) -> Mesh:
+    """``mesh`` with its faces marked ``replaced`` (F,) swapped for the faces of ``part``.
+
+    ``part`` came from ``mesh`` with ``vertex_data["_id"]`` numbering its
+    vertices in ``mesh``; its members are the whole mesh's members (as rejoined).
+    """
+    ids = np.asarray(part.vertex_data["_id"])
+    kept = mesh.select_faces(~replaced)
+    off = np.concatenate([kept.face_offsets, kept.face_offsets[-1] + part.face_offsets[1:]])
+    out = Mesh(mesh.vertices, off, np.concatenate([kept.face_indices, ids[part.face_indices]]),
+               np.concatenate([kept.face_kind, part.face_kind]), ids[part.members], part.member_id,
+               mesh.vertex_data, mesh.info)
+    return out.compact()
