@@ -313,7 +313,10 @@ def pq_mesh(a, b, rows: int = 20, primary: int | str = "middle", option: int = 0
         their generator diagonal); members are the generator segments between
         consecutive vertices; ``vertex_data`` holds ``t`` and ``generator``;
         ``info["warnings"]`` says what was replaced or could not be covered,
-        ``info["runs"]`` how many runs the generators were meshed in.
+        ``info["runs"]`` how many runs the generators were meshed in, and
+        ``flips``, ``collapsed``, ``paired``, ``snapped``, ``opened`` how many
+        edge flips, collapses, paired quads, corners snapped onto the border and
+        quads opened around splinters the fattening made.
 
     Raises
     ------
