@@ -115,10 +115,14 @@ def test_snapped_corners_are_ends_of_generator_diagonals(caught):
 
 def test_opening_stops_where_it_would_cost_too_many_quads(monkeypatch):
     """With no area allowed per splinter, nothing is opened and the splinters stay."""
+    from ruledmesh.pq import pq_mesh
+
+    rulings = build_file(QUALITY / "building-offset.toml").rulings
+    opened = pq_mesh(rulings.a, rulings.b, rows=30)
     monkeypatch.setattr(splinters, "_OPEN_MAX_SHARE", 0.0)
-    mesh = build_file(QUALITY / "building-offset.toml").mesh
-    assert mesh.info["opened"] == 0
-    assert _splinters(mesh) > 0
+    closed = pq_mesh(rulings.a, rulings.b, rows=30)
+    assert opened.info["opened"] > 0 and closed.info["opened"] == 0
+    assert _splinters(closed) > _splinters(opened)
 
 
 curves = st.lists(st.floats(-2.0, 2.0, allow_subnormal=False), min_size=10, max_size=10)

@@ -28,7 +28,7 @@ __all__ = ["BRENTQ_XTOL", "COLLINEAR", "COLLINEAR_SQ", "CONGRUENCE_ANGLE_DEG", "
            "FLIP_MIN_GAIN_DEG", "FLOAT32_WARNING", "INTERIOR", "KKT_REGULARISATION",
            "MIN_EXTENT", "MIN_HALF_ANGLE", "MIN_RELATIVE_EXTENT", "MITRE_FLOOR", "OCCT_FACE",
            "ON_BORDER", "PARAMETER_SLACK", "PLANARITY_FLOOR", "RESTART_ANGLE_DEG", "ROOT_RTOL", "ROOT_XTOL",
-           "ROUNDING", "ROUNDING_SQ", "SAME_ROOT", "SETTLED", "SNAP_GAP", "TINY", "ULPS", "Tolerances"]
+           "ROUNDING", "ROUNDING_SQ", "SAME_ROOT", "SETTLED", "SNAP_GAP", "SPLINTER_AREA_WORTH", "TINY", "ULPS", "Tolerances"]
 
 
 @dataclass(frozen=True)
@@ -191,3 +191,7 @@ COLLAPSE_MAX_SAG = 2.5e-4
 # (ruledmesh.analysis.faces.SPLINTER_DEG); 4 deg cost 4 more points of triangle
 # share at 301 x 300 for 24 fewer splinters out of 200 000 faces.
 RESTART_ANGLE_DEG = 3.0
+#: What a splinter is worth in quad area share when the mesher trades one for the other
+#: (opening the quads around a splinter, keeping a round of added generators): 0.6 % of the
+#: mesh's area per face below RESTART_ANGLE_DEG.
+SPLINTER_AREA_WORTH = 0.006

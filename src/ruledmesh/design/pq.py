@@ -12,7 +12,7 @@ from ..budget import MAX_COUNT
 from ..errors import DesignError, GeometryError
 from ..registry import BuildContext, Built, mesh_method
 from ..skew.pq import MAX_GRID_POINTS, pq_mesh
-from ..tolerances import DEFAULT, TINY
+from ..tolerances import DEFAULT, SPLINTER_AREA_WORTH, TINY
 
 __all__ = ["MESH_KEYS", "build_pq"]
 
@@ -64,8 +64,16 @@ def _mesh(rulings, options: dict):
 
 
 # Rounds of adding generators, and the share of a strip's area outside quads that asks for one.
-_REFINE_ROUNDS = 2
+_REFINE_ROUNDS = 3
 _TROUBLE_SHARE = 0.3
+# Rounds go on while each puts this share more of the area in quads.
+_MIN_GAIN = 0.005
+# A fabricator's goals for a build: no splinter, at most this share of the area in triangles
+# (in exact mode; with a planarity tolerance).
+_GOAL_TRIANGLES = 0.25
+_GOAL_TRIANGLES_TOLERANCE = 0.10
+# ... met with room: no splinter and at most this share of the goal in triangles.
+_ROOM = 0.25
 
 
 def _refined(rulings, mesh, options: dict):
@@ -75,8 +83,12 @@ def _refined(rulings, mesh, options: dict):
     near torsal generators; where the design gives director curves (not
     explicit lines) the discrete generators are ours to choose, so the strips
     whose area is mostly outside quads get one more generator each, at a node
-    of the distribution's exact samples.  The user's generators all stay; a
-    round is kept only if it puts more of the area in quads.
+    of the distribution's exact samples.  The user's generators all stay.
+    Rounds go on while they put more of the area in quads; of the meshes made,
+    the one kept meets more of a fabricator's two goals (no splinter, at most a
+    quarter of the area in triangles, a tenth with a planarity tolerance), and
+    among equals has the larger quad
+    share net of :data:`~ruledmesh.tolerances.SPLINTER_AREA_WORTH` per splinter.
     """
     from dataclasses import replace
 
@@ -86,14 +98,18 @@ def _refined(rulings, mesh, options: dict):
     if surface is None or rulings.info.get("distribution") == "lines":
         return rulings, mesh
     grid, _ = dense_grid(len(rulings.u))
-    # The face areas of each mesh are measured once: the quad share decides whether a
-    # round is kept, the strips' shares where the next one adds generators.
-    best = (*_measured(mesh), rulings, mesh)
+    # The face areas of each mesh are measured once: the quad share decides whether the
+    # rounds go on, the strips' shares where the next one adds generators.
+    cur = (*_measured(mesh), rulings, mesh)
+    rounds = [(cur[0], _splinters(mesh), rulings, mesh)]
     user = len(rulings.u) - int(rulings.info.get("inserted", 0))
     start = len(rulings.u)
+    goal = _GOAL_TRIANGLES_TOLERANCE if options["planarity_tolerance"] > DEFAULT.planarity \
+        else _GOAL_TRIANGLES
     for _ in range(_REFINE_ROUNDS):
-        share, area, cur_rulings, cur_mesh = best
-        if share >= 0.97:
+        share, area, cur_rulings, cur_mesh = cur
+        # More generators are more panels: none once the mesh meets the goals with room.
+        if rounds[-1][1] == 0 and 1.0 - share <= _ROOM * goal:
             break
         u = np.asarray(cur_rulings.u)
         strips = _trouble_strips(cur_mesh, len(u), area)
@@ -116,9 +132,11 @@ def _refined(rulings, mesh, options: dict):
         except GeometryError:
             break
         cand_share, cand_area = _measured(cand_mesh)
-        if cand_share <= share + 0.005:
+        if cand_share <= share + _MIN_GAIN:
             break
-        best = (cand_share, cand_area, candidate, cand_mesh)
+        cur = (cand_share, cand_area, candidate, cand_mesh)
+        rounds.append((cand_share, _splinters(cand_mesh), candidate, cand_mesh))
+    best = max(rounds, key=lambda r: _fabricable(r, goal))
     rulings, mesh = best[2], best[3]
     added = len(rulings.u) - start
     if added <= 0:
@@ -135,6 +153,21 @@ def _measured(mesh) -> tuple[float, np.ndarray]:
     _, area = face_normals(mesh)
     total = float(area.sum()) or 1.0
     return float(area[mesh.valences == 4].sum() / total), area
+
+
+def _fabricable(round_: tuple, goal: float) -> tuple[int, float]:
+    """Order of the rounds: the goals met (no splinter, at most ``goal`` of the area in
+    triangles), then the quad share less SPLINTER_AREA_WORTH per splinter."""
+    share, splinters = round_[0], round_[1]
+    met = int(splinters == 0) + int(1.0 - share <= goal)
+    return met, share - SPLINTER_AREA_WORTH * splinters
+
+
+def _splinters(mesh) -> int:
+    """Faces with a corner below the splinter bar."""
+    from ..analysis.faces import SPLINTER_DEG, face_min_angles
+
+    return int((face_min_angles(mesh) < SPLINTER_DEG).sum())
 
 
 def _trouble_strips(mesh, m: int, area: np.ndarray) -> np.ndarray:

@@ -28,7 +28,7 @@ import numpy as np
 
 from ...analysis.faces import face_min_angles
 from ...mesh import FaceKind, Mesh
-from ...tolerances import ON_BORDER, RESTART_ANGLE_DEG
+from ...tolerances import ON_BORDER, RESTART_ANGLE_DEG, SPLINTER_AREA_WORTH
 from .collapses import _apply
 from .pairing import _rebuilt
 
@@ -36,9 +36,9 @@ __all__ = ["open_walled_splinters", "snap_to_border"]
 
 # Rounds of opening the quads beside the splinters left ...
 _OPEN_ROUNDS = 5
-# ... each kept only if it moves at most this share of the area out of quads per
+# ... each piece kept only if it moves at most this share of the area out of quads per
 # splinter it removes.
-_OPEN_MAX_SHARE = 0.006
+_OPEN_MAX_SHARE = SPLINTER_AREA_WORTH
 
 
 def _splinter_edges(mesh: Mesh, amin: np.ndarray) -> np.ndarray:
