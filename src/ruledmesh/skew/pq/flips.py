@@ -58,12 +58,27 @@ def _ring(t1: np.ndarray, t2: np.ndarray, mark: np.ndarray) -> np.ndarray:
     return out
 
 
-def _round(V: np.ndarray, tri: np.ndarray, fixed: np.ndarray, scale: float,
+def _around(tri: np.ndarray, n: int, mark: np.ndarray, times: int) -> np.ndarray:
+    """(T,) bool: ``mark`` and the triangles ``times`` corner-sharing steps from a marked one.
+
+    A triangle sharing an edge with another shares a corner with it, so this
+    holds every triangle ``times`` edge-sharing steps away (and some more).
+    """
+    for _ in range(times):
+        hit = np.zeros(n, bool)
+        hit[tri[mark]] = True
+        mark = hit[tri[:, 0]] | hit[tri[:, 1]] | hit[tri[:, 2]]
+    return mark
+
+
+def _round(V: np.ndarray, tri: np.ndarray, tmin: np.ndarray, fixed: np.ndarray, scale: float,
            changed: np.ndarray | None) -> np.ndarray:
     """One round of mutual-best flips on ``tri`` (in place); (T,) bool, the triangles it changed.
 
-    ``fixed`` holds the sorted edge keys of every other face (quads, triangles
-    left out of the rounds): a flip may not make one of those edges again.
+    ``tmin`` (T,) holds the smallest angle of each triangle of ``tri`` and is
+    kept up to date (in place).  ``fixed`` holds the sorted edge keys of every
+    other face (quads, triangles left out of the rounds): a flip may not make
+    one of those edges again.
     ``changed`` marks the triangles the previous round changed (None: the
     first round).  Only pairs near them can have gained or lost their best
     choice, so the round weighs the pairs touching them, their neighbours and
@@ -72,18 +87,28 @@ def _round(V: np.ndarray, tri: np.ndarray, fixed: np.ndarray, scale: float,
     a triangle that changed or borders one: the flips every pair would give.
     """
     n = len(V)
-    t1, t2, a, b, c, d = adjacent_triangles(tri, n)
     done = np.zeros(len(tri), bool)
+    near: np.ndarray | None = None
+    if changed is None:
+        rows = None
+        t1, t2, a, b, c, d = adjacent_triangles(tri, n)
+    else:
+        # Every pair weighed, and every edge a taken flip could make again, lies
+        # among the triangles three corner-sharing steps from a change: the
+        # adjacency of those (rows in order, so pairs come in the same order and
+        # with the same sides) is the whole mesh's there.
+        rows = np.flatnonzero(_around(tri, n, changed, 3))
+        t1, t2, a, b, c, d = adjacent_triangles(tri[rows], n)
+        t1, t2 = rows[t1], rows[t2]
     if t1.size == 0:
         return done
-    near: np.ndarray | None = None
     if changed is not None:
         near = _ring(t1, t2, changed)              # choices that may have changed
         weigh = _ring(t1, t2, near)                # their partners: exact best choices
         sel = np.flatnonzero(weigh[t1] | weigh[t2])
         t1, t2, a, b, c, d = t1[sel], t2[sel], a[sel], b[sel], c[sel], d[sel]
     A, B, C, D = V[a], V[b], V[c], V[d]
-    old = np.minimum(_angles(V[tri[t1]]), _angles(V[tri[t2]]))
+    old = np.minimum(tmin[t1], tmin[t2])
     new = np.minimum(_angles(np.stack([A, B, D], 1)), _angles(np.stack([A, D, C], 1)))
     n1, n2 = _unit_normals(A, B, C), _unit_normals(B, D, C)
     m1, m2 = _unit_normals(A, B, D), _unit_normals(A, D, C)
@@ -102,7 +127,7 @@ def _round(V: np.ndarray, tri: np.ndarray, fixed: np.ndarray, scale: float,
         return done
     # The new diagonal must not be an edge already (it would join three faces).
     new_key = np.minimum(a, d) * n + np.maximum(a, d)
-    ok &= ~(_member(new_key, fixed) | _member(new_key, _edge_keys([tri], n)))
+    ok &= ~(_member(new_key, fixed) | _member(new_key, _edge_keys([tri if rows is None else tri[rows]], n)))
     cand = np.flatnonzero(ok)
     if cand.size == 0:
         return done
@@ -121,6 +146,7 @@ def _round(V: np.ndarray, tri: np.ndarray, fixed: np.ndarray, scale: float,
     tri[t1[take]] = np.stack([a[take], b[take], d[take]], axis=1)
     tri[t2[take]] = np.stack([a[take], d[take], c[take]], axis=1)
     done[t1[take]] = done[t2[take]] = True
+    tmin[done] = _angles(V[tri[done]])
     return done
 
 
@@ -132,15 +158,17 @@ def _member(keys: np.ndarray, sorted_keys: np.ndarray) -> np.ndarray:
     return sorted_keys[pos] == keys
 
 
-def _active(V: np.ndarray, tri: np.ndarray) -> np.ndarray:
-    """(T,) bool: triangles thinner than :data:`FLIP_ACTIVE_DEG` and their edge neighbours.
+def _active(V: np.ndarray, tri: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """(T,) bool: triangles thinner than :data:`FLIP_ACTIVE_DEG` and their edge neighbours;
+    (T,) the smallest angle of every triangle.
 
     Only these take part in the rounds: a flip between two fat triangles gains
     little, and most of a large mesh's triangles are fat.
     """
-    thin = _angles(V[tri]) < FLIP_ACTIVE_DEG
+    ang = _angles(V[tri])
+    thin = ang < FLIP_ACTIVE_DEG
     if not thin.any():
-        return thin
+        return thin, ang
     t1, t2, *_ = adjacent_triangles(tri, len(V))
     near = thin.copy()
     near[t2[thin[t1]]] = True
@@ -149,7 +177,7 @@ def _active(V: np.ndarray, tri: np.ndarray) -> np.ndarray:
     out = near.copy()
     out[t2[near[t1]]] = True
     out[t1[near[t2]]] = True
-    return out
+    return out, ang
 
 
 def flip_triangles(mesh: Mesh) -> tuple[Mesh, int]:
@@ -177,7 +205,7 @@ def flip_triangles(mesh: Mesh) -> tuple[Mesh, int]:
     scale = float(np.linalg.norm(V.max(axis=0) - V.min(axis=0))) or 1.0
     ids = np.flatnonzero(is_tri)
     tri_all = mesh.face_indices[mesh.face_offsets[ids][:, None] + np.arange(3)].astype(np.int64)
-    live = _active(V, tri_all)
+    live, ang = _active(V, tri_all)
     if not live.any():
         return mesh, 0
     others = [tri_all[~live]]
@@ -186,11 +214,12 @@ def flip_triangles(mesh: Mesh) -> tuple[Mesh, int]:
         others.append(mesh.face_indices[mesh.face_offsets[f][:, None] + np.arange(k)])
     fixed = _edge_keys(others, n)
     tri = tri_all[live]
+    tmin = ang[live]
     before = tri.copy()
     flips = 0
     changed = None
     for _ in range(_ROUNDS):
-        changed = _round(V, tri, fixed, scale, changed)
+        changed = _round(V, tri, tmin, fixed, scale, changed)
         made = int(changed.sum()) // 2
         flips += made
         if made == 0:
