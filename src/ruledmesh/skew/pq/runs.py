@@ -245,13 +245,8 @@ def _grid(a: np.ndarray, d: np.ndarray, first: int, maps: ChainMaps, tau: np.nda
         # One pass per stage, the same arithmetic (ruledmesh.kernels.grid).
         num, den = kern.propagate(maps.primary, maps.root, maps.fwd, maps.bwd, maps.crossing, roots)
         Xc = crossing_maps(a[:-2], d[:-2], a[1:-1], d[1:-1], a[2:], d[2:]) if m >= 3 else None
-        X, t, far, left, right, pole, cg, _, _ = kern.grid(a, d, num, den, tmax, parity, Xc, first)
-        # The kernel counts bow-ties only; slivers count as failing too (numpy, as below).
-        ic = cg - first
-        hc = np.where(left[:, 0] >= 0, left[:, 0], right[:, 1]) % H
-        hl = np.where(left[:, 1] >= 0, left[:, 1], right[:, 0]) % H
-        failing, on_patch = _failing_faces(a, d, t.reshape(m, H), far.reshape(m, H), ic, hl, hc,
-                                           pole, m)
+        X, t, far, left, right, pole, cg, failing, on_patch = kern.grid(
+            a, d, num, den, tmax, parity, Xc, first, RESTART_ANGLE_DEG)
         gen = np.repeat(np.arange(first, first + m), H)
         return Run(X, t, gen, far, left, right, pole, cg, failing, on_patch)
     num, den = propagate(maps, roots)
