@@ -16,7 +16,7 @@ import math
 import numba as nb
 import numpy as np
 
-from .geometry import _DEG, _dot, _norm
+from .geometry import _angle
 
 __all__ = ["grid", "propagate"]
 
@@ -102,16 +102,6 @@ def _vertices(a, d, num, den, tmax):
             for j in range(3):
                 X[v, j] = a[i, j] + tv * d[i, j]
     return X, t, far
-
-
-@nb.njit(cache=True, inline="always")
-def _angle(X, p, j, q):
-    """Interior angle (degrees) at ``X[j]`` between ``X[p]`` and ``X[q]``, as ``polygon_angles``."""
-    x0, x1, x2 = X[p, 0] - X[j, 0], X[p, 1] - X[j, 1], X[p, 2] - X[j, 2]
-    y0, y1, y2 = X[q, 0] - X[j, 0], X[q, 1] - X[j, 1], X[q, 2] - X[j, 2]
-    cos = _dot(x0, x1, x2, y0, y1, y2)
-    sin = _norm(x1 * y2 - x2 * y1, x2 * y0 - x0 * y2, x0 * y1 - x1 * y0)
-    return math.atan2(sin, cos) * _DEG
 
 
 @nb.njit(cache=True)

@@ -19,6 +19,7 @@ from __future__ import annotations
 import numpy as np
 
 from ..._arrays import cross, unique
+from ...kernels import wanted
 from ...mesh import FaceKind, Mesh
 from ...tolerances import FLIP_ACTIVE_DEG, FLIP_MAX_BEND_DEG, FLIP_MAX_SAG, FLIP_MIN_GAIN_DEG, TINY
 from .pairing import adjacent_triangles
@@ -71,6 +72,32 @@ def _around(tri: np.ndarray, n: int, mark: np.ndarray, times: int) -> np.ndarray
     return mark
 
 
+def _pair_measures(V: np.ndarray, a: np.ndarray, b: np.ndarray, c: np.ndarray, d: np.ndarray,
+                   old: np.ndarray, scale: float) -> tuple[np.ndarray, np.ndarray]:
+    """(P,) the flipped pairs' smaller smallest angle, and whether each flip may be taken.
+
+    Pairs of triangles ``(b, c, a)``, ``(c, b, d)`` with the smaller smallest
+    angle ``old``; a flip gains, and keeps to the surface (no fold, no ridge
+    cut off).  :func:`ruledmesh.kernels.geometry.flip_pairs` is the same, bit for bit.
+    """
+    bend = np.cos(np.radians(FLIP_MAX_BEND_DEG))
+    kern = wanted(len(a))
+    if kern is not None:
+        return kern.flip_pairs(V, a, b, c, d, old, FLIP_MIN_GAIN_DEG, bend, FLIP_MAX_SAG * scale)
+    A, B, C, D = V[a], V[b], V[c], V[d]
+    new = np.minimum(_angles(np.stack([A, B, D], 1)), _angles(np.stack([A, D, C], 1)))
+    n1, n2 = _unit_normals(A, B, C), _unit_normals(B, D, C)
+    m1, m2 = _unit_normals(A, B, D), _unit_normals(A, D, C)
+    mean = n1 + n2
+    mean /= np.maximum(np.linalg.norm(mean, axis=1, keepdims=True), TINY)
+    # The flipped pair's height over the old one: how far the surface moves.
+    sag = np.abs(np.einsum("ij,ij->i", 0.5 * (A + D) - 0.5 * (B + C), mean))
+    ok = (new > old + FLIP_MIN_GAIN_DEG) & (np.einsum("ij,ij->i", n1, n2) >= bend) \
+        & (np.einsum("ij,ij->i", m1, m2) >= bend) & (np.einsum("ij,ij->i", m1, mean) >= bend) \
+        & (np.einsum("ij,ij->i", m2, mean) >= bend) & (sag <= FLIP_MAX_SAG * scale) & (a != d)
+    return new, ok
+
+
 def _round(V: np.ndarray, tri: np.ndarray, tmin: np.ndarray, fixed: np.ndarray, scale: float,
            changed: np.ndarray | None) -> np.ndarray:
     """One round of mutual-best flips on ``tri`` (in place); (T,) bool, the triangles it changed.
@@ -107,19 +134,8 @@ def _round(V: np.ndarray, tri: np.ndarray, tmin: np.ndarray, fixed: np.ndarray, 
         weigh = _ring(t1, t2, near)                # their partners: exact best choices
         sel = np.flatnonzero(weigh[t1] | weigh[t2])
         t1, t2, a, b, c, d = t1[sel], t2[sel], a[sel], b[sel], c[sel], d[sel]
-    A, B, C, D = V[a], V[b], V[c], V[d]
     old = np.minimum(tmin[t1], tmin[t2])
-    new = np.minimum(_angles(np.stack([A, B, D], 1)), _angles(np.stack([A, D, C], 1)))
-    n1, n2 = _unit_normals(A, B, C), _unit_normals(B, D, C)
-    m1, m2 = _unit_normals(A, B, D), _unit_normals(A, D, C)
-    mean = n1 + n2
-    mean /= np.maximum(np.linalg.norm(mean, axis=1, keepdims=True), TINY)
-    bend = np.cos(np.radians(FLIP_MAX_BEND_DEG))
-    # The flipped pair's height over the old one: how far the surface moves.
-    sag = np.abs(np.einsum("ij,ij->i", 0.5 * (A + D) - 0.5 * (B + C), mean))
-    ok = (new > old + FLIP_MIN_GAIN_DEG) & (np.einsum("ij,ij->i", n1, n2) >= bend) \
-        & (np.einsum("ij,ij->i", m1, m2) >= bend) & (np.einsum("ij,ij->i", m1, mean) >= bend) \
-        & (np.einsum("ij,ij->i", m2, mean) >= bend) & (sag <= FLIP_MAX_SAG * scale) & (a != d)
+    new, ok = _pair_measures(V, a, b, c, d, old, scale)
     if near is not None:
         # Pairs away from every change keep the choice they had: not taken then, nor now.
         ok &= near[t1] | near[t2]
