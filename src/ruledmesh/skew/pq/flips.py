@@ -22,7 +22,7 @@ from ..._arrays import cross, unique
 from ...kernels import wanted
 from ...mesh import FaceKind, Mesh
 from ...tolerances import FLIP_ACTIVE_DEG, FLIP_MAX_BEND_DEG, FLIP_MAX_SAG, FLIP_MIN_GAIN_DEG, TINY
-from .pairing import adjacent_triangles
+from .pairing import _adjacent, adjacent_triangles
 
 __all__ = ["flip_triangles"]
 
@@ -117,15 +117,14 @@ def _round(V: np.ndarray, tri: np.ndarray, tmin: np.ndarray, fixed: np.ndarray, 
     done = np.zeros(len(tri), bool)
     near: np.ndarray | None = None
     if changed is None:
-        rows = None
-        t1, t2, a, b, c, d = adjacent_triangles(tri, n)
+        t1, t2, a, b, c, d, keys = _adjacent(tri, n)
     else:
         # Every pair weighed, and every edge a taken flip could make again, lies
         # among the triangles three corner-sharing steps from a change: the
         # adjacency of those (rows in order, so pairs come in the same order and
         # with the same sides) is the whole mesh's there.
         rows = np.flatnonzero(_around(tri, n, changed, 3))
-        t1, t2, a, b, c, d = adjacent_triangles(tri[rows], n)
+        t1, t2, a, b, c, d, keys = _adjacent(tri[rows], n)
         t1, t2 = rows[t1], rows[t2]
     if t1.size == 0:
         return done
@@ -143,7 +142,7 @@ def _round(V: np.ndarray, tri: np.ndarray, tmin: np.ndarray, fixed: np.ndarray, 
         return done
     # The new diagonal must not be an edge already (it would join three faces).
     new_key = np.minimum(a, d) * n + np.maximum(a, d)
-    ok &= ~(_member(new_key, fixed) | _member(new_key, _edge_keys([tri if rows is None else tri[rows]], n)))
+    ok &= ~(_member(new_key, fixed) | _member(np.minimum(a, d) * (n + 1) + np.maximum(a, d), keys))
     cand = np.flatnonzero(ok)
     if cand.size == 0:
         return done
