@@ -25,7 +25,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..._arrays import cross
+from ..._arrays import cross, diagonal
 from ...mesh import FaceKind, Mesh
 from ...tolerances import COLLAPSE_MAX_SAG, FLIP_MAX_BEND_DEG, FLIP_MIN_GAIN_DEG, RESTART_ANGLE_DEG, TINY
 from .flips import _member, _unit_normals
@@ -284,7 +284,7 @@ def collapse_splinters(mesh: Mesh) -> tuple[Mesh, int]:
         nval = near.valences
         tri = near.face_indices[near.face_offsets[np.flatnonzero(nval == 3)][:, None]
                                 + np.arange(3)].astype(np.int64)
-        scale = float(np.linalg.norm(V.max(axis=0) - V.min(axis=0))) or 1.0
+        scale = diagonal(V) or 1.0
         stars = _Stars(tri, keys, n)
         gain, ok = _evaluate(V, tri, stars, keys, np.bincount(mesh.face_indices, minlength=n), v, u, scale)
         ok &= gain > FLIP_MIN_GAIN_DEG

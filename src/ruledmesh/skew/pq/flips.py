@@ -18,7 +18,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..._arrays import cross, unique
+from ..._arrays import cross, diagonal, unique
 from ...kernels import wanted
 from ...mesh import FaceKind, Mesh
 from ...tolerances import FLIP_ACTIVE_DEG, FLIP_MAX_BEND_DEG, FLIP_MAX_SAG, FLIP_MIN_GAIN_DEG, TINY
@@ -217,7 +217,7 @@ def flip_triangles(mesh: Mesh) -> tuple[Mesh, int]:
         return mesh, 0
     V = mesh.vertices
     n = len(V)
-    scale = float(np.linalg.norm(V.max(axis=0) - V.min(axis=0))) or 1.0
+    scale = diagonal(V) or 1.0
     ids = np.flatnonzero(is_tri)
     tri_all = mesh.face_indices[mesh.face_offsets[ids][:, None] + np.arange(3)].astype(np.int64)
     live, ang = _active(V, tri_all)
