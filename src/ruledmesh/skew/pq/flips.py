@@ -22,7 +22,7 @@ from ..._arrays import cross, diagonal, unique
 from ...kernels import wanted
 from ...mesh import FaceKind, Mesh
 from ...tolerances import FLIP_ACTIVE_DEG, FLIP_MAX_BEND_DEG, FLIP_MAX_SAG, FLIP_MIN_GAIN_DEG, TINY
-from .pairing import _adjacent, adjacent_triangles
+from .pairing import _adjacent
 
 __all__ = ["flip_triangles"]
 
@@ -99,7 +99,7 @@ def _pair_measures(V: np.ndarray, a: np.ndarray, b: np.ndarray, c: np.ndarray, d
 
 
 def _round(V: np.ndarray, tri: np.ndarray, tmin: np.ndarray, fixed: np.ndarray, scale: float,
-           changed: np.ndarray | None) -> np.ndarray:
+           changed: np.ndarray | None, adjacency: tuple | None = None) -> np.ndarray:
     """One round of mutual-best flips on ``tri`` (in place); (T,) bool, the triangles it changed.
 
     ``tmin`` (T,) holds the smallest angle of each triangle of ``tri`` and is
@@ -112,12 +112,14 @@ def _round(V: np.ndarray, tri: np.ndarray, tmin: np.ndarray, fixed: np.ndarray, 
     the neighbours' neighbours (every pair of a triangle whose choice may have
     changed, so each such triangle's best is exact), and takes only pairs with
     a triangle that changed or borders one: the flips every pair would give.
+    ``adjacency``: the first round's ``pairing._adjacent(tri, n)`` if known
+    (its keys may hold edges of ``fixed`` too).
     """
     n = len(V)
     done = np.zeros(len(tri), bool)
     near: np.ndarray | None = None
     if changed is None:
-        t1, t2, a, b, c, d, keys = _adjacent(tri, n)
+        t1, t2, a, b, c, d, keys = _adjacent(tri, n) if adjacency is None else adjacency
     else:
         # Every pair weighed, and every edge a taken flip could make again, lies
         # among the triangles three corner-sharing steps from a change: the
@@ -173,9 +175,10 @@ def _member(keys: np.ndarray, sorted_keys: np.ndarray) -> np.ndarray:
     return sorted_keys[pos] == keys
 
 
-def _active(V: np.ndarray, tri: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+def _active(V: np.ndarray, tri: np.ndarray) -> tuple[np.ndarray, np.ndarray, tuple | None]:
     """(T,) bool: triangles thinner than :data:`FLIP_ACTIVE_DEG` and their edge neighbours;
-    (T,) the smallest angle of every triangle.
+    (T,) the smallest angle of every triangle; the adjacency of the marked ones
+    (as ``pairing._adjacent`` of ``tri[marked]``, its keys those of all ``tri``), or None.
 
     Only these take part in the rounds: a flip between two fat triangles gains
     little, and most of a large mesh's triangles are fat.
@@ -183,8 +186,9 @@ def _active(V: np.ndarray, tri: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     ang = _angles(V[tri])
     thin = ang < FLIP_ACTIVE_DEG
     if not thin.any():
-        return thin, ang
-    t1, t2, *_ = adjacent_triangles(tri, len(V))
+        return thin, ang, None
+    adjacency = _adjacent(tri, len(V))
+    t1, t2 = adjacency[:2]
     near = thin.copy()
     near[t2[thin[t1]]] = True
     near[t1[thin[t2]]] = True
@@ -192,7 +196,21 @@ def _active(V: np.ndarray, tri: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     out = near.copy()
     out[t2[near[t1]]] = True
     out[t1[near[t2]]] = True
-    return out, ang
+    return out, ang, _restricted(adjacency, out)
+
+
+def _restricted(adjacency: tuple, live: np.ndarray) -> tuple | None:
+    """The pairs of ``adjacency`` between ``live`` triangles, rows renumbered among those.
+
+    They are the live triangles' own pairs, in the same order, when no edge has
+    three triangles or more (else two live ones could share one): None then.
+    """
+    t1, t2, a, b, c, d, keys = adjacency
+    if keys.size > 2 and bool((keys[2:] == keys[:-2]).any()):
+        return None
+    keep = np.flatnonzero(live[t1] & live[t2])
+    rank = np.cumsum(live) - 1
+    return rank[t1[keep]], rank[t2[keep]], a[keep], b[keep], c[keep], d[keep], keys
 
 
 def flip_triangles(mesh: Mesh) -> tuple[Mesh, int]:
@@ -220,7 +238,7 @@ def flip_triangles(mesh: Mesh) -> tuple[Mesh, int]:
     scale = diagonal(V) or 1.0
     ids = np.flatnonzero(is_tri)
     tri_all = mesh.face_indices[mesh.face_offsets[ids][:, None] + np.arange(3)].astype(np.int64)
-    live, ang = _active(V, tri_all)
+    live, ang, adjacency = _active(V, tri_all)
     if not live.any():
         return mesh, 0
     others = [tri_all[~live]]
@@ -234,7 +252,7 @@ def flip_triangles(mesh: Mesh) -> tuple[Mesh, int]:
     flips = 0
     changed = None
     for _ in range(_ROUNDS):
-        changed = _round(V, tri, tmin, fixed, scale, changed)
+        changed = _round(V, tri, tmin, fixed, scale, changed, adjacency)
         made = int(changed.sum()) // 2
         flips += made
         if made == 0:
