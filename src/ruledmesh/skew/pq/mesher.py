@@ -558,11 +558,15 @@ def _warn_splinters(mesh: Mesh, warnings: list[str], torsal: np.ndarray) -> None
     bad = np.flatnonzero(ang < SPLINTER_DEG)
     if bad.size == 0:
         return
-    gen = np.asarray(mesh.vertex_data["generator"])[mesh.face_indices]
-    t = np.asarray(mesh.vertex_data["t"])[mesh.face_indices]
-    g0 = np.minimum.reduceat(gen, mesh.face_offsets[:-1])[bad]
-    t_lo = np.minimum.reduceat(t, mesh.face_offsets[:-1])[bad]
-    t_hi = np.maximum.reduceat(t, mesh.face_offsets[:-1])[bad]
+    # The corners of the splinters only (a large mesh has few).
+    val = mesh.valences[bad]
+    starts = np.cumsum(val) - val
+    corners = mesh.face_indices[np.repeat(mesh.face_offsets[bad] - starts, val) + np.arange(int(val.sum()))]
+    gen = np.asarray(mesh.vertex_data["generator"])[corners]
+    t = np.asarray(mesh.vertex_data["t"])[corners]
+    g0 = np.minimum.reduceat(gen, starts)
+    t_lo = np.minimum.reduceat(t, starts)
+    t_hi = np.maximum.reduceat(t, starts)
     near_torsal = np.zeros(bad.size, bool)
     for k in torsal.tolist():
         near_torsal |= np.abs(g0 - k) <= 2
