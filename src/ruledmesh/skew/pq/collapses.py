@@ -26,6 +26,7 @@ from __future__ import annotations
 import numpy as np
 
 from ..._arrays import cross, diagonal
+from ...analysis.faces import min_corner_angles
 from ...mesh import FaceKind, Mesh
 from ...tolerances import COLLAPSE_MAX_SAG, FLIP_MAX_BEND_DEG, FLIP_MIN_GAIN_DEG, RESTART_ANGLE_DEG, TINY
 from .flips import _member, _unit_normals
@@ -140,7 +141,7 @@ def _evaluate(V, tri, stars: _Stars, keys, faces_at, v, u, scale) -> tuple[np.nd
     new = old.copy()
     new[np.arange(face.size), corner] = u[rep]
     gone = (old == u[rep][:, None]).any(axis=1)          # the triangles on the edge u v
-    old_ang = _angles(V[old]).min(axis=1)
+    old_ang = min_corner_angles(V, old)
     old_min = np.full(C, 180.0)
     np.minimum.at(old_min, rep, old_ang)
     keep = ~gone
@@ -260,7 +261,7 @@ def collapse_splinters(mesh: Mesh) -> tuple[Mesh, int]:
         tri = mesh.face_indices[mesh.face_offsets[ids][:, None] + np.arange(3)].astype(np.int64)
         if watch is not None:
             tri = tri[watch[tri].any(axis=1)]
-        thin = _angles(V[tri]).min(axis=1) < RESTART_ANGLE_DEG
+        thin = min_corner_angles(V, tri) < RESTART_ANGLE_DEG
         if not thin.any():
             break
         free = np.ones(n, bool)

@@ -19,6 +19,7 @@ from __future__ import annotations
 import numpy as np
 
 from ..._arrays import cross, diagonal, unique
+from ...analysis.faces import min_corner_angles
 from ...kernels import wanted
 from ...mesh import FaceKind, Mesh
 from ...tolerances import FLIP_ACTIVE_DEG, FLIP_MAX_BEND_DEG, FLIP_MAX_SAG, FLIP_MIN_GAIN_DEG, TINY
@@ -163,7 +164,7 @@ def _round(V: np.ndarray, tri: np.ndarray, tmin: np.ndarray, fixed: np.ndarray, 
     tri[t1[take]] = np.stack([a[take], b[take], d[take]], axis=1)
     tri[t2[take]] = np.stack([a[take], d[take], c[take]], axis=1)
     done[t1[take]] = done[t2[take]] = True
-    tmin[done] = _angles(V[tri[done]])
+    tmin[done] = min_corner_angles(V, tri[done])
     return done
 
 
@@ -183,7 +184,7 @@ def _active(V: np.ndarray, tri: np.ndarray) -> tuple[np.ndarray, np.ndarray, tup
     Only these take part in the rounds: a flip between two fat triangles gains
     little, and most of a large mesh's triangles are fat.
     """
-    ang = _angles(V[tri])
+    ang = min_corner_angles(V, tri)
     thin = ang < FLIP_ACTIVE_DEG
     if not thin.any():
         return thin, ang, None
