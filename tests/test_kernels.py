@@ -81,6 +81,21 @@ def test_polygon_angles(monkeypatch, seed, n, k, spread):
 
 
 @SETTINGS
+@given(seed=st.integers(0, 2**31), n=st.integers(3, 80), f=st.integers(0, 200), k=st.integers(3, 5),
+       spread=st.floats(-3, 6))
+def test_min_corner_angles(monkeypatch, seed, n, f, k, spread):
+    """Smallest angles straight from corner indices: repeated and NaN corners included."""
+    rng = np.random.default_rng(seed)
+    V = rng.standard_normal((n, 3)) * 10.0 ** spread + rng.uniform(-1e4, 1e4, 3)
+    V[-1, 1] = np.nan
+    F = rng.integers(0, n, (f, k))
+    F[: f // 4, 1] = F[: f // 4, 0]
+    ref, got = both(monkeypatch, lambda: faces.min_corner_angles(V, F))
+    assert same(ref, got)
+    assert same(ref, faces.polygon_angles(V[F]).min(axis=1))
+
+
+@SETTINGS
 @given(seed=st.integers(0, 2**31), n=st.integers(4, 60), pairs=st.integers(1, 300), spread=st.floats(-3, 6))
 def test_flip_measures(monkeypatch, seed, n, pairs, spread):
     """The flips' measures of triangle pairs: nearly flat ones, repeated and NaN corners included."""
