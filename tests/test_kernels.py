@@ -81,6 +81,40 @@ def test_polygon_angles(monkeypatch, seed, n, k, spread):
 
 
 @SETTINGS
+@given(seed=st.integers(0, 2**31), n=st.integers(3, 80), f=st.integers(0, 200), k=st.integers(3, 5),
+       spread=st.floats(-3, 6))
+def test_min_corner_angles(monkeypatch, seed, n, f, k, spread):
+    """Smallest angles straight from corner indices: repeated and NaN corners included."""
+    rng = np.random.default_rng(seed)
+    V = rng.standard_normal((n, 3)) * 10.0 ** spread + rng.uniform(-1e4, 1e4, 3)
+    V[-1, 1] = np.nan
+    F = rng.integers(0, n, (f, k))
+    F[: f // 4, 1] = F[: f // 4, 0]
+    ref, got = both(monkeypatch, lambda: faces.min_corner_angles(V, F))
+    assert same(ref, got)
+    assert same(ref, faces.polygon_angles(V[F]).min(axis=1))
+
+
+@SETTINGS
+@given(seed=st.integers(0, 2**31), n=st.integers(4, 60), pairs=st.integers(1, 300), spread=st.floats(-3, 6))
+def test_flip_measures(monkeypatch, seed, n, pairs, spread):
+    """The flips' measures of triangle pairs: nearly flat ones, repeated and NaN corners included."""
+    from ruledmesh.skew.pq.flips import _pair_measures
+
+    rng = np.random.default_rng(seed)
+    V = rng.standard_normal((n, 3)) * 10.0 ** spread + rng.uniform(-1e4, 1e4, 3)
+    V[: n - 2, 2] = V[0, 2] + 1e-4 * V[: n - 2, 2]          # most of them nearly in a plane
+    V[-1, 0] = np.nan
+    a, b, c, d = (rng.integers(0, n, pairs) for _ in range(4))
+    d[: pairs // 5] = a[: pairs // 5]                        # a == d: never taken
+    old = rng.uniform(0.0, 30.0, pairs)
+    old[: pairs // 7] = np.nan
+    scale = float(100 * 10.0 ** spread)
+    ref, got = both(monkeypatch, lambda: _pair_measures(V, a, b, c, d, old, scale))
+    assert all(same(r, g) for r, g in zip(ref, got))
+
+
+@SETTINGS
 @given(seed=st.integers(0, 2**31), m=st.integers(3, 40), rows=st.integers(1, 40),
        twist=st.floats(0.1, 3.0), wobble=st.floats(0.0, 1.5), option=st.integers(0, 1))
 def test_run_grid(monkeypatch, seed, m, rows, twist, wobble, option):

@@ -18,7 +18,7 @@ from typing import Any
 
 import numpy as np
 
-from ._arrays import unique
+from ._arrays import diagonal, unique
 from ._validation import check_points
 from .errors import ParameterError
 from .tolerances import ROUNDING, TINY
@@ -303,8 +303,7 @@ class Mesh:
 
     def diagonal(self) -> float:
         """Length of the bounding-box diagonal (the scale of relative measures)."""
-        lo, hi = self.bounding_box()
-        return float(np.linalg.norm(hi - lo))
+        return diagonal(self.vertices) if self.n_vertices else 0.0
 
     @property
     def units(self) -> str:

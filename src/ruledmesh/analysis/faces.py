@@ -30,6 +30,7 @@ __all__ = [
     "edge_lengths",
     "degenerate_faces",
     "face_min_angles",
+    "min_corner_angles",
     "area_shares",
 ]
 
@@ -226,6 +227,26 @@ def polygon_angles(corners: np.ndarray) -> np.ndarray:
     cosang = np.einsum("fkc,fkc->fk", e1, e2)
     sinang = np.linalg.norm(cross(e1, e2), axis=2)
     return np.degrees(np.arctan2(sinang, cosang))
+
+
+def min_corner_angles(vertices: np.ndarray, faces: np.ndarray) -> np.ndarray:
+    """(F,) float64: the smallest interior angle, degrees, of each polygon ``vertices[faces]``.
+
+    ``polygon_angles(vertices[faces]).min(axis=1)``, bit for bit, without the
+    (F, k, 3) copy of the corners where the kernels run.
+
+    Parameters
+    ----------
+    vertices : (n, 3) float64
+    faces : (F, k) int
+        Corners of each polygon, in order around it.
+    """
+    F, k = faces.shape
+    if F and k:
+        kern = wanted(F * k)
+        if kern is not None:
+            return kern.min_angles(vertices, faces.reshape(-1), np.arange(0, F * k + 1, k))
+    return polygon_angles(vertices[faces]).min(axis=1)
 
 
 def corner_angles(mesh: Mesh) -> np.ndarray:

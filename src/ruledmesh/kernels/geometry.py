@@ -18,7 +18,7 @@ import numpy as np
 
 from ..tolerances import ROUNDING_SQ, TINY
 
-__all__ = ["crossing", "min_angles", "newell", "polygon_angles", "quad_planarity"]
+__all__ = ["crossing", "flip_pairs", "min_angles", "newell", "polygon_angles", "quad_planarity"]
 
 _DEG = 180.0 / math.pi
 # numpy's pairwise sum adds up to 128 terms in one unrolled block: the Newell kernel
@@ -310,3 +310,90 @@ def polygon_angles(corners: np.ndarray) -> np.ndarray:
         Interior angles, degrees.
     """
     return _polygon_angles(np.ascontiguousarray(corners, dtype=np.float64))
+
+
+@nb.njit(cache=True, inline="always")
+def _angle(X, p, j, q):
+    """Interior angle (degrees) at ``X[j]`` between ``X[p]`` and ``X[q]``, as ``polygon_angles``."""
+    x0, x1, x2 = X[p, 0] - X[j, 0], X[p, 1] - X[j, 1], X[p, 2] - X[j, 2]
+    y0, y1, y2 = X[q, 0] - X[j, 0], X[q, 1] - X[j, 1], X[q, 2] - X[j, 2]
+    cos = _dot(x0, x1, x2, y0, y1, y2)
+    sin = _norm(x1 * y2 - x2 * y1, x2 * y0 - x0 * y2, x0 * y1 - x1 * y0)
+    return math.atan2(sin, cos) * _DEG
+
+
+@nb.njit(cache=True, inline="always")
+def _triangle_min(V, i, j, k):
+    """``polygon_angles(V[[i, j, k]]).min()``: NaN if an angle is."""
+    a0, a1, a2 = _angle(V, k, i, j), _angle(V, i, j, k), _angle(V, j, k, i)
+    if a0 != a0 or a1 != a1 or a2 != a2:
+        return math.nan
+    return min(a0, min(a1, a2))
+
+
+@nb.njit(cache=True, inline="always")
+def _unit_normal(V, p, q, r):
+    """``flips._unit_normals`` of one triangle: cross(q - p, r - p) over its norm (at least TINY)."""
+    x0, x1, x2 = V[q, 0] - V[p, 0], V[q, 1] - V[p, 1], V[q, 2] - V[p, 2]
+    y0, y1, y2 = V[r, 0] - V[p, 0], V[r, 1] - V[p, 1], V[r, 2] - V[p, 2]
+    n0, n1, n2 = x1 * y2 - x2 * y1, x2 * y0 - x0 * y2, x0 * y1 - x1 * y0
+    g = _max(_norm(n0, n1, n2), TINY)
+    return n0 / g, n1 / g, n2 / g
+
+
+@nb.njit(cache=True, nogil=True)
+def _flip_pairs(V, a, b, c, d, old, gain, bend, max_sag):
+    P = a.shape[0]
+    new = np.empty(P)
+    ok = np.empty(P, np.bool_)
+    for k in range(P):
+        A, B, C, D = a[k], b[k], c[k], d[k]
+        x, y = _triangle_min(V, A, B, D), _triangle_min(V, A, D, C)
+        nw = math.nan if x != x or y != y else min(x, y)
+        new[k] = nw
+        p0, p1, p2 = _unit_normal(V, A, B, C)
+        q0, q1, q2 = _unit_normal(V, B, D, C)
+        r0, r1, r2 = _unit_normal(V, A, B, D)
+        s0, s1, s2 = _unit_normal(V, A, D, C)
+        e0, e1, e2 = p0 + q0, p1 + q1, p2 + q2
+        g = _max(_norm(e0, e1, e2), TINY)
+        e0, e1, e2 = e0 / g, e1 / g, e2 / g
+        w0 = 0.5 * (V[A, 0] + V[D, 0]) - 0.5 * (V[B, 0] + V[C, 0])
+        w1 = 0.5 * (V[A, 1] + V[D, 1]) - 0.5 * (V[B, 1] + V[C, 1])
+        w2 = 0.5 * (V[A, 2] + V[D, 2]) - 0.5 * (V[B, 2] + V[C, 2])
+        sag = abs(_dot(w0, w1, w2, e0, e1, e2))
+        ok[k] = (nw > old[k] + gain and _dot(p0, p1, p2, q0, q1, q2) >= bend
+                 and _dot(r0, r1, r2, s0, s1, s2) >= bend and _dot(r0, r1, r2, e0, e1, e2) >= bend
+                 and _dot(s0, s1, s2, e0, e1, e2) >= bend and sag <= max_sag and A != D)
+    return new, ok
+
+
+def flip_pairs(V: np.ndarray, a: np.ndarray, b: np.ndarray, c: np.ndarray, d: np.ndarray,
+               old: np.ndarray, gain: float, bend: float, max_sag: float) -> tuple[np.ndarray, np.ndarray]:
+    """The measures of :func:`ruledmesh.skew.pq.flips._pair_measures`, bit for bit.
+
+    Parameters
+    ----------
+    V : (n, 3) float64
+    a, b, c, d : (P,) int
+        Pairs of triangles ``(b, c, a)`` and ``(c, b, d)``; the flip makes ``(a, b, d)``, ``(a, d, c)``.
+    old : (P,) float64
+        The smaller smallest angle of each pair (degrees).
+    gain : float
+        Degrees the flip must gain.
+    bend : float
+        Cosine of the largest bend allowed between the normals.
+    max_sag : float
+        Largest height of the flipped pair over the old one.
+
+    Returns
+    -------
+    new : (P,) float64
+        The flipped pair's smaller smallest angle.
+    ok : (P,) bool
+        Whether the flip gains and keeps to the surface.
+    """
+    c_ = np.ascontiguousarray
+    return _flip_pairs(c_(V, dtype=np.float64), c_(a, dtype=np.int64), c_(b, dtype=np.int64),
+                       c_(c, dtype=np.int64), c_(d, dtype=np.int64), c_(old, dtype=np.float64),
+                       float(gain), float(bend), float(max_sag))

@@ -16,6 +16,8 @@ import math
 import numba as nb
 import numpy as np
 
+from .geometry import _angle
+
 __all__ = ["grid", "propagate"]
 
 
@@ -102,9 +104,32 @@ def _vertices(a, d, num, den, tmax):
     return X, t, far
 
 
+@nb.njit(cache=True)
+def _thin(X, i0, i1, i2, i3, thin_deg):
+    """``polygon_angles(X[[i0, i1, i2, i3]]).min() < thin_deg`` (a triangle when ``i3 < 0``).
+
+    The smallest angle is NaN, and so not below, when any angle is.
+    """
+    if i3 < 0:
+        a0, a1, a2 = _angle(X, i2, i0, i1), _angle(X, i0, i1, i2), _angle(X, i1, i2, i0)
+        a3 = a2
+    else:
+        a0, a1 = _angle(X, i3, i0, i1), _angle(X, i0, i1, i2)
+        a2, a3 = _angle(X, i1, i2, i3), _angle(X, i2, i3, i0)
+    if a0 != a0 or a1 != a1 or a2 != a2 or a3 != a3:
+        return False
+    return min(min(a0, a1), min(a2, a3)) < thin_deg
+
+
 @nb.njit(cache=True, nogil=True)
-def _faces(num, den, t, far, parity, Xc, first):
-    """Half-faces, poles, centre generators and convexity counts of the grid's faces."""
+def _faces(num, den, t, far, parity, Xc, first, X, thin_deg):
+    """Half-faces, poles, centre generators and failing counts of the grid's faces.
+
+    A face on the patch fails when its crossing misses its generator diagonal
+    (a bow-tie) or when it has an angle below ``thin_deg``; the notch halves
+    on the end generators count against the generator next to the end, as
+    :func:`ruledmesh.skew.pq.runs._failing_faces` counts them.
+    """
     m, H = num.shape
     per = max(H - 1, 0)
     F = m * per
@@ -144,14 +169,23 @@ def _faces(num, den, t, far, parity, Xc, first):
                       and not far[hi_v] and not far[(i - 1) * H + c] and not far[(i + 1) * H + c])
                 if on:
                     counted[i] += 1
-                    if not ((tc - t[lo_v]) * (tc - t[hi_v]) < 0.0):
+                    if not ((tc - t[lo_v]) * (tc - t[hi_v]) < 0.0) \
+                            or _thin(X, (i - 1) * H + c, lo_v, (i + 1) * H + c, hi_v, thin_deg):
                         failing[i] += 1
+            elif m >= 3:
+                # A notch half on an end generator: a triangle of the mesh.
+                side = 1 if i == 0 else -1
+                o = (i + side) * H + c
+                if not far[lo_v] and not far[hi_v] and not far[o] and t[lo_v] >= 0.0 and t[hi_v] <= 1.0:
+                    counted[i + side] += 1
+                    if _thin(X, lo_v, o, hi_v, -1, thin_deg):
+                        failing[i + side] += 1
             f += 1
     return left, right, pole, cg, failing, counted
 
 
 def grid(a: np.ndarray, d: np.ndarray, num: np.ndarray, den: np.ndarray, tmax: np.ndarray,
-         parity: np.ndarray, Xc: np.ndarray, first: int) -> tuple[np.ndarray, ...]:
+         parity: np.ndarray, Xc: np.ndarray, first: int, thin_deg: float) -> tuple[np.ndarray, ...]:
     """The arrays of :func:`ruledmesh.skew.pq.runs._grid` from the propagated rows, bit for bit.
 
     Parameters
@@ -168,6 +202,8 @@ def grid(a: np.ndarray, d: np.ndarray, num: np.ndarray, den: np.ndarray, tmax: n
         Crossing maps of the inner generators (any shape (0, 2, 2) when ``m < 3``).
     first : int
         Global index of the run's first generator.
+    thin_deg : float
+        A face with a smaller angle fails (:data:`~ruledmesh.tolerances.RESTART_ANGLE_DEG`).
 
     Returns
     -------
@@ -185,5 +221,6 @@ def grid(a: np.ndarray, d: np.ndarray, num: np.ndarray, den: np.ndarray, tmax: n
     if len(a) < 3:
         Xc = np.zeros((0, 2, 2))
     left, right, pole, cg, failing, counted = _faces(num, den, t, far, c(parity, dtype=np.int64),
-                                                    c(Xc, dtype=np.float64), int(first))
+                                                    c(Xc, dtype=np.float64), int(first), X,
+                                                    float(thin_deg))
     return X, t, far, left, right, pole, cg, failing, counted

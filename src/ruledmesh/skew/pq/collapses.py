@@ -25,7 +25,8 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..._arrays import cross
+from ..._arrays import cross, diagonal
+from ...analysis.faces import min_corner_angles
 from ...mesh import FaceKind, Mesh
 from ...tolerances import COLLAPSE_MAX_SAG, FLIP_MAX_BEND_DEG, FLIP_MIN_GAIN_DEG, RESTART_ANGLE_DEG, TINY
 from .flips import _member, _unit_normals
@@ -140,7 +141,7 @@ def _evaluate(V, tri, stars: _Stars, keys, faces_at, v, u, scale) -> tuple[np.nd
     new = old.copy()
     new[np.arange(face.size), corner] = u[rep]
     gone = (old == u[rep][:, None]).any(axis=1)          # the triangles on the edge u v
-    old_ang = _angles(V[old]).min(axis=1)
+    old_ang = min_corner_angles(V, old)
     old_min = np.full(C, 180.0)
     np.minimum.at(old_min, rep, old_ang)
     keep = ~gone
@@ -262,7 +263,7 @@ def collapse_splinters(mesh: Mesh, removable: np.ndarray | None = None) -> tuple
         tri = mesh.face_indices[mesh.face_offsets[ids][:, None] + np.arange(3)].astype(np.int64)
         if watch is not None:
             tri = tri[watch[tri].any(axis=1)]
-        thin = _angles(V[tri]).min(axis=1) < RESTART_ANGLE_DEG
+        thin = min_corner_angles(V, tri) < RESTART_ANGLE_DEG
         if not thin.any():
             break
         free = np.ones(n, bool) if removable is None else removable.copy()
@@ -286,7 +287,7 @@ def collapse_splinters(mesh: Mesh, removable: np.ndarray | None = None) -> tuple
         nval = near.valences
         tri = near.face_indices[near.face_offsets[np.flatnonzero(nval == 3)][:, None]
                                 + np.arange(3)].astype(np.int64)
-        scale = float(np.linalg.norm(V.max(axis=0) - V.min(axis=0))) or 1.0
+        scale = diagonal(V) or 1.0
         stars = _Stars(tri, keys, n)
         gain, ok = _evaluate(V, tri, stars, keys, np.bincount(mesh.face_indices, minlength=n), v, u, scale)
         ok &= gain > FLIP_MIN_GAIN_DEG

@@ -18,10 +18,12 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..._arrays import cross, unique
+from ..._arrays import cross, diagonal, unique
+from ...analysis.faces import min_corner_angles
+from ...kernels import wanted
 from ...mesh import FaceKind, Mesh
 from ...tolerances import FLIP_ACTIVE_DEG, FLIP_MAX_BEND_DEG, FLIP_MAX_SAG, FLIP_MIN_GAIN_DEG, TINY
-from .pairing import adjacent_triangles
+from .pairing import _adjacent
 
 __all__ = ["flip_triangles"]
 
@@ -58,43 +60,84 @@ def _ring(t1: np.ndarray, t2: np.ndarray, mark: np.ndarray) -> np.ndarray:
     return out
 
 
-def _round(V: np.ndarray, tri: np.ndarray, fixed: np.ndarray, scale: float,
-           changed: np.ndarray | None) -> np.ndarray:
+def _around(tri: np.ndarray, n: int, mark: np.ndarray, times: int) -> np.ndarray:
+    """(T,) bool: ``mark`` and the triangles ``times`` corner-sharing steps from a marked one.
+
+    A triangle sharing an edge with another shares a corner with it, so this
+    holds every triangle ``times`` edge-sharing steps away (and some more).
+    """
+    for _ in range(times):
+        hit = np.zeros(n, bool)
+        hit[tri[mark]] = True
+        mark = hit[tri[:, 0]] | hit[tri[:, 1]] | hit[tri[:, 2]]
+    return mark
+
+
+def _pair_measures(V: np.ndarray, a: np.ndarray, b: np.ndarray, c: np.ndarray, d: np.ndarray,
+                   old: np.ndarray, scale: float) -> tuple[np.ndarray, np.ndarray]:
+    """(P,) the flipped pairs' smaller smallest angle, and whether each flip may be taken.
+
+    Pairs of triangles ``(b, c, a)``, ``(c, b, d)`` with the smaller smallest
+    angle ``old``; a flip gains, and keeps to the surface (no fold, no ridge
+    cut off).  :func:`ruledmesh.kernels.geometry.flip_pairs` is the same, bit for bit.
+    """
+    bend = np.cos(np.radians(FLIP_MAX_BEND_DEG))
+    kern = wanted(len(a))
+    if kern is not None:
+        return kern.flip_pairs(V, a, b, c, d, old, FLIP_MIN_GAIN_DEG, bend, FLIP_MAX_SAG * scale)
+    A, B, C, D = V[a], V[b], V[c], V[d]
+    new = np.minimum(_angles(np.stack([A, B, D], 1)), _angles(np.stack([A, D, C], 1)))
+    n1, n2 = _unit_normals(A, B, C), _unit_normals(B, D, C)
+    m1, m2 = _unit_normals(A, B, D), _unit_normals(A, D, C)
+    mean = n1 + n2
+    mean /= np.maximum(np.linalg.norm(mean, axis=1, keepdims=True), TINY)
+    # The flipped pair's height over the old one: how far the surface moves.
+    sag = np.abs(np.einsum("ij,ij->i", 0.5 * (A + D) - 0.5 * (B + C), mean))
+    ok = (new > old + FLIP_MIN_GAIN_DEG) & (np.einsum("ij,ij->i", n1, n2) >= bend) \
+        & (np.einsum("ij,ij->i", m1, m2) >= bend) & (np.einsum("ij,ij->i", m1, mean) >= bend) \
+        & (np.einsum("ij,ij->i", m2, mean) >= bend) & (sag <= FLIP_MAX_SAG * scale) & (a != d)
+    return new, ok
+
+
+def _round(V: np.ndarray, tri: np.ndarray, tmin: np.ndarray, fixed: np.ndarray, scale: float,
+           changed: np.ndarray | None, adjacency: tuple | None = None) -> np.ndarray:
     """One round of mutual-best flips on ``tri`` (in place); (T,) bool, the triangles it changed.
 
-    ``fixed`` holds the sorted edge keys of every other face (quads, triangles
-    left out of the rounds): a flip may not make one of those edges again.
+    ``tmin`` (T,) holds the smallest angle of each triangle of ``tri`` and is
+    kept up to date (in place).  ``fixed`` holds the sorted edge keys of every
+    other face (quads, triangles left out of the rounds): a flip may not make
+    one of those edges again.
     ``changed`` marks the triangles the previous round changed (None: the
     first round).  Only pairs near them can have gained or lost their best
     choice, so the round weighs the pairs touching them, their neighbours and
     the neighbours' neighbours (every pair of a triangle whose choice may have
     changed, so each such triangle's best is exact), and takes only pairs with
     a triangle that changed or borders one: the flips every pair would give.
+    ``adjacency``: the first round's ``pairing._adjacent(tri, n)`` if known
+    (its keys may hold edges of ``fixed`` too).
     """
     n = len(V)
-    t1, t2, a, b, c, d = adjacent_triangles(tri, n)
     done = np.zeros(len(tri), bool)
+    near: np.ndarray | None = None
+    if changed is None:
+        t1, t2, a, b, c, d, keys = _adjacent(tri, n) if adjacency is None else adjacency
+    else:
+        # Every pair weighed, and every edge a taken flip could make again, lies
+        # among the triangles three corner-sharing steps from a change: the
+        # adjacency of those (rows in order, so pairs come in the same order and
+        # with the same sides) is the whole mesh's there.
+        rows = np.flatnonzero(_around(tri, n, changed, 3))
+        t1, t2, a, b, c, d, keys = _adjacent(tri[rows], n)
+        t1, t2 = rows[t1], rows[t2]
     if t1.size == 0:
         return done
-    near: np.ndarray | None = None
     if changed is not None:
         near = _ring(t1, t2, changed)              # choices that may have changed
         weigh = _ring(t1, t2, near)                # their partners: exact best choices
         sel = np.flatnonzero(weigh[t1] | weigh[t2])
         t1, t2, a, b, c, d = t1[sel], t2[sel], a[sel], b[sel], c[sel], d[sel]
-    A, B, C, D = V[a], V[b], V[c], V[d]
-    old = np.minimum(_angles(V[tri[t1]]), _angles(V[tri[t2]]))
-    new = np.minimum(_angles(np.stack([A, B, D], 1)), _angles(np.stack([A, D, C], 1)))
-    n1, n2 = _unit_normals(A, B, C), _unit_normals(B, D, C)
-    m1, m2 = _unit_normals(A, B, D), _unit_normals(A, D, C)
-    mean = n1 + n2
-    mean /= np.maximum(np.linalg.norm(mean, axis=1, keepdims=True), TINY)
-    bend = np.cos(np.radians(FLIP_MAX_BEND_DEG))
-    # The flipped pair's height over the old one: how far the surface moves.
-    sag = np.abs(np.einsum("ij,ij->i", 0.5 * (A + D) - 0.5 * (B + C), mean))
-    ok = (new > old + FLIP_MIN_GAIN_DEG) & (np.einsum("ij,ij->i", n1, n2) >= bend) \
-        & (np.einsum("ij,ij->i", m1, m2) >= bend) & (np.einsum("ij,ij->i", m1, mean) >= bend) \
-        & (np.einsum("ij,ij->i", m2, mean) >= bend) & (sag <= FLIP_MAX_SAG * scale) & (a != d)
+    old = np.minimum(tmin[t1], tmin[t2])
+    new, ok = _pair_measures(V, a, b, c, d, old, scale)
     if near is not None:
         # Pairs away from every change keep the choice they had: not taken then, nor now.
         ok &= near[t1] | near[t2]
@@ -102,7 +145,7 @@ def _round(V: np.ndarray, tri: np.ndarray, fixed: np.ndarray, scale: float,
         return done
     # The new diagonal must not be an edge already (it would join three faces).
     new_key = np.minimum(a, d) * n + np.maximum(a, d)
-    ok &= ~(_member(new_key, fixed) | _member(new_key, _edge_keys([tri], n)))
+    ok &= ~(_member(new_key, fixed) | _member(np.minimum(a, d) * (n + 1) + np.maximum(a, d), keys))
     cand = np.flatnonzero(ok)
     if cand.size == 0:
         return done
@@ -121,6 +164,7 @@ def _round(V: np.ndarray, tri: np.ndarray, fixed: np.ndarray, scale: float,
     tri[t1[take]] = np.stack([a[take], b[take], d[take]], axis=1)
     tri[t2[take]] = np.stack([a[take], d[take], c[take]], axis=1)
     done[t1[take]] = done[t2[take]] = True
+    tmin[done] = min_corner_angles(V, tri[done])
     return done
 
 
@@ -132,16 +176,20 @@ def _member(keys: np.ndarray, sorted_keys: np.ndarray) -> np.ndarray:
     return sorted_keys[pos] == keys
 
 
-def _active(V: np.ndarray, tri: np.ndarray) -> np.ndarray:
-    """(T,) bool: triangles thinner than :data:`FLIP_ACTIVE_DEG` and their edge neighbours.
+def _active(V: np.ndarray, tri: np.ndarray) -> tuple[np.ndarray, np.ndarray, tuple | None]:
+    """(T,) bool: triangles thinner than :data:`FLIP_ACTIVE_DEG` and their edge neighbours;
+    (T,) the smallest angle of every triangle; the adjacency of the marked ones
+    (as ``pairing._adjacent`` of ``tri[marked]``, its keys those of all ``tri``), or None.
 
     Only these take part in the rounds: a flip between two fat triangles gains
     little, and most of a large mesh's triangles are fat.
     """
-    thin = _angles(V[tri]) < FLIP_ACTIVE_DEG
+    ang = min_corner_angles(V, tri)
+    thin = ang < FLIP_ACTIVE_DEG
     if not thin.any():
-        return thin
-    t1, t2, *_ = adjacent_triangles(tri, len(V))
+        return thin, ang, None
+    adjacency = _adjacent(tri, len(V))
+    t1, t2 = adjacency[:2]
     near = thin.copy()
     near[t2[thin[t1]]] = True
     near[t1[thin[t2]]] = True
@@ -149,7 +197,21 @@ def _active(V: np.ndarray, tri: np.ndarray) -> np.ndarray:
     out = near.copy()
     out[t2[near[t1]]] = True
     out[t1[near[t2]]] = True
-    return out
+    return out, ang, _restricted(adjacency, out)
+
+
+def _restricted(adjacency: tuple, live: np.ndarray) -> tuple | None:
+    """The pairs of ``adjacency`` between ``live`` triangles, rows renumbered among those.
+
+    They are the live triangles' own pairs, in the same order, when no edge has
+    three triangles or more (else two live ones could share one): None then.
+    """
+    t1, t2, a, b, c, d, keys = adjacency
+    if keys.size > 2 and bool((keys[2:] == keys[:-2]).any()):
+        return None
+    keep = np.flatnonzero(live[t1] & live[t2])
+    rank = np.cumsum(live) - 1
+    return rank[t1[keep]], rank[t2[keep]], a[keep], b[keep], c[keep], d[keep], keys
 
 
 def flip_triangles(mesh: Mesh, changeable: np.ndarray | None = None) -> tuple[Mesh, int]:
@@ -176,12 +238,13 @@ def flip_triangles(mesh: Mesh, changeable: np.ndarray | None = None) -> tuple[Me
         return mesh, 0
     V = mesh.vertices
     n = len(V)
-    scale = float(np.linalg.norm(V.max(axis=0) - V.min(axis=0))) or 1.0
+    scale = diagonal(V) or 1.0
     ids = np.flatnonzero(is_tri)
     tri_all = mesh.face_indices[mesh.face_offsets[ids][:, None] + np.arange(3)].astype(np.int64)
-    live = _active(V, tri_all)
-    if changeable is not None:
+    live, ang, adjacency = _active(V, tri_all)
+    if changeable is not None and not changeable[ids].all():
         live &= changeable[ids]
+        adjacency = None        # the rounds find the pairs among the triangles left
     if not live.any():
         return mesh, 0
     others = [tri_all[~live]]
@@ -190,11 +253,12 @@ def flip_triangles(mesh: Mesh, changeable: np.ndarray | None = None) -> tuple[Me
         others.append(mesh.face_indices[mesh.face_offsets[f][:, None] + np.arange(k)])
     fixed = _edge_keys(others, n)
     tri = tri_all[live]
+    tmin = ang[live]
     before = tri.copy()
     flips = 0
     changed = None
     for _ in range(_ROUNDS):
-        changed = _round(V, tri, fixed, scale, changed)
+        changed = _round(V, tri, tmin, fixed, scale, changed, adjacency)
         made = int(changed.sum()) // 2
         flips += made
         if made == 0:

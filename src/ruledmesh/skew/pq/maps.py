@@ -20,10 +20,12 @@ from ...tolerances import TINY
 
 __all__ = [
     "ChainMaps",
+    "HopMaps",
     "apply",
     "chain_maps",
     "compose",
     "drift_maps",
+    "hop_maps",
     "inverse",
     "patch_preimage",
     "propagate",
@@ -50,14 +52,46 @@ def unit_det(H: np.ndarray) -> np.ndarray:
     return H / scale[:, None, None]
 
 
-def chain_maps(a: np.ndarray, d: np.ndarray, primary: int) -> ChainMaps:
-    """Landing maps in both directions and the crossing map that roots chain *b*."""
+@dataclass(frozen=True)
+class HopMaps:
+    """The maps of the hops between consecutive generators, measured once for every run.
+
+    Runs restart on the same generators several times; each hop's maps depend
+    on its three generators only, so a run takes its rows of these (the same
+    numbers as measuring its own).
+    """
+
+    fwd: np.ndarray         # (m-2, 2, 2) g_k -> g_k+2, |det| = 1
+    bwd: np.ndarray         # (m-2, 2, 2) g_k+2 -> g_k, |det| = 1
+    crossing: np.ndarray    # (m-2, 2, 2) g_k -> g_k+1 (crossing_maps), not scaled
+
+    def part(self, first: int, m: int) -> HopMaps:
+        """The maps of the run of the ``m`` generators from ``first``."""
+        sl = slice(first, first + max(m - 2, 0))
+        return HopMaps(self.fwd[sl], self.bwd[sl], self.crossing[sl])
+
+
+def _landing(a: np.ndarray, d: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Landing maps of consecutive generators, forwards and backwards, scaled to |det| = 1."""
+    return (unit_det(landing_maps(a[:-2], d[:-2], a[1:-1], d[1:-1], a[2:], d[2:])),
+            unit_det(landing_maps(a[2:], d[2:], a[1:-1], d[1:-1], a[:-2], d[:-2])))
+
+
+def hop_maps(a: np.ndarray, d: np.ndarray) -> HopMaps:
+    """The :class:`HopMaps` of generators ``a``, ``d`` (m, 3)."""
+    return HopMaps(*_landing(a, d), crossing_maps(a[:-2], d[:-2], a[1:-1], d[1:-1], a[2:], d[2:]))
+
+
+def chain_maps(a: np.ndarray, d: np.ndarray, primary: int, hops: HopMaps | None = None) -> ChainMaps:
+    """Landing maps in both directions and the crossing map that roots chain *b*.
+
+    ``hops``: the run's own :class:`HopMaps` (``HopMaps.part``), if measured already.
+    """
     m = len(a)
     if primary + 2 >= m and primary - 2 < 0:
         # Three generators with the primary in the middle: no hop starts there.
         primary = 0
-    fwd = unit_det(landing_maps(a[:-2], d[:-2], a[1:-1], d[1:-1], a[2:], d[2:]))
-    bwd = unit_det(landing_maps(a[2:], d[2:], a[1:-1], d[1:-1], a[:-2], d[:-2]))
+    fwd, bwd = _landing(a, d) if hops is None else (hops.fwd, hops.bwd)
     # Chain b starts where chain a's first hop crosses the neighbour (towards the longer side).
     root = primary + 1 if primary + 2 < m else primary - 1
     far = root + 1 if root > primary else root - 1
@@ -130,7 +164,7 @@ def inverse(M: np.ndarray) -> np.ndarray:
     return out
 
 
-def drift_maps(a: np.ndarray, d: np.ndarray, M: np.ndarray) -> np.ndarray:
+def drift_maps(a: np.ndarray, d: np.ndarray, M: np.ndarray, X: np.ndarray | None = None) -> np.ndarray:
     """How far the two chains have drifted apart, generator by generator.
 
     For a face centred on ``g_i`` the hop line of its row (from ``g_i-1`` to
@@ -144,6 +178,8 @@ def drift_maps(a: np.ndarray, d: np.ndarray, M: np.ndarray) -> np.ndarray:
     a, d : (m, 3) float64
     M : (m, 2, 2) float64
         Composed row maps (:func:`compose`).
+    X : (m-2, 2, 2) float64, optional
+        The crossing maps of the inner generators (``HopMaps.crossing``), if measured already.
 
     Returns
     -------
@@ -154,7 +190,8 @@ def drift_maps(a: np.ndarray, d: np.ndarray, M: np.ndarray) -> np.ndarray:
     N = np.tile(np.eye(2), (m, 1, 1))
     if m < 3:
         return N
-    X = crossing_maps(a[:-2], d[:-2], a[1:-1], d[1:-1], a[2:], d[2:])
+    if X is None:
+        X = crossing_maps(a[:-2], d[:-2], a[1:-1], d[1:-1], a[2:], d[2:])
     inner = np.einsum("kij,kjl->kil", inverse(M[1:-1]), np.einsum("kij,kjl->kil", X, M[:-2]))
     N[1:-1] = inner / np.maximum(np.abs(inner).max(axis=(1, 2)), TINY)[:, None, None]
     return N

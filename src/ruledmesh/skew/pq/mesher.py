@@ -16,6 +16,7 @@ from ...tolerances import DEFAULT, PARAMETER_SLACK, Tolerances
 from .assemble import assemble
 from .collapses import collapse_splinters
 from .flips import flip_triangles
+from .maps import HopMaps, hop_maps
 from .pairing import pair_triangles
 from .runs import (
     BYTES_PER_GRID_POINT,
@@ -87,6 +88,7 @@ class _Plan:
     scale: float
     warnings: list
     crease_generators: frozenset = frozenset()
+    hops: HopMaps | None = None     # of all the generators: each run takes its part
 
 
 def _cut_at(run: Run, primary: int, m: int) -> tuple[int | None, int | None]:
@@ -133,7 +135,8 @@ def _build_segment(plan: _Plan, lo: int, hi: int, primary: int, div: Division,
     if hi - lo + 1 < 3:
         t = div.matched if div.matched is not None and len(div.matched) else _uniform_t(div.rows)
         return [carrier(a[lo:hi + 1], d[lo:hi + 1], lo, t)]
-    run = mesh_run(a[lo:hi + 1], d[lo:hi + 1], lo, primary, div, plan.tol, plan.scale, plan.warnings)
+    run = mesh_run(a[lo:hi + 1], d[lo:hi + 1], lo, primary, div, plan.tol, plan.scale, plan.warnings,
+                   plan.hops)
     m = hi - lo + 1
     if shared is None and _hopeless(run, _NO_ROWS_SHARE):
         # Most faces would be bow-ties or slivers: from the best-twisted primary if
@@ -158,7 +161,7 @@ def _build_segment(plan: _Plan, lo: int, hi: int, primary: int, div: Division,
         k = primary + outward * reach
         r0, r1 = (lo, lo + k) if shared == lo else (lo + k, hi)
         run = mesh_run(a[r0:r1 + 1], d[r0:r1 + 1], r0, primary - (r0 - lo), div, plan.tol, plan.scale,
-                       plan.warnings)
+                       plan.warnings, plan.hops)
         rest = _even(plan, r1 + 1, hi, div.rows) if shared == lo else _even(plan, lo, r0 - 1, div.rows)
         return [run] + rest
     right, left = _cut_at(run, primary, m) if budget[0] > 0 and m >= 2 * _MIN_RUN else (None, None)
@@ -168,7 +171,7 @@ def _build_segment(plan: _Plan, lo: int, hi: int, primary: int, div: Division,
     new_lo = lo + (left if left is not None else 0)
     new_hi = lo + (right if right is not None else m - 1)
     run = mesh_run(a[new_lo:new_hi + 1], d[new_lo:new_hi + 1], new_lo, primary - (new_lo - lo), div,
-                   plan.tol, plan.scale, plan.warnings)
+                   plan.tol, plan.scale, plan.warnings, plan.hops)
     runs = [run]
     if right is not None:
         matched = Division(div.rows, div.option, "auto", div.max_extend, run.inside_t(new_hi))
@@ -349,7 +352,7 @@ def pq_mesh(a, b, rows: int = 20, primary: int | str = "middle", option: int = 0
     a, d, creases, crease_generators = _keep(kept, a, d, creases, crease_generators)
     m = len(a)
     flat, torsal, cg, segs = _cut(a, d, rows, ptol, scale, tol, creases, crease_generators, warnings)
-    plan = _Plan(a, d, tol, scale, warnings, frozenset(cg.tolist()))
+    plan = _Plan(a, d, tol, scale, warnings, frozenset(cg.tolist()), hop_maps(a, d))
     primary = int(np.searchsorted(kept, args.primary, side="right") - 1)
     parts = _build_all(plan, segs, primary, args.middle,
                        Division(rows, args.option, args.extend, args.max_extend), m)
@@ -585,11 +588,15 @@ def _warn_splinters(mesh: Mesh, warnings: list[str], torsal: np.ndarray) -> None
     bad = np.flatnonzero(ang < SPLINTER_DEG)
     if bad.size == 0:
         return
-    gen = np.asarray(mesh.vertex_data["generator"])[mesh.face_indices]
-    t = np.asarray(mesh.vertex_data["t"])[mesh.face_indices]
-    g0 = np.minimum.reduceat(gen, mesh.face_offsets[:-1])[bad]
-    t_lo = np.minimum.reduceat(t, mesh.face_offsets[:-1])[bad]
-    t_hi = np.maximum.reduceat(t, mesh.face_offsets[:-1])[bad]
+    # The corners of the splinters only (a large mesh has few).
+    val = mesh.valences[bad]
+    starts = np.cumsum(val) - val
+    corners = mesh.face_indices[np.repeat(mesh.face_offsets[bad] - starts, val) + np.arange(int(val.sum()))]
+    gen = np.asarray(mesh.vertex_data["generator"])[corners]
+    t = np.asarray(mesh.vertex_data["t"])[corners]
+    g0 = np.minimum.reduceat(gen, starts)
+    t_lo = np.minimum.reduceat(t, starts)
+    t_hi = np.maximum.reduceat(t, starts)
     near_torsal = np.zeros(bad.size, bool)
     for k in torsal.tolist():
         near_torsal |= np.abs(g0 - k) <= 2

@@ -43,6 +43,11 @@ def adjacent_triangles(tri: np.ndarray, n: int):
         Rows of the two triangles, ``t1 = (b, c, a)`` and ``t2 = (c, b, d)``:
         ``b c`` is the shared edge, ``a`` and ``d`` the corners opposite it.
     """
+    return _adjacent(tri, n)[:6]
+
+
+def _adjacent(tri: np.ndarray, n: int):
+    """:func:`adjacent_triangles`, and the (3T,) sorted edge keys ``lo * (n + 1) + hi`` (repeats kept)."""
     e_from = tri.reshape(-1)
     e_to = np.roll(tri, -1, axis=1).reshape(-1)
     key = np.minimum(e_from, e_to) * (n + 1) + np.maximum(e_from, e_to)
@@ -57,7 +62,7 @@ def adjacent_triangles(tri: np.ndarray, n: int):
     s1, s2 = s1[ok], s2[ok]
     t1, j1, t2, j2 = s1 // 3, s1 % 3, s2 // 3, s2 % 3
     return (t1, t2, tri[t1, (j1 + 2) % 3], tri[t1, j1], tri[t1, (j1 + 1) % 3],
-            tri[t2, (j2 + 2) % 3])
+            tri[t2, (j2 + 2) % 3], ks)
 
 
 def pair_triangles(mesh: Mesh, ptol: float, kinds: tuple[int, ...] | None = None) -> tuple[Mesh, int]:

@@ -22,15 +22,16 @@ import numpy as np
 
 from ...budget import MAX_GRID_POINTS, PQ_BYTES_PER_GRID_POINT
 from ...errors import GeometryError
-from ...hop import crossing_maps
 from ...kernels import wanted
 from ...tolerances import INTERIOR, RESTART_ANGLE_DEG, ROUNDING, TINY, Tolerances
 from .maps import (
     ChainMaps,
+    HopMaps,
     apply,
     chain_maps,
     compose,
     drift_maps,
+    hop_maps,
     inverse,
     patch_preimage,
     propagate,
@@ -195,7 +196,7 @@ def _root_b_rows(M: np.ndarray, N: np.ndarray, tau: np.ndarray, primary: int,
 
 
 def mesh_run(a: np.ndarray, d: np.ndarray, first: int, primary: int, div: Division,
-             tol: Tolerances, scale: float, warnings: list[str]) -> Run:
+             tol: Tolerances, scale: float, warnings: list[str], hops: HopMaps | None = None) -> Run:
     """Checkerboard PQ grid on generators a, d (a run), before trimming.
 
     Parameters
@@ -212,9 +213,13 @@ def mesh_run(a: np.ndarray, d: np.ndarray, first: int, primary: int, div: Divisi
         Patch diagonal.
     warnings : list of str
         Appended to.
+    hops : HopMaps, optional
+        The hop maps of all the generators that ``a``, ``d`` are a run of
+        (from index ``first``), if measured already.
     """
     m = len(a)
-    maps = chain_maps(a, d, primary)
+    hops = hops.part(first, m) if hops is not None else hop_maps(a, d)
+    maps = chain_maps(a, d, primary, hops)
     primary = maps.primary
     M = compose(maps, m)
     if div.matched is not None and len(div.matched):
@@ -227,13 +232,13 @@ def mesh_run(a: np.ndarray, d: np.ndarray, first: int, primary: int, div: Divisi
         raise GeometryError(f"the grid would have {m} x {2 * H} points (about {need:.1f} GiB); "
                             f"reduce the generator count, the rows or the extension")
     parity = (np.arange(m) - primary) % 2                     # 0: chain a, 1: chain b
-    N = drift_maps(a, d, M)
+    N = drift_maps(a, d, M, hops.crossing)
     tau = _root_b_rows(M, N, tau, primary, parity)
-    return _grid(a, d, first, maps, tau, parity, tol, scale)
+    return _grid(a, d, first, maps, tau, parity, tol, scale, hops.crossing)
 
 
 def _grid(a: np.ndarray, d: np.ndarray, first: int, maps: ChainMaps, tau: np.ndarray,
-          parity: np.ndarray, tol: Tolerances, scale: float) -> Run:
+          parity: np.ndarray, tol: Tolerances, scale: float, Xc: np.ndarray) -> Run:
     """Vertices and half-faces of a run from its rows' root parameters."""
     m = len(a)
     H = len(tau) // 2
@@ -244,14 +249,8 @@ def _grid(a: np.ndarray, d: np.ndarray, first: int, maps: ChainMaps, tau: np.nda
     if kern is not None:
         # One pass per stage, the same arithmetic (ruledmesh.kernels.grid).
         num, den = kern.propagate(maps.primary, maps.root, maps.fwd, maps.bwd, maps.crossing, roots)
-        Xc = crossing_maps(a[:-2], d[:-2], a[1:-1], d[1:-1], a[2:], d[2:]) if m >= 3 else None
-        X, t, far, left, right, pole, cg, _, _ = kern.grid(a, d, num, den, tmax, parity, Xc, first)
-        # The kernel counts bow-ties only; slivers count as failing too (numpy, as below).
-        ic = cg - first
-        hc = np.where(left[:, 0] >= 0, left[:, 0], right[:, 1]) % H
-        hl = np.where(left[:, 1] >= 0, left[:, 1], right[:, 0]) % H
-        failing, on_patch = _failing_faces(a, d, t.reshape(m, H), far.reshape(m, H), ic, hl, hc,
-                                           pole, m)
+        X, t, far, left, right, pole, cg, failing, on_patch = kern.grid(
+            a, d, num, den, tmax, parity, Xc, first, RESTART_ANGLE_DEG)
         gen = np.repeat(np.arange(first, first + m), H)
         return Run(X, t, gen, far, left, right, pole, cg, failing, on_patch)
     num, den = propagate(maps, roots)
@@ -279,24 +278,24 @@ def _grid(a: np.ndarray, d: np.ndarray, first: int, maps: ChainMaps, tau: np.nda
     # different generators are not comparable: M and -M are the same map.)
     sg = np.signbit(den)
     pole = sg[ic, hl] != sg[ic, hl + 1]
-    failing, on_patch = _failing_faces(a, d, t, far, ic, hl, hc, pole, m)
+    failing, on_patch = _failing_faces(a, d, t, far, ic, hl, hc, pole, m, Xc)
     gen = np.repeat(np.arange(first, first + m), H)
     return Run(X.reshape(-1, 3), t.reshape(-1), gen, far.reshape(-1), left, right, pole,
                ic + first, failing, on_patch)
 
 
-def _failing_faces(a, d, t, far, ic, hl, hc, pole, m) -> tuple[np.ndarray, np.ndarray]:
+def _failing_faces(a, d, t, far, ic, hl, hc, pole, m, X) -> tuple[np.ndarray, np.ndarray]:
     """Per generator: faces centred on it on the patch that fail, and all on the patch.
 
     A face fails when its crossing misses its generator diagonal (a bow-tie) or
-    when it is a sliver (:func:`_thin`).
+    when it is a sliver (:func:`_thin`).  ``X`` (m-2, 2, 2): the crossing maps of
+    the inner generators.
     """
     inner = (ic > 0) & (ic < m - 1)
     failing = np.zeros(m, np.int64)
     counted = np.zeros(m, np.int64)
     if m < 3 or not inner.any():
         return failing, counted
-    X = crossing_maps(a[:-2], d[:-2], a[1:-1], d[1:-1], a[2:], d[2:])
     i, lo, c = ic[inner], hl[inner], hc[inner]
     ts = t[i - 1, c]
     k = i - 1
