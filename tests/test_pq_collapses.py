@@ -91,7 +91,7 @@ def check(before, after, removed):
     d = (B - A) / np.linalg.norm(B - A, axis=1, keepdims=True)
     for end in after.members.T:
         off = Va[end] - A
-        assert np.abs(off - np.einsum("ij,ij->i", off, d)[:, None] * d).max() <= 1e-9 * scale
+        assert np.abs(off - np.einsum("ij,ij->i", off, d)[:, None] * d).max(initial=0.0) <= 1e-9 * scale
     assert np.all(after.members[:, 0] != after.members[:, 1])
     assert len(after.members) >= len(before.members) - removed
 

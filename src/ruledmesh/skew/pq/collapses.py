@@ -232,7 +232,8 @@ def _apply(mesh: Mesh, v: np.ndarray, u: np.ndarray) -> tuple[Mesh, np.ndarray]:
     return out.compact(), np.cumsum(~removed) - 1
 
 
-def collapse_splinters(mesh: Mesh, removable: np.ndarray | None = None) -> tuple[Mesh, int]:
+def collapse_splinters(mesh: Mesh, removable: np.ndarray | None = None,
+                       scale: float | None = None) -> tuple[Mesh, int]:
     """Remove triangle-only vertices of splinters where that fattens the faces around them.
 
     Parameters
@@ -242,6 +243,9 @@ def collapse_splinters(mesh: Mesh, removable: np.ndarray | None = None) -> tuple
         change.
     removable : (V,) bool, optional
         The vertices that may go (default: every vertex only triangles use).
+    scale : float, optional
+        Length the sag bound is relative to (default: the mesh's bounding-box
+        diagonal; a part of a mesh passes the whole one's).
 
     Returns
     -------
@@ -287,9 +291,9 @@ def collapse_splinters(mesh: Mesh, removable: np.ndarray | None = None) -> tuple
         nval = near.valences
         tri = near.face_indices[near.face_offsets[np.flatnonzero(nval == 3)][:, None]
                                 + np.arange(3)].astype(np.int64)
-        scale = diagonal(V) or 1.0
+        size = scale or diagonal(V) or 1.0
         stars = _Stars(tri, keys, n)
-        gain, ok = _evaluate(V, tri, stars, keys, np.bincount(mesh.face_indices, minlength=n), v, u, scale)
+        gain, ok = _evaluate(V, tri, stars, keys, np.bincount(mesh.face_indices, minlength=n), v, u, size)
         ok &= gain > FLIP_MIN_GAIN_DEG
         if not ok.any():
             break

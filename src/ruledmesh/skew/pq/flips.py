@@ -214,7 +214,8 @@ def _restricted(adjacency: tuple, live: np.ndarray) -> tuple | None:
     return rank[t1[keep]], rank[t2[keep]], a[keep], b[keep], c[keep], d[keep], keys
 
 
-def flip_triangles(mesh: Mesh, changeable: np.ndarray | None = None) -> tuple[Mesh, int]:
+def flip_triangles(mesh: Mesh, changeable: np.ndarray | None = None,
+                   scale: float | None = None) -> tuple[Mesh, int]:
     """Re-cut pairs of adjacent triangles for a larger smallest angle.
 
     Parameters
@@ -223,6 +224,9 @@ def flip_triangles(mesh: Mesh, changeable: np.ndarray | None = None) -> tuple[Me
         Any polygon mesh; only its triangles are changed.
     changeable : (F,) bool, optional
         The faces that may change (default: every triangle).
+    scale : float, optional
+        Length the sag bound is relative to (default: the mesh's bounding-box
+        diagonal; a part of a mesh passes the whole one's).
 
     Returns
     -------
@@ -238,7 +242,7 @@ def flip_triangles(mesh: Mesh, changeable: np.ndarray | None = None) -> tuple[Me
         return mesh, 0
     V = mesh.vertices
     n = len(V)
-    scale = diagonal(V) or 1.0
+    scale = scale or diagonal(V) or 1.0
     ids = np.flatnonzero(is_tri)
     tri_all = mesh.face_indices[mesh.face_offsets[ids][:, None] + np.arange(3)].astype(np.int64)
     live, ang, adjacency = _active(V, tri_all)

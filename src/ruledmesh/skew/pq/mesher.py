@@ -412,20 +412,21 @@ def _fattened(mesh: Mesh, ptol: float, tol: Tolerances) -> tuple[Mesh, dict[str,
                   "opened": opened}
 
 
-def _reflipped(mesh: Mesh, frozen: np.ndarray) -> Mesh:
+def _reflipped(mesh: Mesh, frozen: np.ndarray, scale: float) -> Mesh:
     """Flips, collapses and flips again on an opened region of splinters.
 
     ``frozen`` (V,) bool marks, by ``vertex_data["_id"]``, the vertices that faces
-    outside the region also have: faces at them stay, and they stay.
+    outside the region also have: faces at them stay, and they stay.  ``scale``
+    is the whole mesh's diagonal, which the sag bounds are relative to.
     """
     def changeable(m: Mesh) -> np.ndarray:
         at = frozen[np.asarray(m.vertex_data["_id"])][m.face_indices]
         return np.bincount(np.repeat(np.arange(m.n_faces), m.valences)[at], minlength=m.n_faces) == 0
 
-    mesh, _ = flip_triangles(mesh, changeable(mesh))
-    mesh, collapsed = collapse_splinters(mesh, ~frozen[np.asarray(mesh.vertex_data["_id"])])
+    mesh, _ = flip_triangles(mesh, changeable(mesh), scale)
+    mesh, collapsed = collapse_splinters(mesh, ~frozen[np.asarray(mesh.vertex_data["_id"])], scale)
     if collapsed:
-        mesh, _ = flip_triangles(mesh, changeable(mesh))
+        mesh, _ = flip_triangles(mesh, changeable(mesh), scale)
     return mesh
 
 

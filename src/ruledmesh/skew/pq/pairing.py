@@ -87,7 +87,7 @@ def pair_triangles(mesh: Mesh, ptol: float, kinds: tuple[int, ...] | None = None
     int
         Number of quads made.
     """
-    from ...analysis.faces import SPLINTER_DEG, polygon_angles, quad_diagonal_crossing, quad_planarity
+    from ...analysis.faces import SPLINTER_DEG, min_corner_angles, quad_diagonal_crossing, quad_planarity
 
     if kinds is None:
         kinds = (FaceKind.FILL, FaceKind.BORDER, FaceKind.SPLIT)
@@ -101,11 +101,16 @@ def pair_triangles(mesh: Mesh, ptol: float, kinds: tuple[int, ...] | None = None
     quad = np.stack([a, b, d, c], axis=1)
     if t1.size == 0:
         return mesh, 0
+    # The planarity first: in exact mode few pairs pass, and only those are measured further.
+    flat = quad_planarity(V[quad]) <= ptol
+    t1, t2, quad = t1[flat], t2[flat], quad[flat]
     P = V[quad]
     sq, tq, _ = quad_diagonal_crossing(P)
-    ang = polygon_angles(P).min(axis=1)
-    tri_min = polygon_angles(V[tri]).min(axis=1)
-    ok = (quad_planarity(P) <= ptol) & (sq > _MIN_CROSSING) & (sq < 1 - _MIN_CROSSING) \
+    ang = min_corner_angles(V, quad)
+    tri_min = np.zeros(len(tri))
+    near = np.unique(np.concatenate([t1, t2]))
+    tri_min[near] = min_corner_angles(V, tri[near])
+    ok = (sq > _MIN_CROSSING) & (sq < 1 - _MIN_CROSSING) \
         & (tq > _MIN_CROSSING) & (tq < 1 - _MIN_CROSSING) \
         & (ang >= np.minimum(tri_min[t1], tri_min[t2])) & (ang >= SPLINTER_DEG)
     t1, t2, quad, score = t1[ok], t2[ok], quad[ok], ang[ok]

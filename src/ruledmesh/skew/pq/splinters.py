@@ -26,10 +26,11 @@ from dataclasses import replace
 
 import numpy as np
 
+from ..._arrays import diagonal
 from ...analysis.faces import face_min_angles
 from ...mesh import FaceKind, Mesh
 from ...tolerances import ON_BORDER, RESTART_ANGLE_DEG, SPLINTER_AREA_WORTH
-from .collapses import _apply
+from .collapses import _apply, _rejoined
 from .pairing import _rebuilt
 
 __all__ = ["open_walled_splinters", "snap_to_border"]
@@ -114,11 +115,11 @@ def snap_to_border(mesh: Mesh) -> tuple[Mesh, int]:
 
 def _triangle_min_angles(mesh: Mesh) -> np.ndarray:
     """(F,) smallest corner angle of the triangles, degrees (180 for other faces)."""
-    from ...analysis.faces import polygon_angles
+    from ...analysis.faces import min_corner_angles
 
     out = np.full(mesh.n_faces, 180.0)
     f, F = mesh.faces_of_valence(3)
-    out[f] = polygon_angles(mesh.vertices[F]).min(axis=1)
+    out[f] = min_corner_angles(mesh.vertices, F)
     return out
 
 
@@ -246,7 +247,7 @@ def _rings(mesh: Mesh, faces: np.ndarray, k: int) -> np.ndarray:
 
 
 def open_walled_splinters(mesh: Mesh,
-                          fatten: Callable[[Mesh, np.ndarray], Mesh]) -> tuple[Mesh, int]:
+                          fatten: Callable[[Mesh, np.ndarray, float], Mesh]) -> tuple[Mesh, int]:
     """Cut the quads beside the splinters left into triangles and fatten again.
 
     Only a neighbourhood of the splinters is re-cut: the faces within two
@@ -261,8 +262,9 @@ def open_walled_splinters(mesh: Mesh,
     ----------
     mesh : Mesh
     fatten : callable
-        (Mesh, frozen vertices (V,) bool) -> Mesh: the flips and collapses to run
-        on the opened region, leaving the faces at frozen vertices alone.  The
+        (Mesh, frozen vertices (V,) bool, scale) -> Mesh: the flips and collapses
+        to run on the opened region, leaving the faces at frozen vertices alone,
+        their sag bounds relative to ``scale`` (the whole mesh's diagonal).  The
         region mesh numbers its vertices in ``mesh`` by ``vertex_data["_id"]``.
 
     Returns
@@ -272,8 +274,11 @@ def open_walled_splinters(mesh: Mesh,
         Number of quads opened (net of those joined again).
     """
     opened = 0
+    if mesh.n_faces == 0:
+        return mesh, 0
     amin = face_min_angles(mesh)
     total = _quad_area(mesh, every=True)
+    scale = diagonal(mesh.vertices) or 1.0
     for k in range(_OPEN_ROUNDS):
         bad = (amin < RESTART_ANGLE_DEG) & (mesh.valences == 3)
         if not bad.any():
@@ -283,28 +288,38 @@ def open_walled_splinters(mesh: Mesh,
         if not beside.any():
             continue
         region = _rings(mesh, beside | bad, 2)
-        face_of = np.repeat(np.arange(mesh.n_faces), mesh.valences)
-        frozen = np.zeros(mesh.n_vertices, bool)
-        frozen[mesh.face_indices[~region[face_of]]] = True
-        sub = Mesh(mesh.vertices, mesh.face_offsets, mesh.face_indices, mesh.face_kind, mesh.members,
-                   mesh.member_id, {**mesh.vertex_data, "_id": np.arange(mesh.n_vertices)},
-                   mesh.info).select_faces(region)
+        sub, frozen = _region(mesh, region)
         cut, quads, kinds = _cut_quads(sub, beside[region])
-        done = fatten(cut, frozen)
+        done = fatten(cut, frozen, scale)
         # The collapses renumber the vertices: the cut quads in the new numbers.
+        ids = np.asarray(sub.vertex_data["_id"])
         new_of = np.full(mesh.n_vertices, -1)
         new_of[np.asarray(done.vertex_data["_id"])] = np.arange(done.n_vertices)
-        quads = new_of[quads]
+        quads = new_of[ids[quads]]
         whole = (quads >= 0).all(axis=1)
         done = _joined_again(done, quads[whole], kinds[whole])
-        mesh, amin, n_open = _kept_pieces(mesh, amin, region, done, total)
+        mesh, amin, n_open = _kept_pieces(mesh, amin, region, sub, done, total)
         opened += n_open
     return mesh, opened
 
 
-def _kept_pieces(mesh: Mesh, amin: np.ndarray, region: np.ndarray, done: Mesh,
+def _region(mesh: Mesh, region: np.ndarray) -> tuple[Mesh, np.ndarray]:
+    """The faces marked ``region`` (F,) as a mesh of their own vertices, numbered in
+    ``mesh`` by ``vertex_data["_id"]`` (no members), and (V,) the vertices of ``mesh``
+    that a face outside the region also has."""
+    face_of = np.repeat(np.arange(mesh.n_faces), mesh.valences)
+    frozen = np.zeros(mesh.n_vertices, bool)
+    frozen[mesh.face_indices[~region[face_of]]] = True
+    sub = Mesh(mesh.vertices, mesh.face_offsets, mesh.face_indices, mesh.face_kind,
+               np.zeros((0, 2), np.int64), np.zeros(0, np.int64),
+               {**mesh.vertex_data, "_id": np.arange(mesh.n_vertices)}, mesh.info)
+    return sub.select_faces(region).compact(), frozen
+
+
+def _kept_pieces(mesh: Mesh, amin: np.ndarray, region: np.ndarray, sub: Mesh, done: Mesh,
                  total: float) -> tuple[Mesh, np.ndarray, int]:
-    """``mesh`` with the pieces of ``region`` where ``done`` (its re-cut faces) is better.
+    """``mesh`` with the pieces of ``region`` (``sub``) where ``done``, their re-cut faces, is
+    better.
 
     Returns the mesh, its (F,) smallest face angles and the number of quads opened.
     """
@@ -313,41 +328,46 @@ def _kept_pieces(mesh: Mesh, amin: np.ndarray, region: np.ndarray, done: Mesh,
 
     from ...analysis.faces import face_normals
 
-    n = mesh.n_vertices
-    idx = mesh.face_indices
-    face_of = np.repeat(np.arange(mesh.n_faces), mesh.valences)
-    inner = region[face_of]
-    a, b = idx[inner], idx[mesh.next_corners()][inner]
+    n = sub.n_vertices
+    idx = sub.face_indices
+    a, b = idx, idx[sub.next_corners()]
     _, label = connected_components(coo_matrix((np.ones(a.size), (a, b)), shape=(n, n)), directed=False)
-    ids = np.asarray(done.vertex_data["_id"])
-    old_piece = label[idx[mesh.face_offsets[:-1]]]
-    new_piece = label[ids[done.face_indices[done.face_offsets[:-1]]]] if done.n_faces else np.zeros(0, int)
-    k = int(label.max()) + 1
+    ids = np.asarray(sub.vertex_data["_id"])
+    sub_of = np.full(mesh.n_vertices, -1)
+    sub_of[ids] = np.arange(n)
+    done_ids = np.asarray(done.vertex_data["_id"])
+    old_piece = label[idx[sub.face_offsets[:-1]]]
+    new_piece = label[sub_of[done_ids[done.face_indices[done.face_offsets[:-1]]]]] if done.n_faces \
+        else np.zeros(0, np.int64)
+    k = int(label.max()) + 1 if n else 0
+    old_min = amin[region]
     new_min = face_min_angles(done)
-    _, old_area = face_normals(mesh)
+    _, old_area = face_normals(sub)
     _, new_area = face_normals(done)
-
-    def per_piece(piece, values, faces):
-        return np.bincount(piece[faces], weights=values[faces], minlength=k)
-
-    old_r = np.flatnonzero(region)
-    was = per_piece(old_piece, (amin < RESTART_ANGLE_DEG).astype(float), old_r)
+    was = np.bincount(old_piece, weights=(old_min < RESTART_ANGLE_DEG).astype(float), minlength=k)
     now = np.bincount(new_piece, weights=(new_min < RESTART_ANGLE_DEG).astype(float), minlength=k)
     lo_old = np.full(k, 180.0)
-    np.minimum.at(lo_old, old_piece[old_r], amin[old_r])
+    np.minimum.at(lo_old, old_piece, old_min)
     lo_new = np.full(k, 180.0)
     np.minimum.at(lo_new, new_piece, new_min)
-    lost = per_piece(old_piece, np.where(mesh.valences == 4, old_area, 0.0), old_r) - np.bincount(
-        new_piece, weights=np.where(done.valences == 4, new_area, 0.0), minlength=k)
+    lost = np.bincount(old_piece, weights=np.where(sub.valences == 4, old_area, 0.0), minlength=k) \
+        - np.bincount(new_piece, weights=np.where(done.valences == 4, new_area, 0.0), minlength=k)
     better = (now < was) | ((now == was) & (lo_new > lo_old))
     take = better & (lost <= _OPEN_MAX_SHARE * np.maximum(was - now, 0) * total)
     if not take.any():
         return mesh, amin, 0
-    swap = region & take[old_piece]
+    swap = np.zeros(mesh.n_faces, bool)
+    swap[np.flatnonzero(region)[take[old_piece]]] = True
     part = done.select_faces(take[new_piece])
-    out = _spliced(mesh, swap, part)
+    # The vertices the collapses removed in the pieces taken.
+    kept = np.zeros(mesh.n_vertices, bool)
+    kept[done_ids] = True
+    removed = np.zeros(mesh.n_vertices, bool)
+    removed[ids] = ~kept[ids] & take[label]
+    out = _spliced(mesh, swap, part, removed)
+    out_min = np.concatenate([amin[~swap], new_min[take[new_piece]]])
     n_open = int((mesh.valences[swap] == 4).sum() - (part.valences == 4).sum())
-    return out, face_min_angles(out), n_open
+    return out, out_min, n_open
 
 
 def _quad_area(mesh: Mesh, every: bool = False) -> float:
@@ -363,31 +383,38 @@ def _beside(mesh: Mesh, amin: np.ndarray, bad: np.ndarray, ends: bool = True) ->
     keys = _splinter_edges(mesh, amin)
     n = np.int64(mesh.n_vertices)
     idx = mesh.face_indices
-    nxt = idx[mesh.next_corners()]
-    edge = np.minimum(idx, nxt) * n + np.maximum(idx, nxt)
-    pos = np.clip(np.searchsorted(keys, edge), 0, keys.size - 1)
     face_of = np.repeat(np.arange(mesh.n_faces), mesh.valences)
+    # Only the corners of faces at a splinter's corners can be on its edges.
+    at = np.zeros(mesh.n_vertices, bool)
+    at[keys // n] = True
+    at[keys % n] = True
+    near = np.flatnonzero(at[idx] & at[idx[mesh.next_corners()]])
+    nxt = idx[mesh.next_corners()[near]]
+    edge = np.minimum(idx[near], nxt) * n + np.maximum(idx[near], nxt)
+    pos = np.clip(np.searchsorted(keys, edge), 0, keys.size - 1)
     beside = np.zeros(mesh.n_faces, bool)
-    beside[face_of[keys[pos] == edge]] = True
+    beside[face_of[near[keys[pos] == edge]]] = True
     # With the quads at the ends of a splinter's shortest edge open, a collapse may
     # remove that edge.
     if ends:
-        at = np.zeros(mesh.n_vertices, bool)
-        at[_short_edges(mesh, bad)] = True
-        beside[face_of[at[idx]]] = True
+        short = np.zeros(mesh.n_vertices, bool)
+        short[_short_edges(mesh, bad)] = True
+        beside[face_of[short[idx]]] = True
     return beside & (mesh.valences == 4)
 
 
-def _spliced(mesh: Mesh, replaced: np.ndarray, part: Mesh) -> Mesh:
-    """``mesh`` with its faces marked ``replaced`` (F,) swapped for the faces of ``part``.
+def _spliced(mesh: Mesh, replaced: np.ndarray, part: Mesh, removed: np.ndarray) -> Mesh:
+    """``mesh`` with its faces marked ``replaced`` (F,) swapped for the faces of ``part``
+    (appended, in order) and the vertices marked ``removed`` (V,) taken out.
 
-    ``part`` came from ``mesh`` with ``vertex_data["_id"]`` numbering its
-    vertices in ``mesh``; its members are the whole mesh's members (as rejoined).
+    ``part`` came from ``mesh`` with ``vertex_data["_id"]`` numbering its vertices in
+    ``mesh``; the members are joined across the removed vertices.
     """
     ids = np.asarray(part.vertex_data["_id"])
     kept = mesh.select_faces(~replaced)
     off = np.concatenate([kept.face_offsets, kept.face_offsets[-1] + part.face_offsets[1:]])
+    members, member_id = _rejoined(mesh.members, mesh.member_id, removed, mesh.n_vertices)
     out = Mesh(mesh.vertices, off, np.concatenate([kept.face_indices, ids[part.face_indices]]),
-               np.concatenate([kept.face_kind, part.face_kind]), ids[part.members], part.member_id,
+               np.concatenate([kept.face_kind, part.face_kind]), members, member_id,
                mesh.vertex_data, mesh.info)
     return out.compact()
