@@ -142,3 +142,18 @@ def test_splinter_passes_on_random_director_curves(caught, y1, y2, count, rows):
     build_design(parse_design(text))
     for call in caught:
         check(*call)
+
+
+@settings(max_examples=60, deadline=None)
+@given(n=st.integers(1, 60), data=st.data())
+def test_region_pieces_are_the_connected_components(n, data):
+    from scipy.sparse import coo_matrix
+    from scipy.sparse.csgraph import connected_components
+
+    m = data.draw(st.integers(0, 3 * n))
+    a = np.asarray(data.draw(st.lists(st.integers(0, n - 1), min_size=m, max_size=m)), np.int64)
+    b = np.asarray(data.draw(st.lists(st.integers(0, n - 1), min_size=m, max_size=m)), np.int64)
+    mine = splinters._components(n, a, b)
+    k, ref = connected_components(coo_matrix((np.ones(m), (a, b)), shape=(n, n)), directed=False)
+    assert mine.min(initial=0) == 0 and len(np.unique(mine)) == k
+    assert len(set(zip(mine.tolist(), ref.tolist()))) == k

@@ -163,7 +163,8 @@ CONE_THROUGH = _lines([((-np.cos(p), -np.sin(p), -1.0), (np.cos(p), np.sin(p), 1
 
 
 def test_cone_apex_at_the_ends_merges_the_apex(tmp_path, capsys):
-    mesh, _report, _ = expect_mesh(tmp_path, capsys, CONE_AT_END, kinds={"fill"},
+    # Every strip is flat: its triangles pair into exactly planar strip quads where they fit.
+    mesh, _report, _ = expect_mesh(tmp_path, capsys, CONE_AT_END, kinds={"fill", "strip"},
                                   warning="torsal strips")
     apex = np.flatnonzero(np.linalg.norm(mesh.vertices, axis=1) < 1e-12)
     assert len(apex) == 1                          # one apex vertex, no zero-area faces
@@ -172,7 +173,7 @@ def test_cone_apex_at_the_ends_merges_the_apex(tmp_path, capsys):
 
 
 def test_cone_apex_inside_every_generator(tmp_path, capsys):
-    mesh, _report, _ = expect_mesh(tmp_path, capsys, CONE_THROUGH, kinds={"fill"},
+    mesh, _report, _ = expect_mesh(tmp_path, capsys, CONE_THROUGH, kinds={"fill", "strip"},
                                   warning="torsal strips")
     from ruledmesh.analysis import face_areas
     assert face_areas(mesh).min() > 0

@@ -84,7 +84,9 @@ def _refined(rulings, mesh, options: dict):
     explicit lines) the discrete generators are ours to choose, so the strips
     whose area is mostly outside quads get one more generator each, at a node
     of the distribution's exact samples.  The user's generators all stay.
-    Rounds go on while they put more of the area in quads; of the meshes made,
+    Rounds go on while they put more of the area in quads, stop once the mesh
+    meets the goals with room, and the last runs only while it misses one; of
+    the meshes made,
     the one kept meets more of a fabricator's two goals (no splinter, at most a
     quarter of the area in triangles, a tenth with a planarity tolerance), and
     among equals has the larger quad
@@ -106,10 +108,12 @@ def _refined(rulings, mesh, options: dict):
     start = len(rulings.u)
     goal = _GOAL_TRIANGLES_TOLERANCE if options["planarity_tolerance"] > DEFAULT.planarity \
         else _GOAL_TRIANGLES
-    for _ in range(_REFINE_ROUNDS):
+    for k in range(_REFINE_ROUNDS):
         share, area, cur_rulings, cur_mesh = cur
-        # More generators are more panels: none once the mesh meets the goals with room.
-        if rounds[-1][1] == 0 and 1.0 - share <= _ROOM * goal:
+        # More generators are more panels: none once the mesh meets the goals with room,
+        # and a last round only while it misses one.
+        room = _ROOM if k < _REFINE_ROUNDS - 1 else 1.0
+        if rounds[-1][1] == 0 and 1.0 - share <= room * goal:
             break
         u = np.asarray(cur_rulings.u)
         strips = _trouble_strips(cur_mesh, len(u), area)

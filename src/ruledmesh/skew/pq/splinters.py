@@ -300,6 +300,8 @@ def open_walled_splinters(mesh: Mesh,
         done = _joined_again(done, quads[whole], kinds[whole])
         mesh, amin, n_open = _kept_pieces(mesh, amin, region, sub, done, total)
         opened += n_open
+        if n_open == 0 and k > 0:
+            break       # nothing changed: a further round would open the same quads
     return mesh, opened
 
 
@@ -316,6 +318,25 @@ def _region(mesh: Mesh, region: np.ndarray) -> tuple[Mesh, np.ndarray]:
     return sub.select_faces(region).compact(), frozen
 
 
+def _components(n: int, a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    """(n,) int: connected components of the graph on ``n`` vertices with edges ``a b``,
+    numbered from 0 (each vertex labelled by the smallest vertex it reaches, then ranked).
+
+    Minimum labels spread along the edges with pointer jumping: a few whole-array
+    steps for the small regions around splinters (scipy is not imported for a build).
+    """
+    label = np.arange(n)
+    while True:
+        low = label.copy()
+        np.minimum.at(low, a, label[b])
+        np.minimum.at(low, b, label[a])
+        low = low[low]
+        if np.array_equal(low, label):
+            break
+        label = low
+    return np.unique(label, return_inverse=True)[1].reshape(-1)
+
+
 def _kept_pieces(mesh: Mesh, amin: np.ndarray, region: np.ndarray, sub: Mesh, done: Mesh,
                  total: float) -> tuple[Mesh, np.ndarray, int]:
     """``mesh`` with the pieces of ``region`` (``sub``) where ``done``, their re-cut faces, is
@@ -323,15 +344,11 @@ def _kept_pieces(mesh: Mesh, amin: np.ndarray, region: np.ndarray, sub: Mesh, do
 
     Returns the mesh, its (F,) smallest face angles and the number of quads opened.
     """
-    from scipy.sparse import coo_matrix
-    from scipy.sparse.csgraph import connected_components
-
     from ...analysis.faces import face_normals
 
     n = sub.n_vertices
     idx = sub.face_indices
-    a, b = idx, idx[sub.next_corners()]
-    _, label = connected_components(coo_matrix((np.ones(a.size), (a, b)), shape=(n, n)), directed=False)
+    label = _components(n, idx, idx[sub.next_corners()])
     ids = np.asarray(sub.vertex_data["_id"])
     sub_of = np.full(mesh.n_vertices, -1)
     sub_of[ids] = np.arange(n)
