@@ -40,6 +40,8 @@ _OPEN_ROUNDS = 5
 # ... each piece kept only if it moves at most this share of the area out of quads per
 # splinter it removes.
 _OPEN_MAX_SHARE = SPLINTER_AREA_WORTH
+# Opening is tried only where at most this share of the faces are splinters.
+_OPEN_MAX_SPLINTERS = 0.05
 
 
 def _splinter_edges(mesh: Mesh, amin: np.ndarray) -> np.ndarray:
@@ -281,7 +283,9 @@ def open_walled_splinters(mesh: Mesh,
     scale = diagonal(mesh.vertices) or 1.0
     for k in range(_OPEN_ROUNDS):
         bad = (amin < RESTART_ANGLE_DEG) & (mesh.valences == 3)
-        if not bad.any():
+        # A mesh that is mostly splinters (rows far beyond an untrimmed patch) would be
+        # opened everywhere for nothing: opening is for the few left among good faces.
+        if not bad.any() or bad.sum() > _OPEN_MAX_SPLINTERS * mesh.n_faces:
             break
         # The quads on a splinter's edges first; then also those at its shortest edge.
         beside = _beside(mesh, amin, bad, ends=k > 0)
