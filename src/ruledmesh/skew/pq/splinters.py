@@ -27,10 +27,10 @@ from dataclasses import replace
 import numpy as np
 
 from ..._arrays import diagonal
-from ...analysis.faces import face_min_angles
+from ...analysis.faces import face_min_angles, face_normals
 from ...mesh import FaceKind, Mesh
 from ...tolerances import ON_BORDER, RESTART_ANGLE_DEG, SPLINTER_AREA_WORTH
-from .collapses import _apply, _rejoined
+from .collapses import _apply, _near, _rejoined
 from .pairing import _rebuilt
 
 __all__ = ["open_walled_splinters", "snap_to_border"]
@@ -106,7 +106,7 @@ def snap_to_border(mesh: Mesh) -> tuple[Mesh, int]:
     v, b = v[first], b[first]
     if v.size == 0:
         return mesh, 0
-    _, gain = _snapped(_around(mesh, np.concatenate([v, b])), v, b)
+    _, gain = _snapped(_near(mesh, np.concatenate([v, b])), v, b)
     keep = gain > 0
     v, b = v[keep], b[keep]
     if v.size == 0:
@@ -123,14 +123,6 @@ def _triangle_min_angles(mesh: Mesh) -> np.ndarray:
     f, F = mesh.faces_of_valence(3)
     out[f] = min_corner_angles(mesh.vertices, F)
     return out
-
-
-def _around(mesh: Mesh, vertices: np.ndarray) -> Mesh:
-    """The faces with a corner among ``vertices`` (all vertices and members kept)."""
-    mark = np.zeros(mesh.n_vertices, bool)
-    mark[vertices] = True
-    face_of = np.repeat(np.arange(mesh.n_faces), mesh.valences)
-    return mesh.select_faces(np.bincount(face_of[mark[mesh.face_indices]], minlength=mesh.n_faces) > 0)
 
 
 def _snapped(mesh: Mesh, v: np.ndarray, b: np.ndarray, measure: bool = True) -> tuple[Mesh, np.ndarray]:
@@ -279,7 +271,7 @@ def open_walled_splinters(mesh: Mesh,
     if mesh.n_faces == 0:
         return mesh, 0
     amin = face_min_angles(mesh)
-    total = _quad_area(mesh, every=True)
+    total = float(face_normals(mesh)[1].sum())
     scale = diagonal(mesh.vertices) or 1.0
     for k in range(_OPEN_ROUNDS):
         bad = (amin < RESTART_ANGLE_DEG) & (mesh.valences == 3)
@@ -348,7 +340,6 @@ def _kept_pieces(mesh: Mesh, amin: np.ndarray, region: np.ndarray, sub: Mesh, do
 
     Returns the mesh, its (F,) smallest face angles and the number of quads opened.
     """
-    from ...analysis.faces import face_normals
 
     n = sub.n_vertices
     idx = sub.face_indices
@@ -389,14 +380,6 @@ def _kept_pieces(mesh: Mesh, amin: np.ndarray, region: np.ndarray, sub: Mesh, do
     out_min = np.concatenate([amin[~swap], new_min[take[new_piece]]])
     n_open = int((mesh.valences[swap] == 4).sum() - (part.valences == 4).sum())
     return out, out_min, n_open
-
-
-def _quad_area(mesh: Mesh, every: bool = False) -> float:
-    """Area of the quads (of every face with ``every``)."""
-    from ...analysis.faces import face_normals
-
-    _, area = face_normals(mesh)
-    return float(area.sum() if every else area[mesh.valences == 4].sum())
 
 
 def _beside(mesh: Mesh, amin: np.ndarray, bad: np.ndarray, ends: bool = True) -> np.ndarray:
