@@ -389,8 +389,11 @@ def _rss_bytes() -> int:
 
 
 def test_thousand_rapid_updates_without_memory_growth(tmp_path):
-    # A short undo history, so the traced window below sees it turn over completely.
-    server = make_server(Session(SMALL, tmp_path / "small.toml", undo_limit=10), port=0)
+    # A short undo history, so the traced window below sees it turn over completely; the
+    # design unrefined (one build an update, not three: the server's state is under test).
+    design = SMALL + "refine = false\n"
+    assert design.rstrip().splitlines()[-4] == "[mesh]"
+    server = make_server(Session(design, tmp_path / "small.toml", undo_limit=10), port=0)
     threading.Thread(target=server.serve_forever, daemon=True).start()
     conn = http.client.HTTPConnection(*server.server_address[:2], timeout=60)
 

@@ -257,7 +257,12 @@ def collapse_splinters(mesh: Mesh, removable: np.ndarray | None = None,
         Number of vertices removed.
     """
     total = 0
-    watch = None    # after the first round, the vertices whose triangles may have changed
+    # Removing vertices can shrink the bounding box: the bound stays that of the mesh as given.
+    size = scale or diagonal(mesh.vertices) or 1.0
+    # After the first round, the vertices whose candidates must be weighed again: those
+    # allowed but not taken, and those near a collapse (every other candidate's star,
+    # neighbours, edges and border are unchanged, so its verdict is too).
+    watch = None
     for _ in range(_ROUNDS):
         val = mesh.valences
         if not (val == 3).any():
@@ -291,7 +296,6 @@ def collapse_splinters(mesh: Mesh, removable: np.ndarray | None = None,
         nval = near.valences
         tri = near.face_indices[near.face_offsets[np.flatnonzero(nval == 3)][:, None]
                                 + np.arange(3)].astype(np.int64)
-        size = scale or diagonal(V) or 1.0
         stars = _Stars(tri, keys, n)
         gain, ok = _evaluate(V, tri, stars, keys, np.bincount(mesh.face_indices, minlength=n), v, u, size)
         ok &= gain > FLIP_MIN_GAIN_DEG
@@ -309,7 +313,20 @@ def collapse_splinters(mesh: Mesh, removable: np.ndarray | None = None,
             if removable.size != mesh.n_vertices:     # compaction dropped others: stop here
                 removable = np.zeros(mesh.n_vertices, bool)
         total += int(take.size)
-        # Next round: the triangles around the collapses and the splinters left.
-        watch = np.zeros(mesh.n_vertices, bool)
-        watch[new_index[np.concatenate([u[take], splinters.reshape(-1)])]] = True
+        watch = _rings(mesh, new_index[u[take]], 2)
+        waiting = np.ones(v.size, bool)
+        waiting[take] = False
+        waiting &= ~np.isin(v, v[take])
+        watch[new_index[v[waiting]]] = True
     return mesh, total
+
+
+def _rings(mesh: Mesh, seeds: np.ndarray, k: int) -> np.ndarray:
+    """(V,) bool: the vertices within ``k`` face rings of ``seeds``."""
+    mark = np.zeros(mesh.n_vertices, bool)
+    mark[seeds] = True
+    face_of = np.repeat(np.arange(mesh.n_faces), mesh.valences)
+    for _ in range(k):
+        hit = np.bincount(face_of[mark[mesh.face_indices]], minlength=mesh.n_faces) > 0
+        mark[mesh.face_indices[hit[face_of]]] = True
+    return mark
