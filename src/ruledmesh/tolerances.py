@@ -23,7 +23,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
-__all__ = ["BRENTQ_XTOL", "COLLINEAR", "COLLINEAR_SQ", "CONGRUENCE_ANGLE_DEG", "CONVERGED",
+__all__ = ["BORDER_TRIM_MAX_GAP", "BRENTQ_XTOL", "COLLINEAR", "COLLINEAR_SQ", "CONGRUENCE_ANGLE_DEG", "CONVERGED",
            "COLLAPSE_MAX_SAG", "DEFAULT", "DEPTH_BIAS", "FLIP_ACTIVE_DEG", "FLIP_MAX_BEND_DEG", "FLIP_MAX_SAG",
            "FLIP_MIN_GAIN_DEG", "FLOAT32_WARNING", "INTERIOR", "KKT_REGULARISATION",
            "MIN_EXTENT", "MIN_HALF_ANGLE", "MIN_RELATIVE_EXTENT", "MITRE_FLOOR", "OCCT_FACE",
@@ -186,6 +186,10 @@ FLIP_ACTIVE_DEG = 20.0
 #: A triangle-only vertex collapsed into a neighbour (ruledmesh.skew.pq.collapses) may lie
 #: at most this share of the patch diagonal off the plane of each face it leaves behind.
 COLLAPSE_MAX_SAG = 2.5e-4
+#: An end point whose faces are all needles may be dropped with them
+#: (ruledmesh.skew.pq.splinters.trim_border_needles) when it lies at most this share of
+#: the patch diagonal from their far edges: the patch stays within half the gap goal (2e-3).
+BORDER_TRIM_MAX_GAP = 1e-3
 
 # A §4.3 face whose smallest angle is below this (degrees) counts as failing: runs
 # end before such faces (ruledmesh.skew.pq.runs).  The splinter bar of the analysis

@@ -258,7 +258,7 @@ def collapse_splinters(mesh: Mesh, removable: np.ndarray | None = None,
     """
     total = 0
     # Removing vertices can shrink the bounding box: the bound stays that of the mesh as given.
-    size = scale or diagonal(mesh.vertices) or 1.0
+    size = scale or (diagonal(mesh.vertices) if mesh.n_vertices else 0.0) or 1.0
     # After the first round, the vertices whose candidates must be weighed again: those
     # allowed but not taken, and those near a collapse (every other candidate's star,
     # neighbours, edges and border are unchanged, so its verdict is too).

@@ -26,7 +26,7 @@ from .runs import (
     carrier,
     mesh_run,
 )
-from .splinters import open_walled_splinters, snap_to_border
+from .splinters import open_walled_splinters, snap_to_border, trim_border_needles
 
 __all__ = ["pq_mesh"]
 
@@ -396,6 +396,7 @@ def _fattened(mesh: Mesh, ptol: float, tol: Tolerances) -> tuple[Mesh, dict[str,
     sliver from the border snapped onto it, quads walling a splinter in opened."""
     mesh, snapped = snap_to_border(mesh)
     mesh, flips = flip_triangles(mesh)
+    mesh, trimmed = trim_border_needles(mesh)
     mesh, collapsed = collapse_splinters(mesh)
     if collapsed:
         mesh, more = flip_triangles(mesh)
@@ -409,7 +410,7 @@ def _fattened(mesh: Mesh, ptol: float, tol: Tolerances) -> tuple[Mesh, dict[str,
         mesh, more = _paired(mesh, ptol, tol)
         paired += more
     return mesh, {"flips": flips, "collapsed": collapsed, "paired": paired, "snapped": snapped,
-                  "opened": opened}
+                  "trimmed": trimmed, "opened": opened}
 
 
 def _reflipped(mesh: Mesh, frozen: np.ndarray, scale: float) -> Mesh:

@@ -29,11 +29,11 @@ import numpy as np
 from ..._arrays import diagonal
 from ...analysis.faces import face_min_angles, face_normals
 from ...mesh import FaceKind, Mesh
-from ...tolerances import ON_BORDER, RESTART_ANGLE_DEG, SPLINTER_AREA_WORTH
-from .collapses import _apply, _near, _rejoined
+from ...tolerances import BORDER_TRIM_MAX_GAP, ON_BORDER, RESTART_ANGLE_DEG, SPLINTER_AREA_WORTH
+from .collapses import _apply, _near, _rejoined, _segment_distance
 from .pairing import _rebuilt
 
-__all__ = ["open_walled_splinters", "snap_to_border"]
+__all__ = ["open_walled_splinters", "snap_to_border", "trim_border_needles"]
 
 # Rounds of opening the quads beside the splinters left ...
 _OPEN_ROUNDS = 5
@@ -113,6 +113,86 @@ def snap_to_border(mesh: Mesh) -> tuple[Mesh, int]:
         return mesh, 0
     moved, _ = _snapped(mesh, v, b, measure=False)
     return moved, int(v.size)
+
+
+def trim_border_needles(mesh: Mesh, scale: float | None = None) -> tuple[Mesh, int]:
+    """Drop border vertices whose faces are all needles, where the border moves by a hair.
+
+    Where the generators meet a director curve at a grazing angle, an end
+    point can sit a sliver from the line through its neighbours, its only
+    faces needles that no flip or collapse fattens (the vertex opposite is a
+    quad corner).  Taking the end point and its needles away lets the border
+    run along their far edges; every vertex left is still on its generator and
+    no quad changes.  Taken only where the end point lies within
+    :data:`~ruledmesh.tolerances.BORDER_TRIM_MAX_GAP` of the diagonal from those
+    edges (the patch stays that close to the mesh) and the mesh stays a
+    manifold.
+
+    Parameters
+    ----------
+    mesh : Mesh
+        Any polygon mesh.
+    scale : float, optional
+        Length the bound is relative to (default: the mesh's bounding-box diagonal).
+
+    Returns
+    -------
+    Mesh
+        The mesh without those vertices and their triangles.
+    int
+        Number of vertices dropped.
+    """
+    if mesh.n_faces == 0:
+        return mesh, 0
+    n = np.int64(mesh.n_vertices)
+    idx = mesh.face_indices
+    face_of = np.repeat(np.arange(mesh.n_faces), mesh.valences)
+    needle = _triangle_min_angles(mesh) < RESTART_ANGLE_DEG
+    faces_at = np.bincount(idx, minlength=n)
+    cand = (faces_at > 0) & (np.bincount(idx[needle[face_of]], minlength=n) == faces_at)
+    if not cand.any():
+        return mesh, 0
+    keys, uses = mesh.edge_uses()
+    on_border = np.zeros(n, bool)
+    on_border[keys[uses == 1] // n] = on_border[keys[uses == 1] % n] = True
+    cand &= on_border
+    if not cand.any():
+        return mesh, 0
+    tid, T = mesh.faces_of_valence(3)
+    at = cand[T]
+    rows = np.flatnonzero(at.sum(axis=1) == 1)       # a fan's triangles, one candidate each
+    owner = T[rows][at[rows]]
+    # The far edge of each fan triangle, and the candidate's distance from it.
+    corner = np.argmax(at[rows], axis=1)
+    p, q = T[rows, (corner + 1) % 3], T[rows, (corner + 2) % 3]
+    V = mesh.vertices
+    dist = _segment_distance(V[owner], V[p], V[q])
+    far = np.zeros(n)
+    np.maximum.at(far, owner, dist)
+    fan_size = np.bincount(owner, minlength=n)
+    ok = cand & (fan_size == faces_at) & (far <= BORDER_TRIM_MAX_GAP * (scale or diagonal(V) or 1.0))
+    # The fan's inner rim vertices turn into border vertices: they must not be on it already,
+    # nor on the inner rim of another fan (the border would pinch there).  A fan's triangles
+    # have no other candidate, so fans share at most rim vertices.
+    rim = np.concatenate([p, q])
+    rim_owner = np.concatenate([owner, owner])
+    edge_of_fan = np.concatenate([np.minimum(owner, p) * n + np.maximum(owner, p),
+                                  np.minimum(owner, q) * n + np.maximum(owner, q)])
+    along = uses[np.searchsorted(keys, edge_of_fan)] == 1     # rim vertex beside it on the border
+    pinch = np.zeros(n, bool)
+    pinch[rim_owner[on_border[rim] & ~along]] = True
+    ok &= ~pinch
+    inner = ok[rim_owner] & ~along
+    pairs = np.unique(rim_owner[inner] * n + rim[inner])
+    fans = np.bincount(pairs % n, minlength=n)            # fans each vertex is inside the rim of
+    ok &= np.bincount(rim_owner[inner & (fans[rim] > 1)], minlength=n) == 0
+    if not ok.any():
+        return mesh, 0
+    drop = np.zeros(mesh.n_faces, bool)
+    drop[tid[rows[ok[owner]]]] = True
+    members, member_id = _rejoined(mesh.members, mesh.member_id, ok, int(n))
+    out = replace(mesh.select_faces(~drop), members=members, member_id=member_id).compact()
+    return out, int(ok.sum())
 
 
 def _triangle_min_angles(mesh: Mesh) -> np.ndarray:
