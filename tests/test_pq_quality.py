@@ -6,6 +6,7 @@ that a change that brings back triangles or splinters fails here.  The goals the
 reach yet are listed in docs/mesh-quality.md.
 """
 
+import re
 from pathlib import Path
 
 import numpy as np
@@ -13,12 +14,13 @@ import pytest
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
-from ruledmesh.analysis.faces import area_shares, convexity, degenerate_faces, face_min_angles, planarity
+from ruledmesh.analysis.faces import area_shares, convexity, degenerate_faces, face_min_angles, face_normals, planarity
 from ruledmesh.design import build_design, parse_design
 from ruledmesh.mesh import FaceKind
 from ruledmesh.pq import pq_mesh
 
 EXAMPLES = Path(__file__).resolve().parents[1] / "examples"
+QUALITY = EXAMPLES.parent / "benchmarks" / "quality"
 
 
 def _design(c1, c2, count, rows, extra=""):
@@ -104,6 +106,31 @@ def test_exact_mode_says_where_a_nearly_developable_surface_has_no_quads():
     check_exact(built)
     warnings = " ".join(built.mesh.info["warnings"])
     assert "of the area is not in quads" in warnings and "planarity_tolerance" in warnings
+    # The cause and where: every strip nearly developable, the share at the border and inside.
+    said = next(w for w in built.mesh.info["warnings"] if "of the area is not in quads" in w)
+    assert "40 strips nearly developable" in said
+    match = re.search(r"(\d+)% at the border, (\d+)% inside, most between generators (\d+)-(\d+)", said)
+    assert match, said
+    assert abs(int(match[1]) + int(match[2]) - 100) <= 1
+    assert 0 <= int(match[3]) < int(match[4]) <= 40
+
+
+def test_share_warning_names_the_strips_that_hold_the_triangles():
+    """skew-bspline-b-51x30 with its own generators: most of the area outside quads lies
+    beside its torsal generators, and the warning gives those strips with their shares."""
+    text = (QUALITY / "skew-bspline-b-51x30.toml").read_text() + "refine = false\n"
+    built = build_design(parse_design(text))
+    said = next(w for w in built.mesh.info["warnings"] if "of the area is not in quads" in w)
+    ranges = re.findall(r"(\d+)-(\d+) \((\d+)%\)", said.split("most between generators")[1])
+    assert ranges
+    mesh = built.mesh
+    gen = np.asarray(mesh.vertex_data["generator"])
+    _, area = face_normals(mesh)
+    g0 = np.minimum.reduceat(gen[mesh.face_indices], mesh.face_offsets[:-1])
+    for lo, hi, pct in ranges:
+        inside = (g0 >= int(lo)) & (g0 < int(hi)) & (mesh.valences != 4)
+        # The named range holds at least its stated share (border faces of the range included).
+        assert area[inside].sum() / area.sum() >= int(pct) / 100 - 0.006
 
 
 def test_coplanar_generators_carry_exact_strip_quads():
@@ -267,3 +294,10 @@ def test_build_warns_of_splinters_with_the_figures_analyze_reports():
     else:
         assert len(said) == 1 and said[0].startswith(f"{n} faces have an angle below 3 deg")
         assert f"smallest {angles.min():.2g} deg" in said[0]
+
+
+def test_share_warning_in_tolerance_mode_does_not_advise_the_tolerance():
+    text = (EXAMPLES / "linear-directrix.toml").read_text().replace("[mesh]\n", "[mesh]\nplanarity_tolerance = 1e-3\n")
+    built = build_design(parse_design(text))
+    said = [w for w in built.mesh.info["warnings"] if "of the area is not in quads" in w]
+    assert said and "planarity_tolerance" not in said[0] and "more generators" in said[0]

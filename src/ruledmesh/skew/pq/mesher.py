@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from dataclasses import dataclass
 
 import numpy as np
@@ -47,6 +48,9 @@ _DOUBLE = 0.01
 _NO_ROWS_SHARE = 0.5
 # A build with more than this share of its area outside quads says why.
 _WARN_SHARE = 0.3
+# A strip whose strip quads are planar within this (the tolerance mode the warnings
+# suggest) counts as nearly developable.
+_DEVELOPABLE = 1e-3
 # Tolerance mode pairs triangles into quads planar within this share of the stated tolerance.
 _PAIRING_MARGIN = 0.9
 
@@ -317,9 +321,10 @@ def pq_mesh(a, b, rows: int = 20, primary: int | str = "middle", option: int = 0
         consecutive vertices; ``vertex_data`` holds ``t`` and ``generator``;
         ``info["warnings"]`` says what was replaced or could not be covered,
         ``info["runs"]`` how many runs the generators were meshed in, and
-        ``flips``, ``collapsed``, ``paired``, ``snapped``, ``opened`` how many
-        edge flips, collapses, paired quads, corners snapped onto the border and
-        quads opened around splinters the fattening made.
+        ``flips``, ``collapsed``, ``paired``, ``snapped``, ``trimmed``, ``opened`` how many
+        edge flips, collapses, paired quads, corners snapped onto the border, end
+        points trimmed with their needles and quads opened around splinters the
+        fattening made.
 
     Raises
     ------
@@ -361,7 +366,9 @@ def pq_mesh(a, b, rows: int = 20, primary: int | str = "middle", option: int = 0
     meet = np.r_[flat, False] | np.r_[False, flat]      # generators of a coplanar pair
     mesh = assemble(parts, a, d, args.trim, tol, ptol, warnings, scale, meet, rows=rows)
     mesh, fattening = _fattened(mesh, ptol, tol)
-    _warn_share(mesh, warnings, torsal.size, even, restarts, m, rows)
+    _warn_share(mesh, warnings, torsal.size, even, restarts, m, rows,
+                lambda: int(_nearly_flat(a, d, rows, _DEVELOPABLE).sum()) if ptol < _DEVELOPABLE else 0,
+                exact=ptol <= DEFAULT.planarity)
     _warn_splinters(mesh, warnings, torsal)
     if kept.size < m_given:
         mesh = _renumbered(mesh, kept)
@@ -545,27 +552,69 @@ def _even_ranges(parts: list[Run], segs: list[_Segment], warnings: list[str]) ->
 
 
 def _warn_share(mesh: Mesh, warnings: list[str], torsal: int, even: list[str], restarts: int,
-                m: int, rows: int) -> None:
-    """Say so when much of the area is not in quads, with the causes and what to change."""
-    from ...analysis.faces import area_shares
+                m: int, rows: int, developable: Callable[[], int] = lambda: 0,
+                exact: bool = True) -> None:
+    """Say so when much of the area is not in quads: how much, where, why, and what to change.
+
+    ``developable()`` counts the strips whose strip quads would be planar within
+    1e-3 (nearly developable parts), asked only when the warning is given;
+    ``exact`` says whether the build was in exact mode (else a planarity
+    tolerance is no advice).
+    """
+    from ...analysis.faces import face_normals
 
     if mesh.n_faces == 0:
         return
-    share = 1.0 - area_shares(mesh)["quads"]
+    _, area = face_normals(mesh)
+    total = float(area.sum()) or 1.0
+    off = mesh.valences != 4
+    share = float(area[off].sum()) / total
     if share <= _WARN_SHARE:
         return
     causes = []
     if torsal:
-        causes.append(f"{torsal} torsal generators")
+        causes.append(f"{torsal} torsal generator{'s' * (torsal > 1)}")
     if even:
         causes.append(f"no rows on generators {', '.join(even[:4])}")
+    flat = developable()
+    if flat:
+        causes.append(f"{flat} strips nearly developable")
     if restarts:
         causes.append(f"the two chains drifted apart ({restarts} restarts)")
     if m < 2 * rows:
         causes.append(f"few generators for {rows} rows")
-    warnings.append(f"{share:.0%} of the area is not in quads ({'; '.join(causes) or 'border'}): "
-                    "more generators (rulings.count), fewer rows, [mesh] planarity_tolerance = 1e-3 "
-                    "for nearly developable parts, or method = \"hybrid\"")
+    warnings.append(f"{share:.0%} of the area is not in quads ({'; '.join(causes) or 'border'}; "
+                    f"{_where_not_quads(mesh, area, off, total)}): more generators (rulings.count), "
+                    f"fewer rows, {'[mesh] planarity_tolerance = 1e-3 for nearly developable parts, ' * exact}"
+                    "or method = \"hybrid\"")
+
+
+def _where_not_quads(mesh: Mesh, area: np.ndarray, off: np.ndarray, total: float) -> str:
+    """Where the area outside quads lies: the border band, and the strips holding most of the rest."""
+    keys, uses = mesh.edge_uses()
+    n = mesh.n_vertices
+    border_v = np.zeros(n, bool)
+    border_v[keys[uses == 1] // n] = border_v[keys[uses == 1] % n] = True
+    face_of = np.repeat(np.arange(mesh.n_faces), mesh.valences)
+    at_border = np.bincount(face_of[border_v[mesh.face_indices]], minlength=mesh.n_faces) > 0
+    band = float(area[off & at_border].sum()) / total
+    said = [f"{band:.0%} at the border"]
+    gen = mesh.vertex_data.get("generator")
+    inside = off & ~at_border
+    if gen is not None and inside.any():
+        g0 = np.minimum.reduceat(np.asarray(gen)[mesh.face_indices], mesh.face_offsets[:-1])
+        per = np.bincount(g0[inside], weights=area[inside], minlength=int(g0.max()) + 1) / total
+        # Strips holding at least a twentieth of the inner share, as ranges (all of them
+        # where it is spread evenly).
+        busy = np.flatnonzero(per >= 0.05 * per.sum())
+        if busy.size == 0:
+            busy = np.flatnonzero(per > 0)
+        cut = np.flatnonzero(np.diff(busy) > 1)
+        lo, hi = busy[np.r_[0, cut + 1]], busy[np.r_[cut, busy.size - 1]]
+        top = np.argsort([-per[a:b + 1].sum() for a, b in zip(lo, hi)], kind="stable")[:3]
+        ranges = ", ".join(f"{lo[k]}-{hi[k] + 1} ({per[lo[k]:hi[k] + 1].sum():.0%})" for k in sorted(top))
+        said.append(f"{float(per.sum()):.0%} inside, most between generators {ranges}")
+    return ", ".join(said)
 
 
 def _paired(mesh: Mesh, ptol: float, tol: Tolerances) -> tuple[Mesh, int]:
