@@ -2,7 +2,6 @@
 
 from __future__ import annotations
 
-from collections.abc import Callable
 from dataclasses import dataclass
 
 import numpy as np
@@ -13,7 +12,7 @@ from ...errors import GeometryError, ParameterError
 from ...hop import coplanarity
 from ...mesh import Mesh
 from ...normalise import normalised
-from ...tolerances import DEFAULT, PARAMETER_SLACK, Tolerances
+from ...tolerances import DEFAULT, NEARLY_DEVELOPABLE, PARAMETER_SLACK, Tolerances
 from .assemble import assemble
 from .collapses import collapse_splinters
 from .flips import flip_triangles
@@ -48,9 +47,6 @@ _DOUBLE = 0.01
 _NO_ROWS_SHARE = 0.5
 # A build with more than this share of its area outside quads says why.
 _WARN_SHARE = 0.3
-# A strip whose strip quads are planar within this (the tolerance mode the warnings
-# suggest) counts as nearly developable.
-_DEVELOPABLE = 1e-3
 # Tolerance mode pairs triangles into quads planar within this share of the stated tolerance.
 _PAIRING_MARGIN = 0.9
 
@@ -366,9 +362,7 @@ def pq_mesh(a, b, rows: int = 20, primary: int | str = "middle", option: int = 0
     meet = np.r_[flat, False] | np.r_[False, flat]      # generators of a coplanar pair
     mesh = assemble(parts, a, d, args.trim, tol, ptol, warnings, scale, meet, rows=rows)
     mesh, fattening = _fattened(mesh, ptol, tol)
-    _warn_share(mesh, warnings, torsal.size, even, restarts, m, rows,
-                lambda: int(_nearly_flat(a, d, rows, _DEVELOPABLE).sum()) if ptol < _DEVELOPABLE else 0,
-                exact=ptol <= DEFAULT.planarity)
+    _warn_share(mesh, warnings, torsal.size, even, restarts, m, rows, (a, d, ptol))
     _warn_splinters(mesh, warnings, torsal)
     if kept.size < m_given:
         mesh = _renumbered(mesh, kept)
@@ -552,14 +546,13 @@ def _even_ranges(parts: list[Run], segs: list[_Segment], warnings: list[str]) ->
 
 
 def _warn_share(mesh: Mesh, warnings: list[str], torsal: int, even: list[str], restarts: int,
-                m: int, rows: int, developable: Callable[[], int] = lambda: 0,
-                exact: bool = True) -> None:
+                m: int, rows: int, generators: tuple | None = None) -> None:
     """Say so when much of the area is not in quads: how much, where, why, and what to change.
 
-    ``developable()`` counts the strips whose strip quads would be planar within
-    1e-3 (nearly developable parts), asked only when the warning is given;
-    ``exact`` says whether the build was in exact mode (else a planarity
-    tolerance is no advice).
+    ``generators`` is ``(a, d, ptol)``: the generators, to count the strips that
+    are nearly developable (their strip quads planar within
+    :data:`~ruledmesh.tolerances.NEARLY_DEVELOPABLE`), and the build's planarity
+    tolerance (in tolerance mode a tolerance is no advice).
     """
     from ...analysis.faces import face_normals
 
@@ -576,7 +569,10 @@ def _warn_share(mesh: Mesh, warnings: list[str], torsal: int, even: list[str], r
         causes.append(f"{torsal} torsal generator{'s' * (torsal > 1)}")
     if even:
         causes.append(f"no rows on generators {', '.join(even[:4])}")
-    flat = developable()
+    a, d, ptol = generators if generators is not None else (None, None, DEFAULT.planarity)
+    exact = ptol <= DEFAULT.planarity
+    flat = int(_nearly_flat(a, d, rows, NEARLY_DEVELOPABLE).sum()) \
+        if a is not None and ptol < NEARLY_DEVELOPABLE else 0
     if flat:
         causes.append(f"{flat} strips nearly developable")
     if restarts:
