@@ -11,7 +11,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from .._arrays import cross, unique
+from .._arrays import cross, norm, unique
 from ..kernels import wanted
 from ..mesh import Mesh
 from ..tolerances import DEFAULT, ROUNDING_SQ
@@ -20,6 +20,7 @@ from ..tolerances import TINY as _TINY
 __all__ = [
     "quad_planarity",
     "quad_diagonal_crossing",
+    "gap_planarity",
     "polygon_planarity",
     "planarity",
     "convexity",
@@ -74,10 +75,10 @@ def quad_diagonal_crossing(corners: np.ndarray) -> tuple[np.ndarray, np.ndarray,
     s = np.where(parallel, 0.0, (b * e - c * d) / safe)
     t = np.where(parallel, e / np.maximum(c, _TINY), (a * e - b * d) / safe)
     normal = cross(d1, d2)
-    ncross = np.linalg.norm(normal, axis=1)
+    ncross = norm(normal)
     gap_skew = np.abs(np.einsum("ij,ij->i", w, normal)) / np.maximum(ncross, _TINY)
     # Parallel diagonals: distance from q to the line of d1.
-    gap_par = np.linalg.norm(cross(w, d1), axis=1) / np.sqrt(np.maximum(a, _TINY))
+    gap_par = norm(cross(w, d1)) / np.sqrt(np.maximum(a, _TINY))
     gap = np.where(parallel, gap_par, gap_skew)
     return s, t, gap * scale
 
@@ -107,9 +108,21 @@ def quad_planarity(corners: np.ndarray) -> np.ndarray:
     kern = wanted(len(corners))
     if kern is not None and corners.ndim == 3 and corners.shape[1:] == (4, 3):
         return kern.quad_planarity(corners)
-    _, _, gap = quad_diagonal_crossing(corners)
-    l1 = np.linalg.norm(corners[:, 2] - corners[:, 0], axis=1)
-    l2 = np.linalg.norm(corners[:, 3] - corners[:, 1], axis=1)
+    return gap_planarity(corners, quad_diagonal_crossing(corners)[2])
+
+
+def gap_planarity(corners: np.ndarray, gap: np.ndarray) -> np.ndarray:
+    """(F,) float64: :func:`quad_planarity` of quads whose diagonal gap is known.
+
+    Parameters
+    ----------
+    corners : (F, 4, 3) float64
+    gap : (F,) float64
+        The third result of :func:`quad_diagonal_crossing` (``corners``), so that a
+        caller needing the crossing too measures it once.
+    """
+    l1 = norm(corners[:, 2] - corners[:, 0])
+    l2 = norm(corners[:, 3] - corners[:, 1])
     return gap / np.maximum(0.5 * (l1 + l2), _TINY)
 
 
@@ -222,10 +235,17 @@ def polygon_angles(corners: np.ndarray) -> np.ndarray:
         kern = wanted(corners.shape[0] * corners.shape[1])
         if kern is not None:
             return kern.polygon_angles(corners)
-    e1 = np.roll(corners, 1, axis=1) - corners
-    e2 = np.roll(corners, -1, axis=1) - corners
+    # The edges to the previous and the next corner, as ``np.roll(corners, +-1, axis=1) -
+    # corners`` by slices (the same differences, without roll's copies), and the norm as
+    # ``np.linalg.norm`` computes it: this runs on a few faces many times per build.
+    e1 = np.empty_like(corners)
+    e2 = np.empty_like(corners)
+    np.subtract(corners[:, -1:], corners[:, :1], out=e1[:, :1])
+    np.subtract(corners[:, :-1], corners[:, 1:], out=e1[:, 1:])
+    np.subtract(corners[:, 1:], corners[:, :-1], out=e2[:, :-1])
+    np.subtract(corners[:, :1], corners[:, -1:], out=e2[:, -1:])
     cosang = np.einsum("fkc,fkc->fk", e1, e2)
-    sinang = np.linalg.norm(cross(e1, e2), axis=2)
+    sinang = norm(cross(e1, e2))
     return np.degrees(np.arctan2(sinang, cosang))
 
 
@@ -261,7 +281,7 @@ def corner_angles(mesh: Mesh) -> np.ndarray:
     e1 = v[idx[prv]] - v[idx]
     e2 = v[idx[nxt]] - v[idx]
     cosang = np.einsum("ij,ij->i", e1, e2)
-    sinang = np.linalg.norm(cross(e1, e2), axis=1)
+    sinang = norm(cross(e1, e2))
     return np.degrees(np.arctan2(sinang, cosang))
 
 

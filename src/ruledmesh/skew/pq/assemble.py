@@ -108,7 +108,7 @@ def _strip_quads(V, chain, gstart, gaps: Gaps, ptol: float):
     use : (n_gaps,) bool
     quads : (q, 4) int64
     """
-    from ...analysis.faces import quad_diagonal_crossing, quad_planarity
+    from ...analysis.faces import gap_planarity, quad_diagonal_crossing
 
     even = (gaps.na == gaps.nb) & (gaps.na > 0)
     ge = np.flatnonzero(even)
@@ -122,8 +122,8 @@ def _strip_quads(V, chain, gstart, gaps: Gaps, ptol: float):
     ok_q = np.zeros(len(quads), bool)
     if len(quads):
         P = V[quads]
-        sq, tq, _ = quad_diagonal_crossing(P)
-        ok_q = (quad_planarity(P) <= ptol) & (sq > 0.02) & (sq < 0.98) & (tq > 0.02) & (tq < 0.98)
+        sq, tq, gap = quad_diagonal_crossing(P)
+        ok_q = (gap_planarity(P, gap) <= ptol) & (sq > 0.02) & (sq < 0.98) & (tq > 0.02) & (tq < 0.98)
     bad = np.bincount(gid[~ok_q], minlength=len(ge)) if len(ge) else np.zeros(0, np.int64)
     use = np.zeros(len(gaps.strip), bool)
     use[ge[bad == 0]] = True
@@ -227,12 +227,13 @@ def assemble(parts: list[Run], a, d, trim: bool, tol: Tolerances, ptol: float,
     both = ok_l & ok_r
     quads = np.stack([L[both, 0], L[both, 1], R[both, 1], L[both, 2]], axis=1)
     # Bow-ties: the diagonals must cross inside both; else keep the two halves.
-    sq, tq, _ = quad_diagonal_crossing(V[quads])
+    Q = V[quads]
+    sq, tq, _ = quad_diagonal_crossing(Q)
     eps = tol.convexity
     convex = (sq > eps) & (sq < 1 - eps) & (tq > eps) & (tq < 1 - eps)
     # A quad with a splinter's corner is kept as its two halves too: the flips and
     # collapses may fatten triangles (with their fill neighbours), never a quad.
-    sliver = convex & (polygon_angles(V[quads]).min(axis=1) < RESTART_ANGLE_DEG)
+    sliver = convex & (polygon_angles(Q).min(axis=1) < RESTART_ANGLE_DEG)
     nsplit = int(np.count_nonzero(~convex))
     convex &= ~sliver
     whole = np.zeros(len(L), bool)
