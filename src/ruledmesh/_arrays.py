@@ -43,6 +43,13 @@ def unique(values: np.ndarray) -> np.ndarray:
     return arr[keep]
 
 
+# Up to this many numbers per operand, :func:`cross` gathers the components (faster on a
+# few vectors, much slower on many).
+_SMALL = 768
+_NEXT = np.array([1, 2, 0])
+_LAST = np.array([2, 0, 1])
+
+
 def cross(x: np.ndarray, y: np.ndarray) -> np.ndarray:
     """``np.cross`` of (..., 3) arrays: the same products and differences, bit for bit.
 
@@ -50,6 +57,11 @@ def cross(x: np.ndarray, y: np.ndarray) -> np.ndarray:
     call), which costs more than the arithmetic on the few faces of a small
     mesh or a run's generators.
     """
+    if x.shape == y.shape and x.size <= _SMALL:
+        # Few vectors: the components in cyclic order by one gather each, four array
+        # operations in all (the products and differences are the same numbers).
+        return np.take(x, _NEXT, axis=-1) * np.take(y, _LAST, axis=-1) \
+            - np.take(x, _LAST, axis=-1) * np.take(y, _NEXT, axis=-1)
     x0, x1, x2 = x[..., 0], x[..., 1], x[..., 2]
     y0, y1, y2 = y[..., 0], y[..., 1], y[..., 2]
     out = np.empty(np.broadcast_shapes(x.shape, y.shape), dtype=np.result_type(x, y))

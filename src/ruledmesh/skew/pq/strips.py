@@ -200,7 +200,10 @@ def strip_paths(T, chain, gstart, m, L, R, ok_l, ok_r, CG):
     btw = np.flatnonzero(between)
     fst = np.flatnonzero(first)
     lst = np.flatnonzero(last)
-    empty = np.setdiff1d(np.arange(nstrip), st_strip, assume_unique=False)
+    # The strips without steps, in order (np.setdiff1d's result, without its sorts).
+    no_step = np.ones(nstrip, bool)
+    no_step[st_strip] = False
+    empty = np.flatnonzero(no_step)
     g_strip = np.concatenate([st_strip[fst], st_strip[btw], st_strip[lst], empty])
     g_k0 = np.concatenate([np.zeros(len(fst), np.int64), end_k[btw - 1], end_k[lst],
                            np.zeros(len(empty), np.int64)])
