@@ -361,9 +361,9 @@ def pq_mesh(a, b, rows: int = 20, primary: int | str = "middle", option: int = 0
     even = _even_ranges(parts, segs, warnings)
     meet = np.r_[flat, False] | np.r_[False, flat]      # generators of a coplanar pair
     mesh = assemble(parts, a, d, args.trim, tol, ptol, warnings, scale, meet, rows=rows)
-    mesh, fattening = _fattened(mesh, ptol, tol)
-    _warn_share(mesh, warnings, torsal.size, even, restarts, m, rows, (a, d, ptol))
-    _warn_splinters(mesh, warnings, torsal)
+    mesh, fattening, measured = _fattened(mesh, ptol, tol)
+    _warn_share(mesh, warnings, torsal.size, even, restarts, m, rows, (a, d, ptol), measured)
+    _warn_splinters(mesh, warnings, torsal, measured)
     if kept.size < m_given:
         mesh = _renumbered(mesh, kept)
     return mesh.with_info(runs=len(parts), restarts=restarts, planarity_tolerance=ptol, **fattening)
@@ -391,10 +391,14 @@ def _cut(a, d, rows, ptol, scale, tol, creases, crease_generators, warnings):
     return flat, torsal, cg, segs
 
 
-def _fattened(mesh: Mesh, ptol: float, tol: Tolerances) -> tuple[Mesh, dict[str, int]]:
+def _fattened(mesh: Mesh, ptol: float, tol: Tolerances) -> tuple[Mesh, dict[str, int], tuple | None]:
     """Flip the triangles for their angles, collapse what flips cannot fatten, pair the
     triangles in tolerance mode, flip what is left; then the splinters left: corners a
-    sliver from the border snapped onto it, quads walling a splinter in opened."""
+    sliver from the border snapped onto it, quads walling a splinter in opened.
+
+    The third result: the (F,) smallest angles and areas of the faces of the mesh
+    returned, where the opening measured them and left the mesh as it was (else None).
+    """
     mesh, snapped = snap_to_border(mesh)
     mesh, flips = flip_triangles(mesh)
     mesh, trimmed = trim_border_needles(mesh)
@@ -406,12 +410,16 @@ def _fattened(mesh: Mesh, ptol: float, tol: Tolerances) -> tuple[Mesh, dict[str,
     if paired:
         mesh, more = flip_triangles(mesh)
         flips += more
-    mesh, opened = open_walled_splinters(mesh, _reflipped)
+    from ...analysis.faces import face_min_angles, face_normals
+
+    measured = (face_min_angles(mesh), face_normals(mesh)[1]) if mesh.n_faces else None
+    before = mesh
+    mesh, opened = open_walled_splinters(mesh, _reflipped, measured)
     if opened:
         mesh, more = _paired(mesh, ptol, tol)
         paired += more
     return mesh, {"flips": flips, "collapsed": collapsed, "paired": paired, "snapped": snapped,
-                  "trimmed": trimmed, "opened": opened}
+                  "trimmed": trimmed, "opened": opened}, (measured if mesh is before else None)
 
 
 def _reflipped(mesh: Mesh, frozen: np.ndarray, scale: float) -> Mesh:
@@ -546,19 +554,21 @@ def _even_ranges(parts: list[Run], segs: list[_Segment], warnings: list[str]) ->
 
 
 def _warn_share(mesh: Mesh, warnings: list[str], torsal: int, even: list[str], restarts: int,
-                m: int, rows: int, generators: tuple | None = None) -> None:
+                m: int, rows: int, generators: tuple | None = None,
+                measured: tuple | None = None) -> None:
     """Say so when much of the area is not in quads: how much, where, why, and what to change.
 
     ``generators`` is ``(a, d, ptol)``: the generators, to count the strips that
     are nearly developable (their strip quads planar within
     :data:`~ruledmesh.tolerances.NEARLY_DEVELOPABLE`), and the build's planarity
-    tolerance (in tolerance mode a tolerance is no advice).
+    tolerance (in tolerance mode a tolerance is no advice); ``measured`` the (F,)
+    smallest angles and areas of the faces, if known.
     """
     from ...analysis.faces import face_normals
 
     if mesh.n_faces == 0:
         return
-    _, area = face_normals(mesh)
+    area = face_normals(mesh)[1] if measured is None else measured[1]
     total = float(area.sum()) or 1.0
     off = mesh.valences != 4
     share = float(area[off].sum()) / total
@@ -625,13 +635,17 @@ def _paired(mesh: Mesh, ptol: float, tol: Tolerances) -> tuple[Mesh, int]:
     return pair_triangles(mesh, _PAIRING_MARGIN * max(ptol, tol.planarity))
 
 
-def _warn_splinters(mesh: Mesh, warnings: list[str], torsal: np.ndarray) -> None:
-    """Say how many faces are splinters for fabrication, where, and next to what."""
+def _warn_splinters(mesh: Mesh, warnings: list[str], torsal: np.ndarray,
+                    measured: tuple | None = None) -> None:
+    """Say how many faces are splinters for fabrication, where, and next to what.
+
+    ``measured``: the (F,) smallest angles and areas of the faces, if known.
+    """
     from ...analysis.faces import SPLINTER_DEG, face_min_angles
 
     if mesh.n_faces == 0:
         return
-    ang = face_min_angles(mesh)
+    ang = face_min_angles(mesh) if measured is None else measured[0]
     bad = np.flatnonzero(ang < SPLINTER_DEG)
     if bad.size == 0:
         return

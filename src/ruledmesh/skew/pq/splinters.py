@@ -320,8 +320,8 @@ def _rings(mesh: Mesh, faces: np.ndarray, k: int) -> np.ndarray:
     return out
 
 
-def open_walled_splinters(mesh: Mesh,
-                          fatten: Callable[[Mesh, np.ndarray, float], Mesh]) -> tuple[Mesh, int]:
+def open_walled_splinters(mesh: Mesh, fatten: Callable[[Mesh, np.ndarray, float], Mesh],
+                          measured: tuple[np.ndarray, np.ndarray] | None = None) -> tuple[Mesh, int]:
     """Cut the quads beside the splinters left into triangles and fatten again.
 
     Only a neighbourhood of the splinters is re-cut: the faces within two
@@ -340,6 +340,8 @@ def open_walled_splinters(mesh: Mesh,
         to run on the opened region, leaving the faces at frozen vertices alone,
         their sag bounds relative to ``scale`` (the whole mesh's diagonal).  The
         region mesh numbers its vertices in ``mesh`` by ``vertex_data["_id"]``.
+    measured : ((F,) float64, (F,) float64), optional
+        ``face_min_angles(mesh)`` and ``face_normals(mesh)[1]`` if the caller has them.
 
     Returns
     -------
@@ -350,8 +352,8 @@ def open_walled_splinters(mesh: Mesh,
     opened = 0
     if mesh.n_faces == 0:
         return mesh, 0
-    amin = face_min_angles(mesh)
-    total = float(face_normals(mesh)[1].sum())
+    amin, area = measured if measured is not None else (face_min_angles(mesh), face_normals(mesh)[1])
+    total = float(area.sum())
     scale = diagonal(mesh.vertices) or 1.0
     for k in range(_OPEN_ROUNDS):
         bad = (amin < RESTART_ANGLE_DEG) & (mesh.valences == 3)
