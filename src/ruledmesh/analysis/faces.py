@@ -206,7 +206,7 @@ def face_normals(mesh: Mesh) -> tuple[np.ndarray, np.ndarray]:
     origin = v[idx[np.repeat(mesh.face_offsets[:-1], mesh.valences)]]
     cr = cross(v[idx] - origin, v[idx[nxt]] - origin)
     vec = 0.5 * np.add.reduceat(cr, mesh.face_offsets[:-1], axis=0) if idx.size else np.zeros((0, 3))
-    area = np.linalg.norm(vec, axis=1)
+    area = norm(vec)
     normals = vec / np.maximum(area, _TINY)[:, None]
     return normals, area
 

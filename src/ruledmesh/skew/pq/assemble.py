@@ -42,7 +42,7 @@ def _join(parts: list[Run]):
         # Runs that meet on a generator share its division (matched, or both
         # reaching a director curve), so parameters equal to rounding mean the
         # same point: keep the first of each group.
-        first = np.maximum.accumulate(np.where(np.r_[True, ~same], np.arange(len(order)), 0))
+        first = np.maximum.accumulate(np.where(np.concatenate([[True], ~same]), np.arange(len(order)), 0))
         remap = np.arange(len(V))
         remap[order] = order[first]
         L = np.where(L >= 0, remap[np.maximum(L, 0)], -1)
@@ -148,8 +148,8 @@ def _with_ladders(V, T, G, FAR, good_v, chain, gstart, gaps: Gaps, use: np.ndarr
     free = free_edges(open_gaps, gstart, len(a))
     n0 = len(V)
     V, T, G, chain, gstart, added = ladder_points(V, T, G, chain, gstart, free, a, d, rows)
-    FAR = np.r_[FAR, np.zeros(len(V) - n0, bool)]
-    good_v = np.r_[good_v, np.ones(len(V) - n0, bool)]
+    FAR = np.concatenate([FAR, np.zeros(len(V) - n0, bool)])
+    good_v = np.concatenate([good_v, np.ones(len(V) - n0, bool)])
     return V, T, G, FAR, good_v, chain, gstart, added
 
 
@@ -199,8 +199,8 @@ def assemble(parts: list[Run], a, d, trim: bool, tol: Tolerances, ptol: float,
     if trim:
         n0 = len(V)
         V, T, G, chain, gstart = chains(V, T, G, good_v, a, d, m, scale)
-        FAR = np.r_[FAR, np.zeros(len(V) - n0, bool)]
-        good_v = np.r_[good_v, np.ones(len(V) - n0, bool)]
+        FAR = np.concatenate([FAR, np.zeros(len(V) - n0, bool)])
+        good_v = np.concatenate([good_v, np.ones(len(V) - n0, bool)])
         L, R, substituted = _substitute_border(V, T, FAR, L, R, CG, good_v, chain[gstart[:-1]],
                                                chain[gstart[1:] - 1])
     cand_l = (L[:, 0] >= 0) & ~POLE & good_v[np.maximum(L, 0)].all(axis=1)
