@@ -7,9 +7,12 @@ build makes, with the arguments the build passes:
 
 * ``tiny``: a 9-generator, 6-row design (B-spline and polyline director curves),
   ``refine = false``: one mesher call, 59 faces;
-* ``tiny_refine``: the same design refined (three mesher calls);
+* ``tiny_refine``: the same design refined (three mesher calls today);
 * ``designer_default``: the design the designer opens with (41 generators at
-  equal arc length, 40 rows; three mesher calls);
+  equal arc length, 40 rows; three mesher calls today);
+* ``designer_100x100``: the tiny design at 101 generators x 100 rows, refined (the
+  design of the designer's slider-to-frame test; the refinement decides how many
+  mesher calls);
 * ``skew_100x100``: the benchmark skew surface, 100 generators x 100 rows.
 
 Each case is timed in numpy only and with the compiled kernels
@@ -99,6 +102,8 @@ def cases() -> dict[str, list[tuple[tuple, dict]]]:
     a, b = SURFACES["skew"].generators(100)
     return {"tiny": _calls(TINY + "refine = false\n"), "tiny_refine": _calls(TINY),
             "designer_default": _calls(DEFAULT_DESIGN),
+            "designer_100x100": _calls(TINY.replace("count = 9", "count = 101")
+                                       .replace("rows = 6", "rows = 100")),
             "skew_100x100": [((a, b), {"rows": 100, "trim": True})]}
 
 
