@@ -60,8 +60,8 @@ def cross(x: np.ndarray, y: np.ndarray) -> np.ndarray:
     if x.shape == y.shape and x.size <= _SMALL:
         # Few vectors: the components in cyclic order by one gather each, four array
         # operations in all (the products and differences are the same numbers).
-        return np.take(x, _NEXT, axis=-1) * np.take(y, _LAST, axis=-1) \
-            - np.take(x, _LAST, axis=-1) * np.take(y, _NEXT, axis=-1)
+        return x.take(_NEXT, axis=-1) * y.take(_LAST, axis=-1) \
+            - x.take(_LAST, axis=-1) * y.take(_NEXT, axis=-1)
     x0, x1, x2 = x[..., 0], x[..., 1], x[..., 2]
     y0, y1, y2 = y[..., 0], y[..., 1], y[..., 2]
     out = np.empty(np.broadcast_shapes(x.shape, y.shape), dtype=np.result_type(x, y))
