@@ -1,4 +1,4 @@
-"""ruledmesh._arrays.unique against np.unique: the same values, NaNs collapsed alike."""
+"""ruledmesh._arrays against numpy: unique values, cross products and norms, bit for bit."""
 
 from __future__ import annotations
 
@@ -7,7 +7,7 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 from hypothesis.extra import numpy as hnp
 
-from ruledmesh._arrays import unique
+from ruledmesh._arrays import cross, norm, unique
 
 
 def _same(x: np.ndarray, y: np.ndarray) -> bool:
@@ -37,3 +37,46 @@ def test_large_keys_sorted():
     keys = np.concatenate([keys, keys[:50_000]])
     got = unique(keys)
     assert np.array_equal(got, np.unique(keys)) and np.all(np.diff(got) > 0)
+
+
+def _bits(x: np.ndarray, y: np.ndarray) -> bool:
+    """Same shape, dtype and bytes (zeros' signs and NaN payloads included)."""
+    return x.shape == y.shape and x.dtype == y.dtype and x.tobytes() == y.tobytes()
+
+
+_FLOATS = st.floats(-1e6, 1e6, allow_subnormal=True) | st.sampled_from([0.0, -0.0, 1e-300, np.inf, np.nan])
+
+
+@settings(max_examples=200, deadline=None)
+@given(st.integers(0, 400), st.integers(0, 3), st.data())
+def test_cross_is_np_cross(n, extra, data):
+    """Bit for bit np.cross, on both sides of the size where the gathering form stops."""
+    shape = (n,) + (2,) * extra + (3,)
+    x = data.draw(hnp.arrays(np.float64, shape, elements=_FLOATS))
+    y = data.draw(hnp.arrays(np.float64, shape, elements=_FLOATS))
+    with np.errstate(invalid="ignore", over="ignore"):
+        assert _bits(cross(x, y), np.cross(x, y))
+
+
+def test_cross_broadcasts_like_np_cross():
+    rng = np.random.default_rng(5)
+    x, y = rng.standard_normal((4, 1, 3)), rng.standard_normal((1, 6, 3))
+    assert _bits(cross(x, y), np.cross(x, y))
+
+
+@settings(max_examples=200, deadline=None)
+@given(hnp.arrays(np.float64, hnp.array_shapes(min_dims=1, max_dims=3, min_side=0), elements=_FLOATS))
+def test_norm_is_linalg_norm(x):
+    with np.errstate(invalid="ignore", over="ignore"):
+        assert _bits(norm(x), np.linalg.norm(x, axis=-1))
+
+
+@settings(max_examples=300, deadline=None)
+@given(hnp.arrays(np.int64, st.tuples(st.integers(1, 40), st.integers(1, 4)),
+                  elements=st.sampled_from([-(2**62), -3, -1, 0, 1, 2, 7, 2**62])))
+def test_first_of_equal_rows_is_unique_rows(key):
+    """The grouping the mesher merges end points by: np.unique's over rows."""
+    from ruledmesh.skew.pq.assemble import _first_of_equal_rows
+
+    _, first, inverse = np.unique(key, axis=0, return_index=True, return_inverse=True)
+    assert np.array_equal(_first_of_equal_rows(key), first[inverse.reshape(-1)])
