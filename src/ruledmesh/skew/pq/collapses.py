@@ -121,6 +121,20 @@ def _directed(tri: np.ndarray, free: np.ndarray) -> tuple[np.ndarray, np.ndarray
     return pairs[:, 0], pairs[:, 1]
 
 
+def _touching(mesh: Mesh, mark: np.ndarray) -> np.ndarray:
+    """(F,) bool: the faces with a corner where ``mark`` (V,) is true."""
+    face_of = np.repeat(np.arange(mesh.n_faces), mesh.valences)
+    return np.bincount(face_of[mark[mesh.face_indices]], minlength=mesh.n_faces) > 0
+
+
+def _border_vertices(keys: np.ndarray, uses: np.ndarray, n: int) -> np.ndarray:
+    """(n,) bool: the ends of the edges used once (:meth:`Mesh.edge_uses`'s ``keys, uses``)."""
+    border = keys[uses == 1]
+    out = np.zeros(n, bool)
+    out[border // n] = out[border % n] = True
+    return out
+
+
 def _near(mesh: Mesh, vertices: np.ndarray) -> Mesh:
     """The faces with a corner among ``vertices`` (all vertices kept).
 
@@ -129,8 +143,7 @@ def _near(mesh: Mesh, vertices: np.ndarray) -> Mesh:
     """
     mark = np.zeros(mesh.n_vertices, bool)
     mark[vertices] = True
-    face_of = np.repeat(np.arange(mesh.n_faces), mesh.valences)
-    return mesh.select_faces(np.bincount(face_of[mark[mesh.face_indices]], minlength=mesh.n_faces) > 0)
+    return mesh.select_faces(_touching(mesh, mark))
 
 
 def _evaluate(V, tri, stars: _Stars, keys, faces_at, v, u, scale) -> tuple[np.ndarray, np.ndarray]:
@@ -284,11 +297,9 @@ def collapse_splinters(mesh: Mesh, removable: np.ndarray | None = None,
         # Only the faces around the candidates matter: a large mesh has few splinters.
         near = _near(mesh, np.concatenate([v, u]))
         keys, uses = near.edge_uses()
-        border_keys = keys[uses == 1]
-        border_v = np.zeros(n, bool)
-        border_v[border_keys // n] = border_v[border_keys % n] = True
+        border_v = _border_vertices(keys, uses, n)
         # A border vertex collapses only along the border.
-        along = _member(np.minimum(v, u) * n + np.maximum(v, u), border_keys)
+        along = _member(np.minimum(v, u) * n + np.maximum(v, u), keys[uses == 1])
         ok = ~border_v[v] | along
         v, u = v[ok], u[ok]
         if v.size == 0:
@@ -325,8 +336,6 @@ def _rings(mesh: Mesh, seeds: np.ndarray, k: int) -> np.ndarray:
     """(V,) bool: the vertices within ``k`` face rings of ``seeds``."""
     mark = np.zeros(mesh.n_vertices, bool)
     mark[seeds] = True
-    face_of = np.repeat(np.arange(mesh.n_faces), mesh.valences)
     for _ in range(k):
-        hit = np.bincount(face_of[mark[mesh.face_indices]], minlength=mesh.n_faces) > 0
-        mark[mesh.face_indices[hit[face_of]]] = True
+        mark[mesh.face_indices[np.repeat(_touching(mesh, mark), mesh.valences)]] = True
     return mark

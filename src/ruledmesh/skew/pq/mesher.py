@@ -14,7 +14,7 @@ from ...mesh import Mesh
 from ...normalise import normalised
 from ...tolerances import DEFAULT, NEARLY_DEVELOPABLE, PARAMETER_SLACK, Tolerances
 from .assemble import assemble
-from .collapses import collapse_splinters
+from .collapses import _border_vertices, _touching, collapse_splinters
 from .flips import flip_triangles
 from .maps import HopMaps, hop_maps
 from .pairing import pair_triangles
@@ -598,11 +598,7 @@ def _warn_share(mesh: Mesh, warnings: list[str], torsal: int, even: list[str], r
 def _where_not_quads(mesh: Mesh, area: np.ndarray, off: np.ndarray, total: float) -> str:
     """Where the area outside quads lies: the border band, and the strips holding most of the rest."""
     keys, uses = mesh.edge_uses()
-    n = mesh.n_vertices
-    border_v = np.zeros(n, bool)
-    border_v[keys[uses == 1] // n] = border_v[keys[uses == 1] % n] = True
-    face_of = np.repeat(np.arange(mesh.n_faces), mesh.valences)
-    at_border = np.bincount(face_of[border_v[mesh.face_indices]], minlength=mesh.n_faces) > 0
+    at_border = _touching(mesh, _border_vertices(keys, uses, mesh.n_vertices))
     band = float(area[off & at_border].sum()) / total
     said = [f"{band:.0%} at the border"]
     gen = mesh.vertex_data.get("generator")

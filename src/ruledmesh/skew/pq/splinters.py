@@ -30,7 +30,7 @@ from ..._arrays import diagonal
 from ...analysis.faces import face_min_angles, face_normals
 from ...mesh import FaceKind, Mesh
 from ...tolerances import BORDER_TRIM_MAX_GAP, ON_BORDER, RESTART_ANGLE_DEG, SPLINTER_AREA_WORTH
-from .collapses import _apply, _near, _rejoined, _segment_distance
+from .collapses import _apply, _border_vertices, _near, _rejoined, _rings, _segment_distance, _touching
 from .pairing import _rebuilt
 
 __all__ = ["open_walled_splinters", "snap_to_border", "trim_border_needles"]
@@ -153,8 +153,7 @@ def trim_border_needles(mesh: Mesh, scale: float | None = None) -> tuple[Mesh, i
     if not cand.any():
         return mesh, 0
     keys, uses = mesh.edge_uses()
-    on_border = np.zeros(n, bool)
-    on_border[keys[uses == 1] // n] = on_border[keys[uses == 1] % n] = True
+    on_border = _border_vertices(keys, uses, int(n))
     cand &= on_border
     if not cand.any():
         return mesh, 0
@@ -309,17 +308,6 @@ def _short_edges(mesh: Mesh, bad: np.ndarray) -> np.ndarray:
     return np.stack([T[r, k], T[r, (k + 1) % 3]], axis=1)
 
 
-def _rings(mesh: Mesh, faces: np.ndarray, k: int) -> np.ndarray:
-    """(F,) bool: ``faces`` and the faces within ``k`` vertex rings of them."""
-    face_of = np.repeat(np.arange(mesh.n_faces), mesh.valences)
-    out = faces.copy()
-    for _ in range(k):
-        mark = np.zeros(mesh.n_vertices, bool)
-        mark[mesh.face_indices[out[face_of]]] = True
-        out = np.bincount(face_of[mark[mesh.face_indices]], minlength=mesh.n_faces) > 0
-    return out
-
-
 def open_walled_splinters(mesh: Mesh, fatten: Callable[[Mesh, np.ndarray, float], Mesh],
                           measured: tuple[np.ndarray, np.ndarray] | None = None) -> tuple[Mesh, int]:
     """Cut the quads beside the splinters left into triangles and fatten again.
@@ -365,7 +353,9 @@ def open_walled_splinters(mesh: Mesh, fatten: Callable[[Mesh, np.ndarray, float]
         beside = _beside(mesh, amin, bad, ends=k > 0)
         if not beside.any():
             continue
-        region = _rings(mesh, beside | bad, 2)
+        # The faces within two vertex rings of them.
+        corners = mesh.face_indices[np.repeat(beside | bad, mesh.valences)]
+        region = _touching(mesh, _rings(mesh, corners, 1))
         sub, frozen = _region(mesh, region)
         cut, quads, kinds = _cut_quads(sub, beside[region])
         done = fatten(cut, frozen, scale)
