@@ -26,7 +26,7 @@ from dataclasses import dataclass
 __all__ = ["BORDER_TRIM_MAX_GAP", "BRENTQ_XTOL", "COLLINEAR", "COLLINEAR_SQ", "CONGRUENCE_ANGLE_DEG", "CONVERGED",
            "COLLAPSE_MAX_SAG", "DEFAULT", "DEPTH_BIAS", "FLIP_ACTIVE_DEG", "FLIP_MAX_BEND_DEG", "FLIP_MAX_SAG",
            "FLIP_MIN_GAIN_DEG", "FLOAT32_WARNING", "INTERIOR", "KKT_REGULARISATION",
-           "MIN_EXTENT", "MIN_HALF_ANGLE", "NEARLY_DEVELOPABLE", "MIN_RELATIVE_EXTENT", "MITRE_FLOOR", "OCCT_FACE",
+           "MIN_EXTENT", "MIN_HALF_ANGLE", "MIN_RELATIVE_EXTENT", "MITRE_FLOOR", "NEARLY_DEVELOPABLE", "OCCT_FACE",
            "ON_BORDER", "PARAMETER_SLACK", "PLANARITY_FLOOR", "RESTART_ANGLE_DEG", "ROOT_RTOL", "ROOT_XTOL",
            "ROUNDING", "ROUNDING_SQ", "SAME_ROOT", "SETTLED", "SNAP_GAP", "SPLINTER_AREA_WORTH", "TINY",
            "ULPS", "Tolerances"]
@@ -200,6 +200,6 @@ NEARLY_DEVELOPABLE = 1e-3
 # share at 301 x 300 for 24 fewer splinters out of 200 000 faces.
 RESTART_ANGLE_DEG = 3.0
 #: What a splinter is worth in quad area share when the mesher trades one for the other
-#: (opening the quads around a splinter, keeping a round of added generators): 0.6 % of the
-#: mesh's area per face below RESTART_ANGLE_DEG.
+#: (opening the quads around a splinter): 0.6 % of the mesh's area per face below
+#: RESTART_ANGLE_DEG.
 SPLINTER_AREA_WORTH = 0.006

@@ -101,7 +101,6 @@ def _refined(rulings, mesh, options: dict):
     quarter of the area in triangles, a tenth with a planarity tolerance), and
     among equals has fewer splinters, then the larger quad share.
     """
-
     from ..rulings import dense_grid
 
     surface = getattr(rulings, "surface", None)
@@ -205,7 +204,7 @@ def _splinters(mesh) -> int:
 
 
 def _trouble_strips(mesh, m: int, area: np.ndarray, share: float = _TROUBLE_SHARE) -> np.ndarray:
-    """Strips (between generators i and i + 1) whose area is mostly outside quads.
+    """Strips (between generators i and i + 1) with more than ``share`` of their area outside quads.
 
     ``area`` : (F,) the face areas of ``mesh``.
     """
