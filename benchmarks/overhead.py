@@ -52,27 +52,10 @@ if str(HERE) not in sys.path:
 
 from surfaces import SURFACES  # noqa: E402
 
-TINY = """\
-name = "small"
-
-[curves.c1]
-type = "bspline"
-degree = 3
-points = [[0, 0, 0], [3, 1, 0], [6, -1, 0], [10, 0, 0]]
-
-[curves.c2]
-type = "polyline"
-points = [[0, 2, 4], [3, 4, 5], [6, 3, 3], [10, 3, 4]]
-
-[rulings]
-between = ["c1", "c2"]
-distribution = "parameter"
-count = 9
-
-[mesh]
-method = "pq"
-rows = 6
-"""
+# The small design of the tests (tests/_shared.py), so the figures follow the design the
+# designer tests build.
+sys.path.insert(0, str(HERE.parent / "tests"))
+from _shared import small_design  # noqa: E402
 
 
 def _calls(text: str) -> list[tuple[tuple, dict]]:
@@ -100,10 +83,10 @@ def cases() -> dict[str, list[tuple[tuple, dict]]]:
     from ruledmesh.web.session import DEFAULT_DESIGN
 
     a, b = SURFACES["skew"].generators(100)
-    return {"tiny": _calls(TINY + "refine = false\n"), "tiny_refine": _calls(TINY),
+    tiny = small_design()
+    return {"tiny": _calls(tiny + "refine = false\n"), "tiny_refine": _calls(tiny),
             "designer_default": _calls(DEFAULT_DESIGN),
-            "designer_100x100": _calls(TINY.replace("count = 9", "count = 101")
-                                       .replace("rows = 6", "rows = 100")),
+            "designer_100x100": _calls(small_design(count=101, rows=100)),
             "skew_100x100": [((a, b), {"rows": 100, "trim": True})]}
 
 
