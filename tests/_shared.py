@@ -7,7 +7,9 @@ not on ``sys.path``).
 
 from __future__ import annotations
 
-__all__ = ["SMALL_DESIGN", "small_design"]
+import numpy as np
+
+__all__ = ["SMALL_DESIGN", "bspline_design", "check_exact", "small_design"]
 
 
 def small_design(*, name: str = "small", count: int = 9, rows: int = 6) -> str:
@@ -40,3 +42,42 @@ rows = {rows}
 
 #: The default :func:`small_design` (nine generators, six rows).
 SMALL_DESIGN = small_design()
+
+
+def bspline_design(c1, c2, count, rows, extra=""):
+    """A design between two cubic B-splines through control points ``c1``, ``c2`` (5, 3)."""
+    return (f'[curves.c1]\ntype = "bspline"\ndegree = 3\npoints = {np.round(c1, 6).tolist()}\n'
+            f'[curves.c2]\ntype = "bspline"\ndegree = 3\npoints = {np.round(c2, 6).tolist()}\n'
+            f'[rulings]\nbetween = ["c1", "c2"]\ncount = {count}\n'
+            f"[mesh]\nrows = {rows}\n{extra}")
+
+
+def _segment_distance(p, a, b):
+    d = b - a
+    s = np.clip(np.einsum("pgi,gi->pg", p[:, None, :] - a[None], d) / np.einsum("gi,gi->g", d, d),
+                0.0, 1.0)
+    return np.linalg.norm(p[:, None, :] - (a[None] + s[..., None] * d[None]), axis=2)
+
+
+def check_exact(built, ptol=1e-12):
+    """The exact invariants of a §4.3 build: finite, planar, convex, no degenerate face, a
+    disc, every vertex on a generator, the patch's area within 2 %."""
+    from ruledmesh.analysis.faces import convexity, degenerate_faces, planarity
+
+    mesh = built.mesh
+    assert np.all(np.isfinite(mesh.vertices))
+    assert planarity(mesh).max() <= ptol
+    assert convexity(mesh).all()
+    assert not degenerate_faces(mesh).any()
+    assert mesh.euler_characteristic() == 1
+    r = built.rulings
+    on = _segment_distance(mesh.vertices, np.asarray(r.a), np.asarray(r.b)).min(axis=1)
+    assert on.max() <= 1e-9 * mesh.diagonal()
+    patch = built.reference.area()
+    assert abs(float(np.sum(_areas(mesh))) / patch - 1.0) < 0.02
+
+
+def _areas(mesh):
+    from ruledmesh.analysis.faces import face_areas
+
+    return face_areas(mesh)

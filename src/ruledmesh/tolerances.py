@@ -24,8 +24,8 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 __all__ = ["BORDER_TRIM_MAX_GAP", "BRENTQ_XTOL", "COLLINEAR", "COLLINEAR_SQ", "CONGRUENCE_ANGLE_DEG", "CONVERGED",
-           "COLLAPSE_MAX_SAG", "DEFAULT", "DEPTH_BIAS", "FLIP_ACTIVE_DEG", "FLIP_MAX_BEND_DEG", "FLIP_MAX_SAG",
-           "FLIP_MIN_GAIN_DEG", "FLOAT32_WARNING", "INTERIOR", "KKT_REGULARISATION",
+           "COLLAPSE_MAX_SAG", "DEFAULT", "DEPTH_BIAS", "FLAT_PAIR_MAX_SAG", "FLIP_ACTIVE_DEG", "FLIP_MAX_BEND_DEG",
+           "FLIP_MAX_SAG", "FLIP_MIN_GAIN_DEG", "FLOAT32_WARNING", "INTERIOR", "KKT_REGULARISATION",
            "MIN_EXTENT", "MIN_HALF_ANGLE", "MIN_RELATIVE_EXTENT", "MITRE_FLOOR", "NEARLY_DEVELOPABLE", "OCCT_FACE",
            "ON_BORDER", "PARAMETER_SLACK", "PLANARITY_FLOOR", "RESTART_ANGLE_DEG", "ROOT_RTOL", "ROOT_XTOL",
            "ROUNDING", "ROUNDING_SQ", "SAME_ROOT", "SETTLED", "SNAP_GAP", "SPLINTER_AREA_WORTH", "TINY",
@@ -190,6 +190,10 @@ COLLAPSE_MAX_SAG = 2.5e-4
 #: (ruledmesh.skew.pq.splinters.trim_border_needles) when it lies at most this share of
 #: the patch diagonal from their far edges: the patch stays within half the gap goal (2e-3).
 BORDER_TRIM_MAX_GAP = 1e-3
+#: A torsal band is spanned by one coplanar pair of generators (ruledmesh.design.torsal)
+#: only if the smooth surface between stays within this share of the patch diagonal from
+#: their plane: half the gap goal (2e-3).
+FLAT_PAIR_MAX_SAG = 1e-3
 #: A strip whose strip quads are planar within this (the planarity tolerance the mesher's
 #: warnings suggest) counts as nearly developable in a build's warnings.
 NEARLY_DEVELOPABLE = 1e-3

@@ -74,6 +74,8 @@ _TROUBLE_SHARE = 0.3
 # 13.2 % but with a splinter, and the small test design from three builds (68 ms) to five
 # (155 ms): so only while a goal is missed.
 _TROUBLE_SHARE_BROAD = 0.15
+# A torsal band reaches over the strips with more than this share outside quads (.torsal).
+_TROUBLE_SHARE_SPAN = 0.5
 _BROAD_ROUNDS = 1
 # Rounds go on while each puts this share more of the area in quads.
 _MIN_GAIN = 0.005
@@ -96,10 +98,15 @@ def _refined(rulings, mesh, options: dict):
     Rounds go on while they put more of the area in quads, stop once the mesh
     meets the goals with room, and from the third on run only while it misses
     one; when rounds stop helping, one more adds generators to the strips
-    with a smaller share outside quads (the border teeth).  Of the meshes made,
-    the one kept meets more of a fabricator's two goals (no splinter, at most a
-    quarter of the area in triangles, a tenth with a planarity tolerance), and
-    among equals has fewer splinters, then the larger quad share.
+    with a smaller share outside quads (the border teeth).
+
+    Where the twist changes sign, the same rounds also start from the
+    generators with each torsal band spanned by one coplanar pair
+    (:mod:`.torsal`: strip quads instead of the band's triangles; the user's
+    generators inside the band are left out).  Of all the meshes made, the one
+    kept meets more of a fabricator's two goals (no splinter, at most a quarter
+    of the area in triangles, a tenth with a planarity tolerance), and among
+    equals has fewer splinters, then the larger quad share.
     """
     from ..rulings import dense_grid
 
@@ -107,14 +114,37 @@ def _refined(rulings, mesh, options: dict):
     if surface is None or rulings.info.get("distribution") == "lines":
         return rulings, mesh
     grid, _ = dense_grid(len(rulings.u))
-    # The face areas of each mesh are measured once: the quad share decides whether the
-    # rounds go on, the strips' shares where the next one adds generators.
-    cur = (*_measured(mesh), rulings, mesh)
-    rounds = [(cur[0], _splinters(mesh), rulings, mesh)]
     user = len(rulings.u) - int(rulings.info.get("inserted", 0))
-    start = len(rulings.u)
     goal = _GOAL_TRIANGLES_TOLERANCE if options["planarity_tolerance"] > DEFAULT.planarity \
         else _GOAL_TRIANGLES
+    measured = _measured(mesh)
+    rounds = _rounds(rulings, mesh, measured, options, grid, user, goal)
+    spanned = _spanned(rulings, mesh, measured[1], options)
+    if spanned is not None:
+        sp_rulings, sp_mesh, sp_note = spanned
+        rounds += _rounds(sp_rulings, sp_mesh, _measured(sp_mesh), options, grid, user, goal, sp_note)
+    best = max(rounds, key=lambda r: _fabricable(r, goal))
+    added = int(best[2].info.get("inserted", 0)) - int(rulings.info.get("inserted", 0))
+    rulings, mesh = best[2], best[3]
+    notes = [best[4]] if best[4] else []
+    if added > 0:
+        notes.append(f"{added} generators of the smooth surface added where the rows needed them "
+                     f"({len(rulings.u)} in all, {user} given)")
+    if not notes:
+        return rulings, mesh
+    return rulings, mesh.with_info(warnings=list(mesh.info.get("warnings", [])) + notes)
+
+
+def _rounds(rulings, mesh, measured: tuple[float, np.ndarray], options: dict, grid: np.ndarray,
+            user: int, goal: float, note: str = "") -> list[tuple]:
+    """The meshes of the refinement rounds from ``rulings`` and its ``mesh``, the first included.
+
+    Each is ``(quad share, splinters, rulings, mesh, note)``; ``measured`` is the
+    quad share and (F,) face areas of ``mesh``.
+    """
+    surface = rulings.surface
+    cur = (*measured, rulings, mesh)
+    rounds = [(cur[0], _splinters(mesh), rulings, mesh, note)]
     bars = [_TROUBLE_SHARE] * _REFINE_ROUNDS + [_TROUBLE_SHARE_BROAD] * _BROAD_ROUNDS
     k = 0
     while k < len(bars):
@@ -125,7 +155,7 @@ def _refined(rulings, mesh, options: dict):
         room = _ROOM if k < _REFINE_ROUNDS - 1 else 1.0
         if rounds[-1][1] == 0 and 1.0 - share <= room * goal:
             break
-        candidate = _with_generators(cur_rulings, cur_mesh, area, bars[k], grid, surface, user,
+        candidate = _with_generators(cur_rulings, cur_mesh, area, bars[k], grid, surface,
                                      options["rows"])
         cand = None
         if candidate is not None:
@@ -142,26 +172,49 @@ def _refined(rulings, mesh, options: dict):
             k = next((i for i in range(k + 1, len(bars)) if bars[i] < bars[k]), len(bars))
             continue
         cur = cand
-        rounds.append((cand[0], _splinters(cand[3]), candidate, cand[3]))
+        rounds.append((cand[0], _splinters(cand[3]), candidate, cand[3], note))
         k += 1
-    best = max(rounds, key=lambda r: _fabricable(r, goal))
-    rulings, mesh = best[2], best[3]
-    added = len(rulings.u) - start
-    if added <= 0:
-        return rulings, mesh
-    note = (f"{added} generators of the smooth surface added where the rows needed them "
-            f"({len(rulings.u)} in all, {user} given)")
-    return rulings, mesh.with_info(warnings=list(mesh.info.get("warnings", [])) + [note])
+    return rounds
 
 
-def _with_generators(rulings, mesh, area: np.ndarray, bar: float, grid: np.ndarray, surface, user: int,
+def _spanned(rulings, mesh, area: np.ndarray, options: dict):
+    """``(rulings, mesh, note)`` with the torsal bands spanned by coplanar pairs, or None."""
+    from .torsal import span_torsal_bands, twist_changes
+
+    a, d = _generators(rulings)
+    scale = _diagonal(a, d)
+    if twist_changes(a, d, scale).size == 0:
+        return None
+    trouble = np.zeros(len(a) - 1, bool)
+    trouble[_trouble_strips(mesh, len(a), area, _TROUBLE_SHARE_SPAN)] = True
+    spanned, bands, left_out = span_torsal_bands(rulings, trouble, scale)
+    if spanned is None:
+        return None
+    try:
+        spanned_mesh = _mesh(spanned, options)
+    except GeometryError:
+        return None
+    shown = ", ".join(f"{p}-{q}" for p, q in bands)
+    note = (f"{len(bands)} torsal band{'s' * (len(bands) > 1)} spanned by one coplanar pair of "
+            f"generators each (generators {shown}, filled with strip quads; {left_out} generators "
+            "left out inside)")
+    return spanned, spanned_mesh, note
+
+
+def _with_generators(rulings, mesh, area: np.ndarray, bar: float, grid: np.ndarray, surface,
                      rows: int):
     """``rulings`` with one generator more in each strip of ``mesh`` whose share of the area
-    outside quads is above ``bar``, or None (no such strip, or the grid would grow too large)."""
+    outside quads is above ``bar``, or None (no such strip, or the grid would grow too large).
+
+    A strip between coplanar generators gets none: it is flat, and carries strip quads."""
     from dataclasses import replace
+
+    from ..hop import coplanarity
 
     u = np.asarray(rulings.u)
     strips = _trouble_strips(mesh, len(u), area, bar)
+    a, d = _generators(rulings)
+    strips = strips[np.abs(coplanarity(a, d, _diagonal(a, d))[strips]) > DEFAULT.degenerate]
     if strips.size == 0:
         return None
     lo = np.searchsorted(grid, u[strips], side="right")
@@ -172,10 +225,22 @@ def _with_generators(rulings, mesh, area: np.ndarray, bar: float, grid: np.ndarr
         return None
     new_u = np.unique(np.concatenate([u, mid]))
     creases = rulings.info.get("crease_generators")
-    info = {**rulings.info, "inserted": len(new_u) - user}
+    info = {**rulings.info, "inserted": int(rulings.info.get("inserted", 0)) + len(new_u) - len(u)}
     if creases:
         info["crease_generators"] = np.searchsorted(new_u, u[np.asarray(creases)]).tolist()
     return replace(rulings, a=surface.a(new_u), b=surface.b(new_u), u=new_u, info=info)
+
+
+def _generators(rulings) -> tuple[np.ndarray, np.ndarray]:
+    """The (m, 3) points and directions of the generators."""
+    a = np.asarray(rulings.a)
+    return a, np.asarray(rulings.b) - a
+
+
+def _diagonal(a: np.ndarray, d: np.ndarray) -> float:
+    """The diagonal of the generators' bounding box."""
+    p = np.r_[a, a + d]
+    return float(np.linalg.norm(p.max(0) - p.min(0)))
 
 
 def _measured(mesh) -> tuple[float, np.ndarray]:

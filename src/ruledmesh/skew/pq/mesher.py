@@ -187,12 +187,10 @@ def _torsal_cuts(a, d, scale, tol, creases, m):
     twist = coplanarity(a, d, scale)
     flat = np.abs(twist) <= tol.degenerate
     sign = np.sign(np.where(flat, 0.0, twist))
-    # Carry the last non-zero sign forward so a flat pair does not hide a change.
-    idx = np.where(sign != 0, np.arange(len(sign)), 0)
-    np.maximum.accumulate(idx, out=idx)
-    carried = sign[idx]
+    # A change across a flat pair needs no cut of its own: the flat strip is one already,
+    # and a second beside it would leave that strip to triangles.
     change = np.zeros(len(sign), bool)
-    change[1:] = (carried[1:] != carried[:-1]) & (carried[:-1] != 0) & (sign[1:] != 0)
+    change[1:] = (sign[1:] != sign[:-1]) & (sign[:-1] != 0) & (sign[1:] != 0)
     crease = np.zeros(len(sign), bool)
     if creases is not None:
         cr = np.asarray(creases, dtype=np.int64).reshape(-1)

@@ -1,0 +1,167 @@
+"""Torsal bands spanned by one exactly coplanar pair of generators.
+
+Where the twist of a skew surface changes sign (a torsal generator) the §4.3
+rows bunch towards the torsal point: the strips around it carry no rows and are
+closed by triangles.  Two generators that are coplanar carry planar quads of any
+division (paper §3.1), and the surface offers such pairs across every torsal
+generator: the twist ``f(u, v) = det(d(u), d(v), a(v) - a(u))`` of the pair
+``(u, v)`` is symmetric, vanishes to second order at ``u = v``, and its leading
+term at the midpoint is the twist there, which changes sign across the torsal
+generator.  So for a band of strips around it there is a pair ``(u, v)``
+straddling it with ``f(u, v) = 0`` exactly (to rounding), found by bracketing
+and Brent's method.  Where the design gives director curves the generators are
+ours to choose: the generators inside the band are left out and the pair bounds
+one flat strip, which the mesher fills with strip quads.  A pair is taken only
+if the smooth surface between stays within :data:`~ruledmesh.tolerances.FLAT_PAIR_MAX_SAG`
+of the patch diagonal from their plane.
+"""
+
+from __future__ import annotations
+
+from dataclasses import replace
+
+import numpy as np
+from scipy.optimize import brentq
+
+from ..hop import coplanarity
+from ..tolerances import FLAT_PAIR_MAX_SAG, ROOT_XTOL, TINY
+
+__all__ = ["span_torsal_bands", "twist_changes"]
+
+# How many strips a band may reach beyond the torsal strip on each side, how many
+# more strips the search for the partner generator may look across, and how many
+# samples it brackets the root with.
+_MAX_REACH = 1
+_SEARCH = 3
+_SAMPLES = 40
+
+
+def twist_changes(a: np.ndarray, d: np.ndarray, scale: float) -> np.ndarray:
+    """Generators ``k`` where strips ``k - 1`` and ``k`` twist in opposite senses.
+
+    Parameters
+    ----------
+    a, d : (m, 3) float64
+        Generator points and directions.
+    scale : float
+        The patch diagonal.
+
+    Returns
+    -------
+    (k,) int64
+    """
+    sign = np.sign(coplanarity(a, d, scale))
+    return np.flatnonzero((sign[1:] != sign[:-1]) & (sign[1:] != 0) & (sign[:-1] != 0)) + 1
+
+
+def _twist(surface, u: float, v: np.ndarray, scale: float) -> np.ndarray:
+    """(n,) scale-free twist of the pairs (u, v_k), as :func:`ruledmesh.hop.coplanarity`."""
+    uu = np.r_[u, v]
+    a, b = surface.a(uu), surface.b(uu)
+    d = b - a
+    vol = np.einsum("ij,ij->i", np.cross(d[0], d[1:]), a[1:] - a[0])
+    norms = np.linalg.norm(d, axis=1)
+    return vol / np.maximum(norms[0] * norms[1:] * scale, TINY)
+
+
+def _partner(surface, u: float, lo: float, hi: float, scale: float, last: bool) -> float | None:
+    """A ``v`` in [lo, hi] with the pair (u, v) coplanar: the first root (the last if ``last``)."""
+    grid = np.linspace(lo, hi, _SAMPLES)
+    f = _twist(surface, u, grid, scale)
+    ch = np.flatnonzero(np.sign(f[1:]) != np.sign(f[:-1]))
+    if ch.size == 0:
+        return None
+    k = int(ch[-1] if last else ch[0])
+    return float(brentq(lambda v: float(_twist(surface, u, np.array([v]), scale)[0]),
+                        grid[k], grid[k + 1], xtol=ROOT_XTOL))
+
+
+def _pair(surface, u: np.ndarray, lo: int, hi: int, scale: float) -> tuple[float, float] | None:
+    """The narrowest coplanar pair found spanning generators ``lo`` to ``hi``.
+
+    One end stays on a generator (first ``lo``, then ones further left) and the
+    partner is sought beyond the other end of the band.
+    """
+    m = len(u)
+    for left in range(lo, max(lo - _SEARCH, 0) - 1, -1):
+        v = _partner(surface, u[left], u[hi], u[min(hi + _SEARCH, m - 1)], scale, last=False)
+        if v is not None:
+            return float(u[left]), v
+        w = _partner(surface, u[hi], u[max(left - _SEARCH, 0)], u[left], scale, last=True)
+        if w is not None:
+            return w, float(u[hi])
+    return None
+
+
+def _sag(surface, pair: tuple[float, float], scale: float) -> float:
+    """Largest distance of the smooth surface between the pair from their plane, over ``scale``."""
+    ends = np.asarray(pair)
+    a, b = surface.a(ends), surface.b(ends)
+    d = b - a
+    n = np.cross(d[0], d[1])
+    if np.linalg.norm(n) <= 1e-9 * np.linalg.norm(d[0]) * np.linalg.norm(d[1]):
+        n = np.cross(d[0], a[1] - a[0])          # parallel pair: the plane through both
+    n = n / max(float(np.linalg.norm(n)), TINY)
+    s = np.linspace(ends[0], ends[1], 9)[1:-1]
+    t = np.linspace(0.0, 1.0, 5)
+    p = surface.point(s[:, None], t[None, :])
+    return float(np.abs((p - a[0]) @ n).max()) / scale
+
+
+def span_torsal_bands(rulings, trouble: np.ndarray, scale: float):
+    """``rulings`` with each torsal band spanned by one coplanar pair of generators.
+
+    Parameters
+    ----------
+    rulings : Rulings
+        With a smooth ``surface``.
+    trouble : (m - 1,) bool
+        Strips mostly outside quads in the mesh of ``rulings``: a band reaches
+        from the torsal generator over such strips (at most ``_MAX_REACH`` on
+        each side).
+    scale : float
+        The patch diagonal.
+
+    Returns
+    -------
+    rulings : Rulings or None
+        None where no band could be spanned.
+    bands : list of (int, int)
+        The generators of ``rulings`` (the new ones) that bound the flat strips.
+    left_out : int
+        Generators of the given ``rulings`` left out inside the bands.
+    """
+    surface = rulings.surface
+    u = np.asarray(rulings.u)
+    a = np.asarray(rulings.a)
+    d = np.asarray(rulings.b) - a
+    m = len(u)
+    creases = np.asarray(rulings.info.get("crease_generators") or [], dtype=np.int64)
+    keep = np.ones(m, bool)
+    pairs: list[tuple[float, float]] = []
+    for g in twist_changes(a, d, scale).tolist():
+        lo, hi = g - 1, g
+        while lo > 0 and trouble[lo - 1] and g - lo < _MAX_REACH:
+            lo -= 1
+        while hi < m - 2 and trouble[hi] and hi - g < _MAX_REACH - 1:
+            hi += 1
+        hi += 1
+        if lo < 1 or hi > m - 2 or (pairs and u[lo] <= pairs[-1][1]) \
+                or np.any((creases >= lo) & (creases <= hi)):
+            continue
+        pair = _pair(surface, u, lo, hi, scale)
+        if pair is None or _sag(surface, pair, scale) > FLAT_PAIR_MAX_SAG:
+            continue
+        pairs.append(pair)
+        keep &= ~((u > pair[0]) & (u < pair[1]))
+    if not pairs:
+        return None, [], 0
+    ends = np.asarray(pairs).reshape(-1)
+    new_u = np.unique(np.r_[u[keep], ends])
+    info = dict(rulings.info)
+    info["inserted"] = int(info.get("inserted", 0)) + int(np.isin(new_u, u, invert=True).sum())
+    if len(creases):
+        info["crease_generators"] = np.searchsorted(new_u, u[creases]).tolist()
+    bands = [(int(np.searchsorted(new_u, p)), int(np.searchsorted(new_u, q))) for p, q in pairs]
+    spanned = replace(rulings, a=surface.a(new_u), b=surface.b(new_u), u=new_u, info=info)
+    return spanned, bands, int((~keep).sum())
