@@ -80,7 +80,7 @@ def test_a_spanned_band_is_one_strip_of_exact_strip_quads():
     built = build_file(QUALITY / "right-conoid-wide-arc.toml")
     check_exact(built)
     mesh = built.mesh
-    said = [w for w in mesh.info["warnings"] if "spanned by one coplanar pair" in w]
+    said = [w for w in mesh.info["warnings"] if "spanned by a coplanar pair" in w]
     assert said, mesh.info["warnings"]
     strip = mesh.face_kind == FaceKind.STRIP
     assert strip.any() and planarity(mesh)[strip].max() <= 1e-12

@@ -121,12 +121,12 @@ def _refined(rulings, mesh, options: dict):
     rounds = _rounds(rulings, mesh, measured, options, grid, user, goal)
     spanned = _spanned(rulings, mesh, measured[1], options)
     if spanned is not None:
-        sp_rulings, sp_mesh, sp_note = spanned
-        rounds += _rounds(sp_rulings, sp_mesh, _measured(sp_mesh), options, grid, user, goal, sp_note)
+        sp_rulings, sp_mesh, sp_pairs = spanned
+        rounds += _rounds(sp_rulings, sp_mesh, _measured(sp_mesh), options, grid, user, goal, sp_pairs)
     best = max(rounds, key=lambda r: _fabricable(r, goal))
     added = int(best[2].info.get("inserted", 0)) - int(rulings.info.get("inserted", 0))
     rulings, mesh = best[2], best[3]
-    notes = [best[4]] if best[4] else []
+    notes = [_spanned_note(rulings, best[4])] if best[4] else []
     if added > 0:
         notes.append(f"{added} generators of the smooth surface added where the rows needed them "
                      f"({len(rulings.u)} in all, {user} given)")
@@ -136,15 +136,16 @@ def _refined(rulings, mesh, options: dict):
 
 
 def _rounds(rulings, mesh, measured: tuple[float, np.ndarray], options: dict, grid: np.ndarray,
-            user: int, goal: float, note: str = "") -> list[tuple]:
+            user: int, goal: float, pairs: tuple = ()) -> list[tuple]:
     """The meshes of the refinement rounds from ``rulings`` and its ``mesh``, the first included.
 
-    Each is ``(quad share, splinters, rulings, mesh, note)``; ``measured`` is the
-    quad share and (F,) face areas of ``mesh``.
+    Each is ``(quad share, splinters, rulings, mesh, pairs)``; ``measured`` is the
+    quad share and (F,) face areas of ``mesh``, ``pairs`` what :func:`_spanned` made of
+    ``rulings`` (empty if nothing).
     """
     surface = rulings.surface
     cur = (*measured, rulings, mesh)
-    rounds = [(cur[0], _splinters(mesh), rulings, mesh, note)]
+    rounds = [(cur[0], _splinters(mesh), rulings, mesh, pairs)]
     bars = [_TROUBLE_SHARE] * _REFINE_ROUNDS + [_TROUBLE_SHARE_BROAD] * _BROAD_ROUNDS
     k = 0
     while k < len(bars):
@@ -172,13 +173,17 @@ def _rounds(rulings, mesh, measured: tuple[float, np.ndarray], options: dict, gr
             k = next((i for i in range(k + 1, len(bars)) if bars[i] < bars[k]), len(bars))
             continue
         cur = cand
-        rounds.append((cand[0], _splinters(cand[3]), candidate, cand[3], note))
+        rounds.append((cand[0], _splinters(cand[3]), candidate, cand[3], pairs))
         k += 1
     return rounds
 
 
 def _spanned(rulings, mesh, area: np.ndarray, options: dict):
-    """``(rulings, mesh, note)`` with the torsal bands spanned by coplanar pairs, or None."""
+    """``(rulings, mesh, pairs)`` with the torsal bands spanned by coplanar pairs, or None.
+
+    ``pairs`` is ``((u, v), ...), left_out``: the parameters of each pair and how
+    many generators of ``rulings`` were left out inside them.
+    """
     from .torsal import span_torsal_bands, twist_changes
 
     a, d = _generators(rulings)
@@ -194,11 +199,18 @@ def _spanned(rulings, mesh, area: np.ndarray, options: dict):
         spanned_mesh = _mesh(spanned, options)
     except GeometryError:
         return None
-    shown = ", ".join(f"{p}-{q}" for p, q in bands)
-    note = (f"{len(bands)} torsal band{'s' * (len(bands) > 1)} spanned by one coplanar pair of "
-            f"generators each (generators {shown}, filled with strip quads; {left_out} generators "
-            "left out inside)")
-    return spanned, spanned_mesh, note
+    u = np.asarray(spanned.u)
+    return spanned, spanned_mesh, (tuple((float(u[p]), float(u[q])) for p, q in bands), left_out)
+
+
+def _spanned_note(rulings, pairs: tuple) -> str:
+    """What the build says of the torsal bands spanned by coplanar pairs (final generator indices)."""
+    ends, left_out = pairs
+    k = np.searchsorted(np.asarray(rulings.u), np.asarray(ends))
+    shown = ", ".join(f"{p}-{q}" for p, q in k.tolist())
+    return (f"{len(ends)} torsal band{'s' * (len(ends) > 1)} spanned by a coplanar pair of generators "
+            f"({shown}) and filled with strip quads; {left_out} given generator"
+            f"{'s' * (left_out != 1)} left out inside")
 
 
 def _with_generators(rulings, mesh, area: np.ndarray, bar: float, grid: np.ndarray, surface,
