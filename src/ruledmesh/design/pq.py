@@ -106,10 +106,9 @@ def _refined(rulings, mesh, options: dict):
     Where the twist changes sign, the same rounds also start from the
     generators with each torsal band spanned by one coplanar pair
     (:mod:`.torsal`: strip quads instead of the band's triangles; the user's
-    generators inside the band are left out).  Of all the meshes made, the one
-    kept meets more of a fabricator's two goals (no splinter, at most a quarter
-    of the area in triangles, a tenth with a planarity tolerance), and among
-    equals has fewer splinters, then the larger quad share.
+    generators inside the band are left out), and with a planarity tolerance,
+    where the meshes so far miss a goal, from the exact rows too.  Of all the
+    meshes made, the one kept is first by :func:`_fabricable`.
     """
     from ..rulings import dense_grid
 
