@@ -271,3 +271,11 @@ def test_share_warning_in_tolerance_mode_does_not_advise_the_tolerance():
     built = build_design(parse_design(text))
     said = [w for w in built.mesh.info["warnings"] if "of the area is not in quads" in w]
     assert said and "planarity_tolerance" not in said[0] and "more generators" in said[0]
+
+
+def test_no_warning_in_tolerance_mode_advises_the_tolerance():
+    """The Pluecker conoid at 1e-3: its generators without rows were still told to use it."""
+    text = (QUALITY / "plucker-conoid.toml").read_text().replace("[mesh]\n", "[mesh]\nplanarity_tolerance = 1e-3\n")
+    warnings = build_design(parse_design(text)).mesh.info["warnings"]
+    assert any("carry no §4.3 rows" in w for w in warnings)
+    assert not any("planarity_tolerance" in w for w in warnings), warnings

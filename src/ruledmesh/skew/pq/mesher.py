@@ -356,7 +356,7 @@ def pq_mesh(a, b, rows: int = 20, primary: int | str = "middle", option: int = 0
     parts = _build_all(plan, segs, primary, args.middle,
                        Division(rows, args.option, args.extend, args.max_extend), m)
     restarts = max(len([r for r in parts if len(r.left)]) - len([s for s in segs if s.hi - s.lo >= 2]), 0)
-    even = _even_ranges(parts, segs, warnings)
+    even = _even_ranges(parts, segs, warnings, exact=ptol <= tol.planarity)
     meet = np.r_[flat, False] | np.r_[False, flat]      # generators of a coplanar pair
     mesh = assemble(parts, a, d, args.trim, tol, ptol, warnings, scale, meet, rows=rows)
     mesh, fattening, measured = _fattened(mesh, ptol, tol)
@@ -534,8 +534,11 @@ def _say_cuts(flat: np.ndarray, change: np.ndarray, crease: np.ndarray,
     return torsal
 
 
-def _even_ranges(parts: list[Run], segs: list[_Segment], warnings: list[str]) -> list[str]:
-    """Generator ranges that carry an even division without hops (not the short segments)."""
+def _even_ranges(parts: list[Run], segs: list[_Segment], warnings: list[str],
+                 exact: bool = True) -> list[str]:
+    """Generator ranges that carry an even division without hops (not the short segments).
+
+    The warning suggests a planarity tolerance only in exact mode (``exact``)."""
     short = {(s.lo, s.hi) for s in segs if s.hi - s.lo < 2}
     out = []
     for r in parts:
@@ -546,8 +549,8 @@ def _even_ranges(parts: list[Run], segs: list[_Segment], warnings: list[str]) ->
     if out:
         warnings.append(f"generators {', '.join(out[:8])}{' ...' if len(out) > 8 else ''} carry no "
                         "§4.3 rows (the rows bunch along the generators there: nearly developable, "
-                        "or next to a torsal generator) and are closed by strip quads or triangles; "
-                        "planarity_tolerance = 1e-3 admits nearly planar strip quads there")
+                        "or next to a torsal generator) and are closed by strip quads or triangles"
+                        + "; planarity_tolerance = 1e-3 admits nearly planar strip quads there" * exact)
     return out
 
 
