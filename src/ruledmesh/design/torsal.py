@@ -9,9 +9,10 @@ generator: the twist ``f(u, v) = det(d(u), d(v), a(v) - a(u))`` of the pair
 term at the midpoint is the twist there, which changes sign across the torsal
 generator.  So for a band of strips around it there is a pair ``(u, v)``
 straddling it with ``f(u, v) = 0`` exactly (to rounding), found by bracketing
-and Brent's method.  Where the design gives director curves the generators are
-ours to choose: the generators inside the band are left out and the pair bounds
-one flat strip, which the mesher fills with strip quads.  A pair is taken only
+and Brent's method (:func:`ruledmesh.roots.brentq`, no scipy import).  Where
+the design gives director curves the generators are ours to choose: the
+generators inside the band are left out and the pair bounds one flat strip,
+which the mesher fills with strip quads.  A pair is taken only
 if the smooth surface between stays within :data:`~ruledmesh.tolerances.FLAT_PAIR_MAX_SAG`
 of the patch diagonal from their plane.
 """
@@ -21,9 +22,9 @@ from __future__ import annotations
 from dataclasses import replace
 
 import numpy as np
-from scipy.optimize import brentq
 
 from ..hop import coplanarity
+from ..roots import brentq
 from ..tolerances import FLAT_PAIR_MAX_SAG, ROOT_XTOL, TINY
 
 __all__ = ["span_torsal_bands", "twist_changes"]
