@@ -25,7 +25,7 @@ import numpy as np
 
 from ..hop import coplanarity
 from ..roots import brentq
-from ..tolerances import FLAT_PAIR_MAX_SAG, ROOT_XTOL, TINY
+from ..tolerances import DEFAULT, FLAT_PAIR_MAX_SAG, ROOT_XTOL, TINY
 
 __all__ = ["span_torsal_bands", "twist_changes"]
 
@@ -100,7 +100,7 @@ def _sag(surface, pair: tuple[float, float], scale: float) -> float:
     a, b = surface.a(ends), surface.b(ends)
     d = b - a
     n = np.cross(d[0], d[1])
-    if np.linalg.norm(n) <= 1e-9 * np.linalg.norm(d[0]) * np.linalg.norm(d[1]):
+    if np.linalg.norm(n) <= DEFAULT.degenerate * np.linalg.norm(d[0]) * np.linalg.norm(d[1]):
         n = np.cross(d[0], a[1] - a[0])          # parallel pair: the plane through both
     n = n / max(float(np.linalg.norm(n)), TINY)
     s = np.linspace(ends[0], ends[1], 9)[1:-1]
