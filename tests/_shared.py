@@ -61,7 +61,7 @@ def _segment_distance(p, a, b):
 
 def check_exact(built, ptol=1e-12):
     """The exact invariants of a §4.3 build: finite, planar, convex, no degenerate face, a
-    disc, every vertex on a generator, the patch's area within 2 %."""
+    disc turned one way, every vertex on a generator, the patch's area within 2 %."""
     from ruledmesh.analysis.faces import convexity, degenerate_faces, planarity
 
     mesh = built.mesh
@@ -70,6 +70,10 @@ def check_exact(built, ptol=1e-12):
     assert convexity(mesh).all()
     assert not degenerate_faces(mesh).any()
     assert mesh.euler_characteristic() == 1
+    # One orientation: no edge run through twice in the same direction.
+    idx = mesh.face_indices.astype(np.int64)
+    key = idx * mesh.n_vertices + idx[mesh.next_corners()]
+    assert np.unique(key).size == key.size
     r = built.rulings
     on = _segment_distance(mesh.vertices, np.asarray(r.a), np.asarray(r.b)).min(axis=1)
     assert on.max() <= 1e-9 * mesh.diagonal()

@@ -104,3 +104,42 @@ def test_spanned_bands_are_coplanar_on_random_director_curves(y1, y2, count):
         assert bands == [] and left_out == 0
         return
     _check_pairs(rulings, spanned, bands, left_out)
+
+
+def _same_sense_edges(mesh):
+    """Edges two faces run through in the same direction (their normals disagree)."""
+    idx = mesh.face_indices.astype(np.int64)
+    key = idx * mesh.n_vertices + idx[mesh.next_corners()]
+    return int((np.unique(key, return_counts=True)[1] > 1).sum())
+
+
+def test_strip_quads_turn_the_way_their_neighbours_do():
+    """The strip quads and the fill between runs were laid out by their strips and came out
+    turned against the runs' faces (8 edges on right-conoid-wide-arc, 170 on
+    skew-bspline-51x30 at 1e-3): every face now turns one way."""
+    for name in ("right-conoid-wide-arc.toml", "skew-bspline-51x30-tol1e-3.toml", "corner-90deg-tol1e-3.toml",
+                 "twisted-helices-tol1e-3.toml", "near-cone.toml"):
+        mesh = build_file(QUALITY / name).mesh
+        assert _same_sense_edges(mesh) == 0, name
+
+
+def test_large_strip_quads_are_cut_to_the_size_of_the_other_panels():
+    """right-conoid-wide-arc: the spanned strip had 4 quads of 17 times the median quad's
+    area; they are cut along lines between its generators, the triangles beside them fanned,
+    with no face turned, no angle lowered and the share in quads as it was."""
+    from ruledmesh.analysis.faces import convexity, face_normals
+
+    built = build_file(QUALITY / "right-conoid-wide-arc.toml")
+    check_exact(built)
+    mesh = built.mesh
+    assert mesh.info["cut"] >= 2
+    area = face_normals(mesh)[1]
+    quads = mesh.valences == 4
+    strip = mesh.face_kind == FaceKind.STRIP
+    assert area[strip].max() <= 10.0 * np.median(area[quads & ~strip])
+    assert convexity(mesh).all() and _same_sense_edges(mesh) == 0
+    assert face_min_angles(mesh).min() >= 3.0
+    # The members along the cut generators still run end to end, one piece per edge.
+    g = np.asarray(mesh.vertex_data["generator"])
+    assert np.all(g[mesh.members[:, 0]] == g[mesh.members[:, 1]])
+    assert np.all(g[mesh.members[:, 0]] == mesh.member_id)

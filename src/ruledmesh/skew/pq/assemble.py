@@ -279,12 +279,34 @@ def _first_of_equal_rows(key: np.ndarray) -> np.ndarray:
     return out
 
 
+def _one_sense(faces: list[np.ndarray], T: np.ndarray, G: np.ndarray) -> list[np.ndarray]:
+    """The face arrays with every face turning the way the first non-empty one's faces do
+    in the (generator, t) plane.
+
+    The surface is an immersion of that plane, so one sense there is one orientation of
+    the mesh; the strip quads and the fill between runs are laid out by their strips,
+    not by the runs' rows, and came out turned the other way where the rows run down
+    the generators (their normals flipped against their neighbours').
+    """
+    signed = []
+    for f in faces:
+        g, t = G[f].astype(np.float64), T[f]
+        signed.append((g * np.roll(t, -1, axis=1) - np.roll(g, -1, axis=1) * t).sum(axis=1))
+    ref = next((np.sign(s[s != 0].sum()) for s in signed if np.any(s != 0)), 0.0)
+    if ref == 0.0:
+        return faces
+    # Reversed from the same first corner: (a, b, c, d) -> (a, d, c, b).
+    return [np.where((s * ref < 0)[:, None], np.roll(f[:, ::-1], 1, axis=1), f) if f.size else f
+            for f, s in zip(faces, signed, strict=True)]
+
+
 def to_mesh(V, T, G, faces, kinds, warnings, chain, gstart, scale, meet=None) -> Mesh:
     """Mesh from fixed-valence face arrays; members along the generators.
 
     ``meet`` (m,) bool marks generators that meet a neighbour (a coplanar pair):
     their vertices may coincide with the neighbour's and are merged with them.
     """
+    faces = _one_sense(faces, T, G)
     starts = [np.zeros(1, np.int64)]
     total = 0
     for f in faces:

@@ -18,6 +18,7 @@ from .collapses import _border_vertices, _touching, collapse_splinters
 from .flips import flip_triangles
 from .maps import HopMaps, hop_maps
 from .pairing import pair_triangles
+from .panels import split_strip_quads
 from .runs import (
     BYTES_PER_GRID_POINT,
     MAX_GRID_POINTS,
@@ -315,10 +316,10 @@ def pq_mesh(a, b, rows: int = 20, primary: int | str = "middle", option: int = 0
         consecutive vertices; ``vertex_data`` holds ``t`` and ``generator``;
         ``info["warnings"]`` says what was replaced or could not be covered,
         ``info["runs"]`` how many runs the generators were meshed in, and
-        ``flips``, ``collapsed``, ``paired``, ``snapped``, ``trimmed``, ``opened`` how many
-        edge flips, collapses, paired quads, corners snapped onto the border, end
-        points trimmed with their needles and quads opened around splinters the
-        fattening made.
+        ``flips``, ``collapsed``, ``paired``, ``snapped``, ``trimmed``, ``opened``, ``cut`` how
+        many edge flips, collapses, paired quads, corners snapped onto the border, end
+        points trimmed with their needles, quads opened around splinters the fattening
+        made and strip quads cut to the size of the other panels.
 
     Raises
     ------
@@ -360,6 +361,9 @@ def pq_mesh(a, b, rows: int = 20, primary: int | str = "middle", option: int = 0
     meet = np.r_[flat, False] | np.r_[False, flat]      # generators of a coplanar pair
     mesh = assemble(parts, a, d, args.trim, tol, ptol, warnings, scale, meet, rows=rows)
     mesh, fattening, measured = _fattened(mesh, ptol, tol)
+    mesh, fattening["cut"] = split_strip_quads(mesh)
+    if fattening["cut"]:
+        measured = None
     _warn_share(mesh, warnings, torsal.size, even, restarts, m, rows, (a, d, ptol), measured)
     _warn_splinters(mesh, warnings, torsal, measured)
     if kept.size < m_given:

@@ -1,0 +1,213 @@
+"""Strip quads split to the size of the other panels.
+
+Two coplanar generators carry planar quads of any division (paper §3.1), so a
+strip quad far larger than the mesh's other panels (a torsal band spanned by one
+coplanar pair, with the runs beside it leaving few vertices on its generators)
+can be cut along lines between the two generators into smaller planar quads:
+points are added on both generator edges at the same fractions.  The face on the
+other side of each generator edge must take the new points too; a triangle is
+fanned from its opposite corner (still planar, still a triangle); where a fan would
+lower the mesh's smallest angle (or make a splinter), or the face is not a
+triangle, the quad is cut into fewer pieces or not at all.  Every new point lies
+on its generator, and members along the generators are split with the edges.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from ...mesh import FaceKind, Mesh
+from ...tolerances import RESTART_ANGLE_DEG
+
+__all__ = ["split_strip_quads"]
+
+# A strip quad is cut where its area is above this many times the median quad area, into
+# pieces near that median (at most _MAX_PIECES).
+_LARGE = 3.0
+_MAX_PIECES = 8
+
+
+def split_strip_quads(mesh: Mesh) -> tuple[Mesh, int]:
+    """Cut strip quads much larger than the median quad into pieces along their generators.
+
+    Parameters
+    ----------
+    mesh : Mesh
+        A §4.3 mesh with ``vertex_data["generator"]`` and ``vertex_data["t"]``.
+
+    Returns
+    -------
+    Mesh
+        The mesh with the large strip quads cut (new faces at the end).
+    int
+        Number of strip quads cut.
+    """
+    from ...analysis.faces import face_min_angles, face_normals
+
+    if mesh.n_faces == 0 or "generator" not in mesh.vertex_data:
+        return mesh, 0
+    quads = mesh.valences == 4
+    strip = np.flatnonzero(quads & (mesh.face_kind == FaceKind.STRIP))
+    if strip.size == 0:
+        return mesh, 0
+    area = face_normals(mesh)[1]
+    usual = area[quads & (mesh.face_kind != FaceKind.STRIP)]
+    median = float(np.median(usual if usual.size else area[quads]))
+    big = strip[area[strip] > _LARGE * median]
+    if big.size == 0 or median <= 0.0:
+        return mesh, 0
+    pieces = np.clip(np.rint(area[big] / median), 2, _MAX_PIECES).astype(np.int64)
+    corners = _strip_corners(mesh, big)
+    # The fans never lower the mesh's smallest angle (nor go below the splinter bar).
+    floor = max(RESTART_ANGLE_DEG, float(face_min_angles(mesh).min()))
+    pieces = _fitting(mesh, corners, pieces, floor)
+    keep = pieces > 1
+    if not keep.any():
+        return mesh, 0
+    return _cut(mesh, big[keep], corners[keep], pieces[keep]), int(keep.sum())
+
+
+def _strip_corners(mesh: Mesh, faces: np.ndarray) -> np.ndarray:
+    """(k, 4) corners ``a0, a1, b1, b0`` of strip quads: ``a0 a1`` and ``b1 b0`` on generators."""
+    idx = mesh.face_indices[mesh.face_offsets[faces][:, None] + np.arange(4)]
+    gen = np.asarray(mesh.vertex_data["generator"])[idx]
+    turn = gen[:, 0] != gen[:, 1]
+    idx[turn] = np.roll(idx[turn], -1, axis=1)
+    return idx
+
+
+def _neighbours(mesh: Mesh, a: np.ndarray, b: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """For each edge ``a -> b`` of a face: the face using ``b -> a`` (-1: none) and its corner
+    opposite the edge if it is a triangle (-1 otherwise)."""
+    n = np.int64(mesh.n_vertices)
+    idx = mesh.face_indices
+    nxt = idx[mesh.next_corners()]
+    key = idx * n + nxt
+    order = np.argsort(key, kind="stable")
+    want = b.astype(np.int64) * n + a
+    pos = np.searchsorted(key[order], want)
+    pos = np.minimum(pos, len(order) - 1)
+    found = key[order][pos] == want
+    corner = np.where(found, order[pos], -1)
+    face_of = np.repeat(np.arange(mesh.n_faces), mesh.valences)
+    face = np.where(found, face_of[np.maximum(corner, 0)], -1)
+    tri = found & (mesh.valences[np.maximum(face, 0)] == 3)
+    # In a triangle (b, a, x) the corner after a is x.
+    after = mesh.next_corners()[mesh.next_corners()[np.maximum(corner, 0)]]
+    apex = np.where(tri, idx[after], -1)
+    return face, apex
+
+
+def _fitting(mesh: Mesh, corners: np.ndarray, pieces: np.ndarray, floor: float) -> np.ndarray:
+    """Pieces each quad can be cut into: its neighbours across the generator edges are
+    triangles (or the border) whose fans keep every angle at or above ``floor`` (degrees)."""
+    from ...analysis.faces import min_corner_angles
+
+    V = mesh.vertices
+    out = pieces.copy()
+    for a, b in ((corners[:, 0], corners[:, 1]), (corners[:, 2], corners[:, 3])):
+        face, apex = _neighbours(mesh, a, b)
+        out[(face >= 0) & (apex < 0)] = 1
+        # The fan's triangles (apex, b_j, a_j) for each cut: the largest count that keeps them.
+        for k in range(_MAX_PIECES, 1, -1):
+            sel = np.flatnonzero((out >= k) & (apex >= 0))
+            if sel.size == 0:
+                continue
+            s = np.arange(k + 1) / k
+            P = V[a[sel], None, :] + s[None, :, None] * (V[b[sel]] - V[a[sel]])[:, None, :]
+            tris = np.stack([np.broadcast_to(V[apex[sel], None, :], P[:, 1:].shape), P[:, 1:], P[:, :-1]],
+                            axis=2)
+            flat = tris.reshape(-1, 3)
+            worst = min_corner_angles(flat, np.arange(len(flat)).reshape(-1, 3)).reshape(len(sel), k).min(axis=1)
+            out[sel[worst < floor]] = k - 1
+    return out
+
+
+def _cut(mesh: Mesh, faces: np.ndarray, corners: np.ndarray, pieces: np.ndarray) -> Mesh:
+    """The mesh with each strip quad ``a0 a1 b1 b0`` cut into ``pieces`` and the triangles
+    across its generator edges fanned (new faces at the end, each face's sense kept)."""
+    V = mesh.vertices
+    t = np.asarray(mesh.vertex_data["t"])
+    gen = np.asarray(mesh.vertex_data["generator"])
+    a0, a1, b1, b0 = corners.T
+    # Points along a0 -> a1 and b0 -> b1 at the same fractions, ends included.
+    m = pieces
+    inner = m - 1
+    first = mesh.n_vertices + np.r_[0, np.cumsum(2 * inner)[:-1]]
+    s = np.concatenate([np.arange(1, k) / k for k in m.tolist()])
+    owner = np.repeat(np.arange(len(m)), inner)
+
+    def points(p, q):
+        return V[p[owner]] + s[:, None] * (V[q[owner]] - V[p[owner]]), t[p[owner]] + s * (t[q[owner]] - t[p[owner]])
+
+    pa, ta = points(a0, a1)
+    pb, tb = points(b0, b1)
+    ranks = _ranges(inner)
+    ia = first[owner] + ranks                      # new points on a, then those on b, per quad
+    ib = ia + inner[owner]
+    vertices = np.empty((mesh.n_vertices + 2 * len(s), 3))
+    vertices[:mesh.n_vertices] = V
+    vertices[ia], vertices[ib] = pa, pb
+    tt = np.empty(len(vertices))
+    tt[:mesh.n_vertices] = t
+    tt[ia], tt[ib] = ta, tb
+    gg = np.empty(len(vertices), dtype=gen.dtype)
+    gg[:mesh.n_vertices] = gen
+    gg[ia], gg[ib] = gen[a0[owner]], gen[b0[owner]]
+    chain_a = [np.r_[a0[j], ia[owner == j], a1[j]] for j in range(len(m))]
+    chain_b = [np.r_[b0[j], ib[owner == j], b1[j]] for j in range(len(m))]
+    drop = np.zeros(mesh.n_faces, bool)
+    drop[faces] = True
+    polys = [np.stack([ca[:-1], ca[1:], cb[1:], cb[:-1]], axis=1) for ca, cb in zip(chain_a, chain_b, strict=True)]
+    kinds = [np.full(len(p), FaceKind.STRIP) for p in polys]
+    for chains, (p, q), forward in ((chain_a, (a0, a1), False), (chain_b, (b1, b0), True)):
+        face, apex = _neighbours(mesh, p, q)
+        for j in np.flatnonzero(apex >= 0).tolist():
+            c = chains[j]
+            fan = np.stack([np.full(len(c) - 1, apex[j]), c[:-1], c[1:]], axis=1)
+            polys.append(fan if forward else fan[:, [0, 2, 1]])
+            kinds.append(np.full(len(fan), mesh.face_kind[face[j]]))
+            drop[face[j]] = True
+    members, member_id = _split_members(mesh, chain_a + chain_b)
+    keep = np.flatnonzero(~drop)
+    valence = mesh.valences[keep]
+    kept = mesh.face_indices[np.repeat(mesh.face_offsets[keep], valence) + _ranges(valence)]
+    sizes = np.concatenate([valence] + [np.full(len(p), p.shape[1]) for p in polys])
+    indices = np.concatenate([kept] + [p.reshape(-1) for p in polys])
+    kind = np.concatenate([mesh.face_kind[keep]] + [k.astype(mesh.face_kind.dtype) for k in kinds])
+    return Mesh.from_arrays(vertices, np.r_[0, np.cumsum(sizes)], indices, kind, members=members,
+                            member_id=member_id, vertex_data={"t": tt, "generator": gg},
+                            info=dict(mesh.info))
+
+
+def _ranges(counts: np.ndarray) -> np.ndarray:
+    """0 .. c - 1 for each count, concatenated."""
+    total = int(counts.sum())
+    starts = np.repeat(np.cumsum(counts) - counts, counts)
+    return np.arange(total) - starts
+
+
+def _split_members(mesh: Mesh, chains: list[np.ndarray]) -> tuple[np.ndarray, np.ndarray]:
+    """Members along the cut generator edges replaced by their pieces (same member ids)."""
+    members, ids = mesh.members, mesh.member_id
+    if members.size == 0:
+        return members, ids
+    n = np.int64(mesh.n_vertices)
+    key = np.minimum(members[:, 0], members[:, 1]) * n + np.maximum(members[:, 0], members[:, 1])
+    order = np.argsort(key)
+    out_m, out_i = [], []
+    gone = np.zeros(len(members), bool)
+    for c in chains:
+        p, q = int(c[0]), int(c[-1])
+        want = min(p, q) * n + max(p, q)
+        pos = int(np.searchsorted(key[order], want))
+        if pos >= len(order) or key[order][pos] != want:
+            continue
+        row = int(order[pos])
+        gone[row] = True
+        seq = c if members[row, 0] == p else c[::-1]
+        out_m.append(np.stack([seq[:-1], seq[1:]], axis=1))
+        out_i.append(np.full(len(seq) - 1, ids[row]))
+    if not out_m:
+        return members, ids
+    return (np.concatenate([members[~gone]] + out_m), np.concatenate([ids[~gone]] + out_i))
