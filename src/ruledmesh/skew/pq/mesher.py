@@ -361,9 +361,6 @@ def pq_mesh(a, b, rows: int = 20, primary: int | str = "middle", option: int = 0
     meet = np.r_[flat, False] | np.r_[False, flat]      # generators of a coplanar pair
     mesh = assemble(parts, a, d, args.trim, tol, ptol, warnings, scale, meet, rows=rows)
     mesh, fattening, measured = _fattened(mesh, ptol, tol)
-    mesh, fattening["cut"] = split_strip_quads(mesh)
-    if fattening["cut"]:
-        measured = None
     _warn_share(mesh, warnings, torsal.size, even, restarts, m, rows, (a, d, ptol), measured)
     _warn_splinters(mesh, warnings, torsal, measured)
     if kept.size < m_given:
@@ -396,7 +393,8 @@ def _cut(a, d, rows, ptol, scale, tol, creases, crease_generators, warnings):
 def _fattened(mesh: Mesh, ptol: float, tol: Tolerances) -> tuple[Mesh, dict[str, int], tuple | None]:
     """Flip the triangles for their angles, collapse what flips cannot fatten, pair the
     triangles in tolerance mode, flip what is left; then the splinters left: corners a
-    sliver from the border snapped onto it, quads walling a splinter in opened.
+    sliver from the border snapped onto it, quads walling a splinter in opened; last, strip
+    quads much larger than the other panels cut.
 
     The third result: the (F,) smallest angles and areas of the faces of the mesh
     returned, where the opening measured them and left the mesh as it was (else None).
@@ -420,8 +418,9 @@ def _fattened(mesh: Mesh, ptol: float, tol: Tolerances) -> tuple[Mesh, dict[str,
     if opened:
         mesh, more = _paired(mesh, ptol, tol)
         paired += more
+    mesh, cut = split_strip_quads(mesh)
     return mesh, {"flips": flips, "collapsed": collapsed, "paired": paired, "snapped": snapped,
-                  "trimmed": trimmed, "opened": opened}, (measured if mesh is before else None)
+                  "trimmed": trimmed, "opened": opened, "cut": cut}, (measured if mesh is before else None)
 
 
 def _reflipped(mesh: Mesh, frozen: np.ndarray, scale: float) -> Mesh:
