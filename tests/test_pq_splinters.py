@@ -202,3 +202,18 @@ def test_region_pieces_are_the_connected_components(n, data):
     k, ref = connected_components(coo_matrix((np.ones(m), (a, b)), shape=(n, n)), directed=False)
     assert mine.min(initial=0) == 0 and len(np.unique(mine)) == k
     assert len(set(zip(mine.tolist(), ref.tolist()))) == k
+
+
+def test_snap_measures_a_part_of_the_mesh_with_unused_vertices():
+    """Found by the fuzz test: four generators a micrometre long, one row, untrimmed. The snap
+    measured its candidates on the faces around them only, whose compaction dropped more
+    vertices than the snapped ones, and the new indices pointed past the end (IndexError)."""
+    import numpy as np
+
+    from ruledmesh.analysis.faces import planarity
+    from ruledmesh.pq import pq_mesh
+
+    a = np.array([[1e-6, 0, 1e-6], [1e-6, 1 / 3e7, 1 / 3e6], [1e-6, 4 / 3e7, -1 / 3e6], [1e-6, 3e-7, -1e-6]])
+    b = np.array([[0, 1e-6, 3e-6], [1 / 6e6, 2 / 3e6, 9.4 / 3e6], [1 / 3e6, 1 / 3e6, 3.2e-6], [5e-7, 0, 3.2e-6]])
+    mesh = pq_mesh(a, b, rows=1, option=0, trim=False, primary="middle", extend=0.0)
+    assert mesh.n_faces and planarity(mesh).max() <= 1e-12

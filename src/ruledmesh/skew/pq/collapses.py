@@ -229,7 +229,7 @@ def _rejoined(members: np.ndarray, member_id: np.ndarray, removed: np.ndarray, n
 
 def _apply(mesh: Mesh, v: np.ndarray, u: np.ndarray) -> tuple[Mesh, np.ndarray]:
     """The mesh with each ``v`` collapsed into its ``u`` and the emptied vertices dropped,
-    and the new index of each old vertex."""
+    and the new index of each old vertex (-1 for those dropped)."""
     n = mesh.n_vertices
     remap = np.arange(n)
     remap[v] = u
@@ -242,7 +242,12 @@ def _apply(mesh: Mesh, v: np.ndarray, u: np.ndarray) -> tuple[Mesh, np.ndarray]:
     # The triangles on each edge u v now repeat u: they go with the repeated corner.
     out = Mesh(mesh.vertices, mesh.face_offsets, remap[mesh.face_indices], kind, members, member_id,
                mesh.vertex_data, mesh.info).drop_repeated_corners()
-    return out.compact(), np.cumsum(~removed) - 1
+    # The new index as compact() numbers them: it drops every vertex no face or member
+    # uses, not only the collapsed ones (a part of a mesh, a face gone with its corner).
+    used = np.zeros(n, bool)
+    used[out.face_indices] = True
+    used[out.members.reshape(-1)] = True
+    return out.compact(), np.where(used, np.cumsum(used) - 1, -1)
 
 
 def collapse_splinters(mesh: Mesh, removable: np.ndarray | None = None,
