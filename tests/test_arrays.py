@@ -7,7 +7,7 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 from hypothesis.extra import numpy as hnp
 
-from ruledmesh._arrays import cross, norm, unique
+from ruledmesh._arrays import cross, norm, ranks, unique
 
 
 def _same(x: np.ndarray, y: np.ndarray) -> bool:
@@ -80,3 +80,10 @@ def test_first_of_equal_rows_is_unique_rows(key):
 
     _, first, inverse = np.unique(key, axis=0, return_index=True, return_inverse=True)
     assert np.array_equal(_first_of_equal_rows(key), first[inverse.reshape(-1)])
+
+
+@given(st.lists(st.integers(0, 6), max_size=30))
+def test_ranks_are_the_aranges_of_the_counts(counts):
+    got = ranks(np.asarray(counts, dtype=np.int64))
+    want = np.concatenate([np.arange(c) for c in counts]) if counts else np.zeros(0)
+    assert got.shape == want.shape and np.array_equal(got, want)

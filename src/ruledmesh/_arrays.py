@@ -1,4 +1,5 @@
-"""Array helpers that numpy has, but slowly: sorted unique values, cross products, box diagonals.
+"""Array helpers that numpy has, but slowly: sorted unique values, cross products, box diagonals;
+and the ranks within groups of given sizes, which numpy has not.
 
 numpy 2.3+ finds the unique values of a plain ``np.unique(x)`` through a hash
 table and sorts them afterwards; on arrays of a million edge keys or vertex
@@ -12,7 +13,7 @@ from __future__ import annotations
 
 import numpy as np
 
-__all__ = ["cross", "diagonal", "norm", "unique"]
+__all__ = ["cross", "diagonal", "norm", "ranks", "unique"]
 
 
 def unique(values: np.ndarray) -> np.ndarray:
@@ -95,3 +96,17 @@ def diagonal(points: np.ndarray) -> float:
     lo = np.array([points[:, j].min() for j in range(k)])
     hi = np.array([points[:, j].max() for j in range(k)])
     return float(np.linalg.norm(hi - lo))
+
+
+def ranks(counts: np.ndarray) -> np.ndarray:
+    """``0 .. c - 1`` for each count ``c``, concatenated: the rank of each element in its group.
+
+    Parameters
+    ----------
+    counts : (k,) int, >= 0
+
+    Returns
+    -------
+    (sum(counts),) int
+    """
+    return np.arange(int(counts.sum())) - np.repeat(np.cumsum(counts) - counts, counts)

@@ -28,6 +28,7 @@ from typing import Any
 
 import numpy as np
 
+from .._arrays import ranks
 from ..design import Design, build_design, parse_design
 from ..errors import DesignError, ExportError, ParameterError
 from ..mesh import FaceKind, Mesh
@@ -260,9 +261,8 @@ def fan_triangles(mesh: Mesh) -> tuple[np.ndarray, np.ndarray]:
     val = np.diff(off)
     ntri = np.maximum(val - 2, 0)
     face = np.repeat(np.arange(len(val)), ntri)
-    # j = 1 .. k-2 within each face: running index minus the start of the face's run.
-    start = np.repeat(np.cumsum(ntri) - ntri, ntri)
-    j = np.arange(face.size) - start + 1
+    # j = 1 .. k-2 within each face.
+    j = ranks(ntri) + 1
     base = off[:-1][face]
     tris = np.stack([idx[base], idx[base + j], idx[base + j + 1]], axis=1)
     return tris, face

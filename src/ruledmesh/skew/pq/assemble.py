@@ -12,6 +12,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from ..._arrays import ranks
 from ...mesh import FaceKind, Mesh
 from ...tolerances import RESTART_ANGLE_DEG, ROUNDING, Tolerances
 from .ladders import free_edges, ladder_points
@@ -114,7 +115,7 @@ def _strip_quads(V, chain, gstart, gaps: Gaps, ptol: float):
     ge = np.flatnonzero(even)
     n = gaps.na[ge]
     gid = np.repeat(np.arange(len(ge)), n)
-    q = np.arange(gid.size) - np.repeat(np.cumsum(n) - n, n)
+    q = ranks(n)
     s = gaps.strip[ge][gid]
     ka = gstart[s] + gaps.k0[ge][gid] + q
     lb = gstart[s + 1] + gaps.l0[ge][gid] + q
@@ -168,7 +169,7 @@ def _notch_fans(chain, gstart, L, R, sel_l, sel_r, CG, jump_l, jump_r) -> np.nda
         f = np.flatnonzero(sel)
         n = jump[f]
         fid = np.repeat(f, n)
-        q = np.arange(fid.size) - np.repeat(np.cumsum(n) - n, n)
+        q = ranks(n)
         lo = gstart[CG[fid]] + rank_of[half[fid, lo_col]] + q
         apex = half[fid, apex_col]
         # Left halves run apex, lo, hi; right halves lo, apex, hi (the same orientation).

@@ -17,6 +17,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from ..._arrays import ranks
 from ...tolerances import TINY
 from .strips import Gaps
 
@@ -123,7 +124,7 @@ def ladder_points(V, T, G, chain, gstart, free, a, d, rows: int):
     if n_new.sum() == 0:
         return V, T, G, chain, gstart, 0
     e = np.repeat(np.arange(j.size), n_new)
-    k = np.arange(e.size) - np.repeat(np.cumsum(n_new) - n_new, n_new) + 1
+    k = ranks(n_new) + 1
     tn = t0[e] + (t1[e] - t0[e]) * k / (n_new[e] + 1)
     gn = g[e]
     base = len(V)

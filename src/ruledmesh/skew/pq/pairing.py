@@ -18,6 +18,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from ..._arrays import ranks
 from ...mesh import FaceKind, Mesh
 
 __all__ = ["adjacent_triangles", "pair_triangles"]
@@ -151,7 +152,7 @@ def _rebuilt(mesh: Mesh, keep: np.ndarray, quads: np.ndarray, quad_kind: np.ndar
     kept = np.flatnonzero(keep)
     starts = mesh.face_offsets[kept]
     n = val[kept]
-    flat = np.repeat(starts, n) + (np.arange(n.sum()) - np.repeat(np.cumsum(n) - n, n))
+    flat = np.repeat(starts, n) + ranks(n)
     idx = np.concatenate([mesh.face_indices[flat], quads.reshape(-1)]).astype(np.int64)
     counts = np.concatenate([n, np.full(len(quads), 4)])
     off = np.zeros(len(counts) + 1, np.int64)

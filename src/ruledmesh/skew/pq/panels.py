@@ -16,7 +16,8 @@ from __future__ import annotations
 
 import numpy as np
 
-from ...mesh import FaceKind, Mesh
+from ..._arrays import ranks
+from ...mesh import FaceKind, Mesh, offsets_from_valences
 from ...tolerances import RESTART_ANGLE_DEG
 
 __all__ = ["split_strip_quads"]
@@ -81,8 +82,8 @@ def _neighbours(mesh: Mesh, a: np.ndarray, b: np.ndarray) -> tuple[np.ndarray, n
     opposite the edge if it is a triangle (-1 otherwise)."""
     n = np.int64(mesh.n_vertices)
     idx = mesh.face_indices
-    nxt = idx[mesh.next_corners()]
-    key = idx * n + nxt
+    following = mesh.next_corners()
+    key = idx * n + idx[following]
     order = np.argsort(key, kind="stable")
     want = b.astype(np.int64) * n + a
     pos = np.searchsorted(key[order], want)
@@ -93,7 +94,7 @@ def _neighbours(mesh: Mesh, a: np.ndarray, b: np.ndarray) -> tuple[np.ndarray, n
     face = np.where(found, face_of[np.maximum(corner, 0)], -1)
     tri = found & (mesh.valences[np.maximum(face, 0)] == 3)
     # In a triangle (b, a, x) the corner after a is x.
-    after = mesh.next_corners()[mesh.next_corners()[np.maximum(corner, 0)]]
+    after = following[following[np.maximum(corner, 0)]]
     apex = np.where(tri, idx[after], -1)
     return face, apex
 
@@ -142,8 +143,7 @@ def _cut(mesh: Mesh, faces: np.ndarray, corners: np.ndarray, pieces: np.ndarray)
 
     pa, ta = points(a0, a1)
     pb, tb = points(b0, b1)
-    ranks = _ranges(inner)
-    ia = first[owner] + ranks                      # new points on a, then those on b, per quad
+    ia = first[owner] + ranks(inner)           # new points on a, then those on b, per quad
     ib = ia + inner[owner]
     vertices = np.empty((mesh.n_vertices + 2 * len(s), 3))
     vertices[:mesh.n_vertices] = V
@@ -169,22 +169,13 @@ def _cut(mesh: Mesh, faces: np.ndarray, corners: np.ndarray, pieces: np.ndarray)
             kinds.append(np.full(len(fan), mesh.face_kind[face[j]]))
             drop[face[j]] = True
     members, member_id = _split_members(mesh, chain_a + chain_b)
-    keep = np.flatnonzero(~drop)
-    valence = mesh.valences[keep]
-    kept = mesh.face_indices[np.repeat(mesh.face_offsets[keep], valence) + _ranges(valence)]
-    sizes = np.concatenate([valence] + [np.full(len(p), p.shape[1]) for p in polys])
-    indices = np.concatenate([kept] + [p.reshape(-1) for p in polys])
-    kind = np.concatenate([mesh.face_kind[keep]] + [k.astype(mesh.face_kind.dtype) for k in kinds])
-    return Mesh.from_arrays(vertices, np.r_[0, np.cumsum(sizes)], indices, kind, members=members,
+    kept = mesh.select_faces(~drop)
+    sizes = np.concatenate([kept.valences] + [np.full(len(p), p.shape[1]) for p in polys])
+    indices = np.concatenate([kept.face_indices] + [p.reshape(-1) for p in polys])
+    kind = np.concatenate([kept.face_kind] + [k.astype(mesh.face_kind.dtype) for k in kinds])
+    return Mesh.from_arrays(vertices, offsets_from_valences(sizes), indices, kind, members=members,
                             member_id=member_id, vertex_data={"t": tt, "generator": gg},
                             info=dict(mesh.info))
-
-
-def _ranges(counts: np.ndarray) -> np.ndarray:
-    """0 .. c - 1 for each count, concatenated."""
-    total = int(counts.sum())
-    starts = np.repeat(np.cumsum(counts) - counts, counts)
-    return np.arange(total) - starts
 
 
 def _split_members(mesh: Mesh, chains: list[np.ndarray]) -> tuple[np.ndarray, np.ndarray]:

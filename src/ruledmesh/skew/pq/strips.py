@@ -15,6 +15,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from ..._arrays import ranks
 from ...kernels import wanted
 from ...tolerances import ON_BORDER, SNAP_GAP, TINY
 
@@ -230,8 +231,8 @@ def zippers(V, T, chain, gstart, strip, k0, l0, na, nb) -> np.ndarray:
         return np.zeros((0, 3), np.int64)
     gid_a = np.repeat(np.arange(ng), na)
     gid_b = np.repeat(np.arange(ng), nb)
-    ka = np.arange(gid_a.size) - np.repeat(np.cumsum(na) - na, na)   # 0..na-1 within the gap
-    lb = np.arange(gid_b.size) - np.repeat(np.cumsum(nb) - nb, nb)
+    ka = ranks(na)   # 0..na-1 within the gap
+    lb = ranks(nb)
     A = lambda g, k: chain[gstart[strip[g]] + k]
     B = lambda g, l: chain[gstart[strip[g] + 1] + l]
     key_a = T[A(gid_a, k0[gid_a] + ka + 1)]
