@@ -4,7 +4,7 @@ from pathlib import Path
 
 import numpy as np
 from _shared import bspline_design as _design  # a helper module of tests/ (see conftest.py)
-from _shared import check_exact
+from _shared import check_exact, same_sense_edges
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
@@ -106,13 +106,6 @@ def test_spanned_bands_are_coplanar_on_random_director_curves(y1, y2, count):
     _check_pairs(rulings, spanned, bands, left_out)
 
 
-def _same_sense_edges(mesh):
-    """Edges two faces run through in the same direction (their normals disagree)."""
-    idx = mesh.face_indices.astype(np.int64)
-    key = idx * mesh.n_vertices + idx[mesh.next_corners()]
-    return int((np.unique(key, return_counts=True)[1] > 1).sum())
-
-
 def test_strip_quads_turn_the_way_their_neighbours_do():
     """The strip quads and the fill between runs were laid out by their strips and came out
     turned against the runs' faces (8 edges on right-conoid-wide-arc, 170 on
@@ -120,7 +113,7 @@ def test_strip_quads_turn_the_way_their_neighbours_do():
     for name in ("right-conoid-wide-arc.toml", "skew-bspline-51x30-tol1e-3.toml", "corner-90deg-tol1e-3.toml",
                  "twisted-helices-tol1e-3.toml", "near-cone.toml"):
         mesh = build_file(QUALITY / name).mesh
-        assert _same_sense_edges(mesh) == 0, name
+        assert same_sense_edges(mesh) == 0, name
 
 
 def test_large_strip_quads_are_cut_to_the_size_of_the_other_panels():
@@ -137,7 +130,7 @@ def test_large_strip_quads_are_cut_to_the_size_of_the_other_panels():
     quads = mesh.valences == 4
     strip = mesh.face_kind == FaceKind.STRIP
     assert area[strip].max() <= 10.0 * np.median(area[quads & ~strip])
-    assert convexity(mesh).all() and _same_sense_edges(mesh) == 0
+    assert convexity(mesh).all() and same_sense_edges(mesh) == 0
     assert face_min_angles(mesh).min() >= 3.0
     # The members along the cut generators still run end to end, one piece per edge.
     g = np.asarray(mesh.vertex_data["generator"])

@@ -21,7 +21,7 @@ import numpy as np
 from ._arrays import cross as _cross
 from .tolerances import ROUNDING, TINY
 
-__all__ = ["hop", "landing_maps", "crossing_maps", "coplanarity", "apply_map"]
+__all__ = ["hop", "landing_maps", "crossing_maps", "coplanarity", "sense_changes", "apply_map"]
 
 
 def _dot(x: np.ndarray, y: np.ndarray) -> np.ndarray:
@@ -157,6 +157,20 @@ def coplanarity(a: np.ndarray, d: np.ndarray, scale: float) -> np.ndarray:
     vol = _dot(_cross(d[:-1], d[1:]), a[1:] - a[:-1])
     norms = np.linalg.norm(d, axis=1)
     return vol / np.maximum(norms[:-1] * norms[1:] * scale, TINY)
+
+
+def sense_changes(twist: np.ndarray, flat: np.ndarray) -> np.ndarray:
+    """(m - 1,) bool: strips that twist in the other sense than the strip before them.
+
+    ``twist`` is :func:`coplanarity`; ``flat`` (m - 1,) bool marks the coplanar
+    pairs, which have no sense: a change across one needs no cut of its own (the
+    flat strip is one already, and a second beside it would leave that strip to
+    triangles).
+    """
+    sign = np.sign(np.where(flat, 0.0, twist))
+    change = np.zeros(len(sign), bool)
+    change[1:] = (sign[1:] != sign[:-1]) & (sign[:-1] != 0) & (sign[1:] != 0)
+    return change
 
 
 def apply_map(M: np.ndarray, tau: np.ndarray) -> tuple[np.ndarray, np.ndarray]:

@@ -7,6 +7,7 @@ from typing import Any
 
 import numpy as np
 
+from .._arrays import diagonal
 from .._validation import check_bool, check_float, check_int, check_keys, describe
 from ..budget import MAX_COUNT
 from ..errors import DesignError, GeometryError
@@ -205,12 +206,13 @@ def _spanned(rulings, mesh, area: np.ndarray, options: dict):
     from .torsal import span_torsal_bands, twist_changes
 
     a, d = _generators(rulings)
-    scale = _diagonal(a, d)
-    if twist_changes(a, d, scale).size == 0:
+    scale = diagonal(np.r_[a, a + d])
+    changes = twist_changes(a, d, scale)
+    if changes.size == 0:
         return None
     trouble = np.zeros(len(a) - 1, bool)
     trouble[_trouble_strips(mesh, len(a), area, _TROUBLE_SHARE_SPAN)] = True
-    spanned, bands, left_out = span_torsal_bands(rulings, trouble, scale)
+    spanned, bands, left_out = span_torsal_bands(rulings, trouble, scale, changes)
     if spanned is None:
         return None
     try:
@@ -244,7 +246,7 @@ def _with_generators(rulings, mesh, area: np.ndarray, bar: float, grid: np.ndarr
     u = np.asarray(rulings.u)
     strips = _trouble_strips(mesh, len(u), area, bar)
     a, d = _generators(rulings)
-    strips = strips[np.abs(coplanarity(a, d, _diagonal(a, d))[strips]) > DEFAULT.degenerate]
+    strips = strips[np.abs(coplanarity(a, d, diagonal(np.r_[a, a + d]))[strips]) > DEFAULT.degenerate]
     if strips.size == 0:
         return None
     lo = np.searchsorted(grid, u[strips], side="right")
@@ -265,12 +267,6 @@ def _generators(rulings) -> tuple[np.ndarray, np.ndarray]:
     """The (m, 3) points and directions of the generators."""
     a = np.asarray(rulings.a)
     return a, np.asarray(rulings.b) - a
-
-
-def _diagonal(a: np.ndarray, d: np.ndarray) -> float:
-    """The diagonal of the generators' bounding box."""
-    p = np.r_[a, a + d]
-    return float(np.linalg.norm(p.max(0) - p.min(0)))
 
 
 def _measured(mesh) -> tuple[float, np.ndarray]:

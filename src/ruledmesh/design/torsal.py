@@ -23,7 +23,7 @@ from dataclasses import replace
 
 import numpy as np
 
-from ..hop import coplanarity
+from ..hop import coplanarity, sense_changes
 from ..roots import brentq
 from ..tolerances import DEFAULT, FLAT_PAIR_MAX_SAG, ROOT_XTOL, TINY
 
@@ -40,6 +40,10 @@ _SAMPLES = 40
 def twist_changes(a: np.ndarray, d: np.ndarray, scale: float) -> np.ndarray:
     """Generators ``k`` where strips ``k - 1`` and ``k`` twist in opposite senses.
 
+    Unlike the mesher's cuts (:func:`ruledmesh.hop.sense_changes` with the coplanar pairs
+    taken as senseless), a change across a strip that is flat to the degenerate
+    tolerance counts: a pair spanning it and its neighbours is still worth trying.
+
     Parameters
     ----------
     a, d : (m, 3) float64
@@ -51,18 +55,17 @@ def twist_changes(a: np.ndarray, d: np.ndarray, scale: float) -> np.ndarray:
     -------
     (k,) int64
     """
-    sign = np.sign(coplanarity(a, d, scale))
-    return np.flatnonzero((sign[1:] != sign[:-1]) & (sign[1:] != 0) & (sign[:-1] != 0)) + 1
+    twist = coplanarity(a, d, scale)
+    return np.flatnonzero(sense_changes(twist, np.zeros(len(twist), bool)))
 
 
 def _twist(surface, u: float, v: np.ndarray, scale: float) -> np.ndarray:
-    """(n,) scale-free twist of the pairs (u, v_k), as :func:`ruledmesh.hop.coplanarity`."""
-    uu = np.r_[u, v]
-    a, b = surface.a(uu), surface.b(uu)
-    d = b - a
-    vol = np.einsum("ij,ij->i", np.cross(d[0], d[1:]), a[1:] - a[0])
-    norms = np.linalg.norm(d, axis=1)
-    return vol / np.maximum(norms[0] * norms[1:] * scale, TINY)
+    """(n,) scale-free twist of the pairs (u, v_k): :func:`ruledmesh.hop.coplanarity` of
+    the generators u, v_0, u, v_1, ... taken pair by pair."""
+    uu = np.empty(2 * len(v))
+    uu[0::2], uu[1::2] = u, v
+    a = surface.a(uu)
+    return coplanarity(a, surface.b(uu) - a, scale)[0::2]
 
 
 def _partner(surface, u: float, lo: float, hi: float, scale: float, last: bool) -> float | None:
@@ -109,7 +112,7 @@ def _sag(surface, pair: tuple[float, float], scale: float) -> float:
     return float(np.abs((p - a[0]) @ n).max()) / scale
 
 
-def span_torsal_bands(rulings, trouble: np.ndarray, scale: float):
+def span_torsal_bands(rulings, trouble: np.ndarray, scale: float, changes: np.ndarray | None = None):
     """``rulings`` with each torsal band spanned by one coplanar pair of generators.
 
     Parameters
@@ -122,6 +125,8 @@ def span_torsal_bands(rulings, trouble: np.ndarray, scale: float):
         each side).
     scale : float
         The patch diagonal.
+    changes : (k,) int, optional
+        :func:`twist_changes` of ``rulings``, if the caller has them.
 
     Returns
     -------
@@ -140,7 +145,7 @@ def span_torsal_bands(rulings, trouble: np.ndarray, scale: float):
     creases = np.asarray(rulings.info.get("crease_generators") or [], dtype=np.int64)
     keep = np.ones(m, bool)
     pairs: list[tuple[float, float]] = []
-    for g in twist_changes(a, d, scale).tolist():
+    for g in (twist_changes(a, d, scale) if changes is None else changes).tolist():
         lo, hi = g - 1, g
         while lo > 0 and trouble[lo - 1] and g - lo < _MAX_REACH:
             lo -= 1

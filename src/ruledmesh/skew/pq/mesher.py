@@ -9,7 +9,7 @@ import numpy as np
 from ..._arrays import unique
 from ..._validation import check_bool, check_float, check_int, check_points, describe
 from ...errors import GeometryError, ParameterError
-from ...hop import coplanarity
+from ...hop import coplanarity, sense_changes
 from ...mesh import Mesh
 from ...normalise import normalised
 from ...tolerances import DEFAULT, NEARLY_DEVELOPABLE, PARAMETER_SLACK, Tolerances
@@ -187,12 +187,8 @@ def _torsal_cuts(a, d, scale, tol, creases, m):
     """Torsal strips: coplanar pairs (flat), the twist changing sign (change), creases."""
     twist = coplanarity(a, d, scale)
     flat = np.abs(twist) <= tol.degenerate
-    sign = np.sign(np.where(flat, 0.0, twist))
-    # A change across a flat pair needs no cut of its own: the flat strip is one already,
-    # and a second beside it would leave that strip to triangles.
-    change = np.zeros(len(sign), bool)
-    change[1:] = (sign[1:] != sign[:-1]) & (sign[:-1] != 0) & (sign[1:] != 0)
-    crease = np.zeros(len(sign), bool)
+    change = sense_changes(twist, flat)
+    crease = np.zeros(len(twist), bool)
     if creases is not None:
         cr = np.asarray(creases, dtype=np.int64).reshape(-1)
         if cr.size and (cr.min() < 0 or cr.max() >= m - 1):
