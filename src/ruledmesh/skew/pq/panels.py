@@ -59,13 +59,16 @@ def split_strip_quads(mesh: Mesh) -> tuple[Mesh, int]:
         return mesh, 0
     pieces = np.clip(np.rint(area[big] / median), 2, _MAX_PIECES).astype(np.int64)
     corners = _strip_corners(mesh, big)
+    # The faces across the two generator edges a0 -> a1 and b1 -> b0.
+    across = [_neighbours(mesh, corners[:, 0], corners[:, 1]), _neighbours(mesh, corners[:, 2], corners[:, 3])]
     # The fans never lower the mesh's smallest angle (nor go below the splinter bar).
     floor = max(RESTART_ANGLE_DEG, float(face_min_angles(mesh).min()))
-    pieces = _fitting(mesh, corners, pieces, floor)
+    pieces = _fitting(mesh, corners, pieces, across, floor)
     keep = pieces > 1
     if not keep.any():
         return mesh, 0
-    return _cut(mesh, big[keep], corners[keep], pieces[keep]), int(keep.sum())
+    across = [(face[keep], apex[keep]) for face, apex in across]
+    return _cut(mesh, big[keep], corners[keep], pieces[keep], across), int(keep.sum())
 
 
 def _strip_corners(mesh: Mesh, faces: np.ndarray) -> np.ndarray:
@@ -99,15 +102,16 @@ def _neighbours(mesh: Mesh, a: np.ndarray, b: np.ndarray) -> tuple[np.ndarray, n
     return face, apex
 
 
-def _fitting(mesh: Mesh, corners: np.ndarray, pieces: np.ndarray, floor: float) -> np.ndarray:
-    """Pieces each quad can be cut into: its neighbours across the generator edges are
-    triangles (or the border) whose fans keep every angle at or above ``floor`` (degrees)."""
+def _fitting(mesh: Mesh, corners: np.ndarray, pieces: np.ndarray, across: list, floor: float) -> np.ndarray:
+    """Pieces each quad can be cut into: its neighbours across the generator edges
+    (``across``: :func:`_neighbours` of each) are triangles (or the border) whose fans keep
+    every angle at or above ``floor`` (degrees)."""
     from ...analysis.faces import min_corner_angles
 
     V = mesh.vertices
     out = pieces.copy()
-    for a, b in ((corners[:, 0], corners[:, 1]), (corners[:, 2], corners[:, 3])):
-        face, apex = _neighbours(mesh, a, b)
+    for (a, b), (face, apex) in zip(((corners[:, 0], corners[:, 1]), (corners[:, 2], corners[:, 3])), across,
+                                    strict=True):
         out[(face >= 0) & (apex < 0)] = 1
         # The fan's triangles (apex, b_j, a_j) for each cut: the largest count that keeps them.
         for k in range(_MAX_PIECES, 1, -1):
@@ -124,9 +128,9 @@ def _fitting(mesh: Mesh, corners: np.ndarray, pieces: np.ndarray, floor: float) 
     return out
 
 
-def _cut(mesh: Mesh, faces: np.ndarray, corners: np.ndarray, pieces: np.ndarray) -> Mesh:
+def _cut(mesh: Mesh, faces: np.ndarray, corners: np.ndarray, pieces: np.ndarray, across: list) -> Mesh:
     """The mesh with each strip quad ``a0 a1 b1 b0`` cut into ``pieces`` and the triangles
-    across its generator edges fanned (new faces at the end, each face's sense kept)."""
+    across its generator edges (``across``) fanned (new faces at the end, each face's sense kept)."""
     V = mesh.vertices
     t = np.asarray(mesh.vertex_data["t"])
     gen = np.asarray(mesh.vertex_data["generator"])
@@ -160,8 +164,7 @@ def _cut(mesh: Mesh, faces: np.ndarray, corners: np.ndarray, pieces: np.ndarray)
     drop[faces] = True
     polys = [np.stack([ca[:-1], ca[1:], cb[1:], cb[:-1]], axis=1) for ca, cb in zip(chain_a, chain_b, strict=True)]
     kinds = [np.full(len(p), FaceKind.STRIP) for p in polys]
-    for chains, (p, q), forward in ((chain_a, (a0, a1), False), (chain_b, (b1, b0), True)):
-        face, apex = _neighbours(mesh, p, q)
+    for chains, (face, apex), forward in zip((chain_a, chain_b), across, (False, True), strict=True):
         for j in np.flatnonzero(apex >= 0).tolist():
             c = chains[j]
             fan = np.stack([np.full(len(c) - 1, apex[j]), c[:-1], c[1:]], axis=1)
