@@ -56,12 +56,12 @@ def test_tolerance_mode_keeps_the_exact_mesh_where_it_has_more_quads():
 
 def test_tolerance_mode_misses_the_goals_by_the_least_on_a_hard_surface():
     """skew-bspline-b at 40 x 30 with planarity_tolerance = 1e-3: the mesh kept had 53 % of the
-    area in triangles and no splinter. Now 8 % with one face at 1.6 degrees: both meet one goal,
-    and that face costs five points of area, less than the 6 points above 10 % of the mesh
-    with 16 % and none."""
+    area in triangles and no splinter; then 8 % with one face at 1.6 degrees (that face costs
+    five points of area, less than the 6 points above 10 % of a mesh with 16 % and none).
+    With the torsal bands spanned among denser generators a mesh with 10.6 % and no splinter
+    is made: it misses the share by 0.6 points, less than the splinter's five, and is kept."""
     built = _variant("skew-bspline-b-51x30.toml", 40, 30, tolerance=1e-3)
     mesh = built.mesh
     assert planarity(mesh).max() <= 1e-3
-    assert 1.0 - area_shares(mesh)["quads"] <= 0.10
-    angles = face_min_angles(mesh)
-    assert (angles < 3.0).sum() <= 1 and angles.min() >= 1.5
+    assert 1.0 - area_shares(mesh)["quads"] <= 0.11
+    assert face_min_angles(mesh).min() >= 3.0

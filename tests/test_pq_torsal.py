@@ -64,14 +64,62 @@ def test_span_torsal_bands_gives_coplanar_pairs_on_the_right_conoid():
     _check_pairs(rulings, spanned, bands, left_out)
 
 
-def test_a_pair_whose_strip_would_leave_the_surface_is_refused():
-    """On the Pluecker conoid the surface bulges between any pair across its torsal
-    generators by more than the bound at this spacing: no band is spanned."""
+def test_the_sag_of_a_pair_counts_the_border_curves_within_its_plane():
+    """A pair's strip is a planar quadrilateral with straight ends: where the director curves
+    bow away from those ends within the plane, that is a gap of the mesh as much as a bulge
+    out of it.  A flat patch between a circular arc and a line: no bulge, and the sag is the
+    arc's chordal sag (it was measured as zero)."""
+
+    class Flat:
+        r = 10.0
+
+        def a(self, u):
+            th = np.asarray(u, float)
+            return np.stack([self.r * np.cos(th), self.r * np.sin(th), 0.0 * th], axis=-1)
+
+        def b(self, u):
+            th = np.asarray(u, float)
+            return np.stack([0.5 * self.r * np.cos(th), 0.5 * self.r * np.sin(th), 0.0 * th], axis=-1)
+
+        def point(self, u, t):
+            u, t = np.broadcast_arrays(np.asarray(u, float), np.asarray(t, float))
+            return self.a(u) + t[..., None] * (self.b(u) - self.a(u))
+
+    u0, u1 = 0.2, 0.6
+    chord = Flat.r * (1.0 - np.cos((u1 - u0) / 2))
+    sag = _sag(Flat(), (u0, u1), 1.0)
+    assert 0.97 * chord <= sag <= chord * (1 + 1e-12)
+
+
+def test_a_band_too_wide_for_its_pair_is_spanned_among_denser_generators(monkeypatch):
+    """On the Pluecker conoid every pair across a torsal generator at the given spacing
+    bulges from its plane by more than the bound: without added generators no band is
+    spanned; with the spacing around the bands halved, both are, within the bound."""
+    import ruledmesh.design.torsal as torsal
+
     rulings = _unrefined("plucker-conoid.toml")
     a, d, scale = _generators(rulings)
-    assert twist_changes(a, d, scale).size == 2
+    u = np.asarray(rulings.u)
+    changes = twist_changes(a, d, scale)
+    assert changes.size == 2
+    for g in changes.tolist():
+        pair = torsal._pair(rulings.surface, u, g - 1, g + 1, scale)
+        assert pair is None or _sag(rulings.surface, pair, scale) > FLAT_PAIR_MAX_SAG
+    with monkeypatch.context() as m:
+        m.setattr(torsal, "_DENSER_LEVELS", 0)
+        spanned, bands, left_out = span_torsal_bands(rulings, np.ones(len(a) - 1, bool), scale)
+        assert spanned is None and bands == [] and left_out == 0
     spanned, bands, left_out = span_torsal_bands(rulings, np.ones(len(a) - 1, bool), scale)
-    assert spanned is None and bands == [] and left_out == 0
+    assert spanned is not None and len(bands) == 2
+    _check_pairs(rulings, spanned, bands, left_out)
+    # The added generators lie around the bands only, and are counted.
+    new_u = np.asarray(spanned.u)
+    added = new_u[~np.isin(new_u, u)]
+    assert spanned.info["inserted"] - rulings.info.get("inserted", 0) == added.size > 2 * 2
+    near = np.zeros(added.size, bool)
+    for g in changes.tolist():
+        near |= (added >= u[g - 2]) & (added <= u[g + 2])
+    assert near.all()
 
 
 def test_a_spanned_band_is_one_strip_of_exact_strip_quads():

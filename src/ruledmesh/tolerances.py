@@ -192,7 +192,8 @@ COLLAPSE_MAX_SAG = 2.5e-4
 BORDER_TRIM_MAX_GAP = 1e-3
 #: A torsal band is spanned by one coplanar pair of generators (ruledmesh.design.torsal)
 #: only if the smooth surface between stays within this share of the patch diagonal from
-#: their plane: half the gap goal (2e-3).
+#: the flat strip they bound (their plane, and the strip's straight ends where the director
+#: curves leave them): half the gap goal (2e-3).
 FLAT_PAIR_MAX_SAG = 1e-3
 #: A strip whose strip quads are planar within this (the planarity tolerance the mesher's
 #: warnings suggest) counts as nearly developable in a build's warnings.

@@ -14,7 +14,11 @@ the design gives director curves the generators are ours to choose: the
 generators inside the band are left out and the pair bounds one flat strip,
 which the mesher fills with strip quads.  A pair is taken only
 if the smooth surface between stays within :data:`~ruledmesh.tolerances.FLAT_PAIR_MAX_SAG`
-of the patch diagonal from their plane.
+of the patch diagonal from the flat strip they bound (out of its plane, and
+within it where the director curves leave its straight ends).  The sag grows with the square of the
+pair's width, so where the generators beside the torsal one are too far apart for
+that, generators of the smooth surface are added around the band (halving their
+spacing, twice at most) and the pair is sought among them.
 """
 
 from __future__ import annotations
@@ -25,7 +29,7 @@ import numpy as np
 
 from ..hop import coplanarity, sense_changes
 from ..roots import brentq
-from ..tolerances import DEFAULT, FLAT_PAIR_MAX_SAG, ROOT_XTOL, TINY
+from ..tolerances import FLAT_PAIR_MAX_SAG, ROOT_XTOL, TINY
 
 __all__ = ["span_torsal_bands", "twist_changes"]
 
@@ -35,6 +39,8 @@ __all__ = ["span_torsal_bands", "twist_changes"]
 _MAX_REACH = 1
 _SEARCH = 3
 _SAMPLES = 40
+# Halvings of the generator spacing around a band whose pair sags too far (see _denser_pair).
+_DENSER_LEVELS = 2
 
 
 def twist_changes(a: np.ndarray, d: np.ndarray, scale: float) -> np.ndarray:
@@ -97,19 +103,56 @@ def _pair(surface, u: np.ndarray, lo: int, hi: int, scale: float) -> tuple[float
     return None
 
 
+def _denser_pair(surface, u: np.ndarray, lo: int, hi: int, scale: float):
+    """A coplanar pair within the sag bound across the band lo..hi, the generators around it
+    halved in spacing until one is found: ``(pair, added parameters)`` or ``(None, [])``.
+
+    The sag of a pair grows with the square of its width, and the pair can only be
+    as narrow as the generators beside the torsal one: where the given spacing is
+    too coarse, generators of the smooth surface are added in the strips around
+    the band (each level halves their spacing), as the refinement would add them
+    strip by strip, and the pair is sought among those.
+    """
+    w_lo, w_hi = max(lo - 1, 0), min(hi + 1, len(u) - 1)
+    local = u[w_lo:w_hi + 1]
+    for _ in range(_DENSER_LEVELS):
+        local = np.unique(np.r_[local, 0.5 * (local[1:] + local[:-1])])
+        a = surface.a(local)
+        d = surface.b(local) - a
+        ch = twist_changes(a, d, scale)
+        if ch.size == 0:
+            return None, np.zeros(0)
+        # The change nearest the middle of the window is the band's torsal generator.
+        g = int(ch[np.argmin(np.abs(local[ch] - 0.5 * (u[lo] + u[hi])))])
+        if g - 1 < 1 or g + 1 > len(local) - 2:
+            return None, np.zeros(0)
+        pair = _pair(surface, local, g - 1, g + 1, scale)
+        if pair is not None and _sag(surface, pair, scale) <= FLAT_PAIR_MAX_SAG:
+            return pair, np.setdiff1d(local, u)
+    return None, np.zeros(0)
+
+
 def _sag(surface, pair: tuple[float, float], scale: float) -> float:
-    """Largest distance of the smooth surface between the pair from their plane, over ``scale``."""
+    """Largest distance of the smooth surface between the pair from the flat strip they bound,
+    over ``scale``.
+
+    The strip's quads join points of equal ``t`` on the two generators, so a point
+    ``(s, t)`` of the surface between them is measured from the rung at its ``t``:
+    the distance holds the bulge out of the pair's plane and, at the strip's ends,
+    the director curves bowing away from its straight edges within it (the whole gap
+    there; inside, a bound on it).
+    """
     ends = np.asarray(pair)
     a, b = surface.a(ends), surface.b(ends)
-    d = b - a
-    n = np.cross(d[0], d[1])
-    if np.linalg.norm(n) <= DEFAULT.degenerate * np.linalg.norm(d[0]) * np.linalg.norm(d[1]):
-        n = np.cross(d[0], a[1] - a[0])          # parallel pair: the plane through both
-    n = n / max(float(np.linalg.norm(n)), TINY)
     s = np.linspace(ends[0], ends[1], 9)[1:-1]
     t = np.linspace(0.0, 1.0, 5)
-    p = surface.point(s[:, None], t[None, :])
-    return float(np.abs((p - a[0]) @ n).max()) / scale
+    p = surface.point(s[:, None], t[None, :])                     # (7, 5, 3)
+    lo = a[0] + t[:, None] * (b[0] - a[0])                        # (5, 3): the rungs' ends
+    hi = a[1] + t[:, None] * (b[1] - a[1])
+    rung = hi - lo
+    w = np.einsum("stk,tk->st", p - lo, rung) / np.maximum(np.einsum("tk,tk->t", rung, rung), TINY)
+    foot = lo + np.clip(w, 0.0, 1.0)[..., None] * rung
+    return float(np.linalg.norm(p - foot, axis=-1).max()) / scale
 
 
 def span_torsal_bands(rulings, trouble: np.ndarray, scale: float, changes: np.ndarray | None = None):
@@ -131,7 +174,9 @@ def span_torsal_bands(rulings, trouble: np.ndarray, scale: float, changes: np.nd
     Returns
     -------
     rulings : Rulings or None
-        None where no band could be spanned.
+        None where no band could be spanned; else with the pairs' generators and
+        those added around the bands (see :func:`_denser_pair`) counted in
+        ``info["inserted"]``.
     bands : list of (int, int)
         The generators of ``rulings`` (the new ones) that bound the flat strips.
     left_out : int
@@ -145,6 +190,7 @@ def span_torsal_bands(rulings, trouble: np.ndarray, scale: float, changes: np.nd
     creases = np.asarray(rulings.info.get("crease_generators") or [], dtype=np.int64)
     keep = np.ones(m, bool)
     pairs: list[tuple[float, float]] = []
+    denser: list[np.ndarray] = []
     for g in (twist_changes(a, d, scale) if changes is None else changes).tolist():
         lo, hi = g - 1, g
         while lo > 0 and trouble[lo - 1] and g - lo < _MAX_REACH:
@@ -156,14 +202,24 @@ def span_torsal_bands(rulings, trouble: np.ndarray, scale: float, changes: np.nd
                 or np.any((creases >= lo) & (creases <= hi)):
             continue
         pair = _pair(surface, u, lo, hi, scale)
+        extra = np.zeros(0)
         if pair is None or _sag(surface, pair, scale) > FLAT_PAIR_MAX_SAG:
-            continue
+            pair, extra = _denser_pair(surface, u, lo, hi, scale)
+            if pair is None:
+                continue
         pairs.append(pair)
         keep &= ~((u > pair[0]) & (u < pair[1]))
+        denser.append(extra)
     if not pairs:
         return None, [], 0
     ends = np.asarray(pairs).reshape(-1)
-    new_u = np.unique(np.r_[u[keep], ends])
+    added = np.concatenate(denser)
+    # No added generator may fall inside a pair (its own or a neighbouring band's): the
+    # pair bounds one flat strip.
+    inside = np.zeros(added.size, bool)
+    for p, q in pairs:
+        inside |= (added > p) & (added < q)
+    new_u = np.unique(np.r_[u[keep], ends, added[~inside]])
     info = dict(rulings.info)
     info["inserted"] = int(info.get("inserted", 0)) + int(np.isin(new_u, u, invert=True).sum())
     if len(creases):

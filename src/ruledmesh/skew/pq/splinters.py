@@ -106,9 +106,14 @@ def snap_to_border(mesh: Mesh) -> tuple[Mesh, int]:
     v, b = v[first], b[first]
     if v.size == 0:
         return mesh, 0
-    _, gain = _snapped(_near(mesh, np.concatenate([v, b])), v, b)
-    keep = gain > 0
-    v, b = v[keep], b[keep]
+    # The moves are measured together (neighbouring ones change each other's faces), so
+    # once some are left out the rest are measured again, until every one left gains.
+    while v.size:
+        _, gain = _snapped(_near(mesh, np.concatenate([v, b])), v, b)
+        keep = gain > 0
+        if keep.all():
+            break
+        v, b = v[keep], b[keep]
     if v.size == 0:
         return mesh, 0
     moved, _ = _snapped(mesh, v, b, measure=False)
@@ -214,21 +219,26 @@ def _snapped(mesh: Mesh, v: np.ndarray, b: np.ndarray, measure: bool = True) -> 
     out = replace(out, face_kind=kind)
     if not measure:
         return out, np.zeros(v.size)
-    before = _around_min(mesh, [v, b])
-    after = _around_min(out, [new_index[b]])
-    return out, after - before
+    before, thin_before = _around_min(mesh, [v, b])
+    after, thin_after = _around_min(out, [new_index[b]])
+    # A move that fattens the thinnest face but leaves more splinters around is no gain.
+    return out, np.where(thin_after > thin_before, -1.0, after - before)
 
 
-def _around_min(mesh: Mesh, groups: list[np.ndarray]) -> np.ndarray:
-    """(k,) the smallest angle of the faces at any of ``groups[j][i]``, per ``i``."""
+def _around_min(mesh: Mesh, groups: list[np.ndarray]) -> tuple[np.ndarray, np.ndarray]:
+    """(k,) the smallest angle of the faces at any of ``groups[j][i]``, per ``i``, and
+    (k,) how many of those faces are splinters (each counted once)."""
     slot = np.full(mesh.n_vertices, -1)
     for g in groups:
         slot[g] = np.arange(g.size)
     face_of = np.repeat(np.arange(mesh.n_faces), mesh.valences)
     s = slot[mesh.face_indices]
     out = np.full(groups[0].size, 180.0)
-    np.minimum.at(out, s[s >= 0], face_min_angles(mesh)[face_of[s >= 0]])
-    return out
+    angles = face_min_angles(mesh)
+    np.minimum.at(out, s[s >= 0], angles[face_of[s >= 0]])
+    pairs = np.unique(np.stack([s[s >= 0], face_of[s >= 0]], axis=1), axis=0)
+    thin = np.bincount(pairs[:, 0][angles[pairs[:, 1]] < RESTART_ANGLE_DEG], minlength=groups[0].size)
+    return out, thin
 
 
 def _cut_quads(mesh: Mesh, which: np.ndarray) -> tuple[Mesh, np.ndarray, np.ndarray]:
