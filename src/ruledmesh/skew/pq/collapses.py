@@ -146,14 +146,24 @@ def _near(mesh: Mesh, vertices: np.ndarray) -> Mesh:
     return mesh.select_faces(_touching(mesh, mark))
 
 
-def _evaluate(V, tri, stars: _Stars, keys, faces_at, v, u, scale) -> tuple[np.ndarray, np.ndarray]:
-    """(C,) gain in smallest angle (degrees) of each collapse ``v -> u``, and whether it is allowed."""
-    C = v.size
+def _collapsed_star(tri, stars: _Stars, v, u):
+    """The star of each ``v`` before and after collapsing it into its ``u``.
+
+    Returns ``rep`` (candidate row per star triangle), ``old`` and ``new`` (the
+    triangles, ``v`` replaced by ``u`` in ``new``) and ``gone`` (the triangles on
+    the edge ``u v``, which the collapse removes).
+    """
     rep, face, corner = stars.triangles(v)
     old = tri[face]
     new = old.copy()
     new[np.arange(face.size), corner] = u[rep]
-    gone = (old == u[rep][:, None]).any(axis=1)          # the triangles on the edge u v
+    return rep, old, new, (old == u[rep][:, None]).any(axis=1)
+
+
+def _evaluate(V, tri, stars: _Stars, keys, faces_at, v, u, scale) -> tuple[np.ndarray, np.ndarray]:
+    """(C,) gain in smallest angle (degrees) of each collapse ``v -> u``, and whether it is allowed."""
+    C = v.size
+    rep, old, new, gone = _collapsed_star(tri, stars, v, u)
     old_ang = min_corner_angles(V, old)
     old_min = np.full(C, 180.0)
     np.minimum.at(old_min, rep, old_ang)
@@ -219,11 +229,8 @@ def _keeps_ghosts(V, tri, stars: _Stars, v, u, ghosts, anchors, scale) -> np.nda
     cand, g = key // len(anchors), key % len(anchors)
     bound = COLLAPSE_MAX_SAG * scale
     # Distance to the collapse's new faces.
-    c_rep, c_face, c_corner = stars.triangles(v[cand])
-    new = tri[c_face].copy()
-    new[np.arange(c_face.size), c_corner] = u[cand][c_rep]
-    live = ~(new == v[cand][c_rep][:, None]).any(axis=1) & \
-        ~((tri[c_face] == u[cand][c_rep][:, None]).any(axis=1))
+    c_rep, _, new, gone = _collapsed_star(tri, stars, v[cand], u[cand])
+    live = ~gone
     near = np.full(cand.size, np.inf)
     np.minimum.at(near, c_rep[live], _triangle_distance(ghosts[g[c_rep[live]]], V[new[live]]))
     # ... or to the triangles at the anchor that do not have v for a corner.
