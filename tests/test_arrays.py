@@ -7,7 +7,7 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 from hypothesis.extra import numpy as hnp
 
-from ruledmesh._arrays import cross, norm, ranks, unique
+from ruledmesh._arrays import cross, member, norm, ranks, unique
 
 
 def _same(x: np.ndarray, y: np.ndarray) -> bool:
@@ -87,3 +87,22 @@ def test_ranks_are_the_aranges_of_the_counts(counts):
     got = ranks(np.asarray(counts, dtype=np.int64))
     want = np.concatenate([np.arange(c) for c in counts]) if counts else np.zeros(0)
     assert got.shape == want.shape and np.array_equal(got, want)
+
+
+@settings(max_examples=300, deadline=None)
+@given(hnp.arrays(np.float64, hnp.array_shapes(min_dims=1, max_dims=2, min_side=0),
+                  elements=st.sampled_from([0.0, -0.0, 1.5, 2.0, -3.25, np.inf, np.nan])),
+       hnp.arrays(np.float64, st.integers(0, 80),
+                  elements=st.sampled_from([0.0, 1.5, 2.0, 7.0, -np.inf, np.nan])))
+def test_member_is_isin(values, among):
+    """Large ``among`` too: np.isin's sorting path (the one that imports numpy.ma)."""
+    got = member(values, among)
+    assert got.shape == values.shape
+    assert np.array_equal(got, np.isin(values, among))
+
+
+def test_member_of_integer_keys():
+    rng = np.random.default_rng(3)
+    values, among = rng.integers(0, 5000, 3000), rng.integers(0, 5000, 2000)
+    assert np.array_equal(member(values, among), np.isin(values, among))
+    assert not member(values, np.zeros(0, np.int64)).any()

@@ -13,7 +13,7 @@ from __future__ import annotations
 
 import numpy as np
 
-__all__ = ["cross", "diagonal", "norm", "ranks", "unique"]
+__all__ = ["cross", "diagonal", "member", "norm", "ranks", "unique"]
 
 
 def unique(values: np.ndarray) -> np.ndarray:
@@ -43,6 +43,32 @@ def unique(values: np.ndarray) -> np.ndarray:
         keep[first + 1:] = False
     return arr[keep]
 
+
+
+def member(values: np.ndarray, among: np.ndarray) -> np.ndarray:
+    """Which of ``values`` occur in ``among``: ``np.isin(values, among)``, by sorting.
+
+    ``np.isin`` on larger arrays takes the plain ``np.unique`` of ``among``, and
+    with it the ``numpy.ma`` import (see the module's docstring).
+
+    Parameters
+    ----------
+    values : array_like
+        Any shape.
+    among : array_like
+        Any shape; flattened.
+
+    Returns
+    -------
+    ndarray of bool
+        The shape of ``values``; NaN is in nothing, as with ``np.isin``.
+    """
+    v = np.asarray(values)
+    s = unique(among)
+    if s.size == 0:
+        return np.zeros(v.shape, dtype=bool)
+    i = np.minimum(np.searchsorted(s, v), s.size - 1)
+    return s[i] == v
 
 # Up to this many numbers per operand, :func:`cross` gathers the components (faster on a
 # few vectors, much slower on many).

@@ -21,6 +21,7 @@ from typing import Any
 import numpy as np
 
 from .. import budget as _budget
+from .._arrays import unique
 from .._validation import check_keys, describe, near_miss
 from ..errors import DesignError, GeometryError, RuledMeshError
 from ..progress import SILENT, Progress, Task, stages
@@ -403,7 +404,7 @@ def _with_creases(rulings, table: Mapping, curves: Mapping) -> Any:
             else:
                 new_u.append(u)
     if new_u and surface is not None:
-        u_all = np.unique(np.concatenate([rulings.u, new_u]))
+        u_all = unique(np.concatenate([rulings.u, new_u]))
         keep = np.r_[True, np.diff(u_all) > DEFAULT.degenerate]
         u_all = u_all[keep]
         inserted = len(u_all) - len(rulings.u)

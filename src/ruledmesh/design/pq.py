@@ -7,7 +7,7 @@ from typing import Any
 
 import numpy as np
 
-from .._arrays import diagonal
+from .._arrays import diagonal, unique
 from .._validation import check_bool, check_float, check_int, check_keys, describe
 from ..budget import MAX_COUNT
 from ..errors import DesignError, GeometryError
@@ -255,7 +255,7 @@ def _with_generators(rulings, mesh, area: np.ndarray, bar: float, grid: np.ndarr
     mid = grid[(lo[ok] + hi[ok]) // 2]
     if mid.size == 0 or (len(u) + mid.size) * (rows + 1) > MAX_GRID_POINTS // 4:
         return None
-    new_u = np.unique(np.concatenate([u, mid]))
+    new_u = unique(np.concatenate([u, mid]))
     creases = rulings.info.get("crease_generators")
     info = {**rulings.info, "inserted": int(rulings.info.get("inserted", 0)) + len(new_u) - len(u)}
     if creases:

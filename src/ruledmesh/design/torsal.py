@@ -27,6 +27,7 @@ from dataclasses import replace
 
 import numpy as np
 
+from .._arrays import member, unique
 from ..hop import coplanarity, sense_changes
 from ..roots import brentq
 from ..tolerances import FLAT_PAIR_MAX_SAG, ROOT_XTOL, TINY
@@ -116,7 +117,7 @@ def _denser_pair(surface, u: np.ndarray, lo: int, hi: int, scale: float):
     w_lo, w_hi = max(lo - 1, 0), min(hi + 1, len(u) - 1)
     local = u[w_lo:w_hi + 1]
     for _ in range(_DENSER_LEVELS):
-        local = np.unique(np.r_[local, 0.5 * (local[1:] + local[:-1])])
+        local = unique(np.r_[local, 0.5 * (local[1:] + local[:-1])])
         a = surface.a(local)
         d = surface.b(local) - a
         ch = twist_changes(a, d, scale)
@@ -128,7 +129,8 @@ def _denser_pair(surface, u: np.ndarray, lo: int, hi: int, scale: float):
             return None, np.zeros(0)
         pair = _pair(surface, local, g - 1, g + 1, scale)
         if pair is not None and _sag(surface, pair, scale) <= FLAT_PAIR_MAX_SAG:
-            return pair, np.setdiff1d(local, u)
+            added = unique(local)
+            return pair, added[~member(added, u)]
     return None, np.zeros(0)
 
 
@@ -219,9 +221,9 @@ def span_torsal_bands(rulings, trouble: np.ndarray, scale: float, changes: np.nd
     inside = np.zeros(added.size, bool)
     for p, q in pairs:
         inside |= (added > p) & (added < q)
-    new_u = np.unique(np.r_[u[keep], ends, added[~inside]])
+    new_u = unique(np.r_[u[keep], ends, added[~inside]])
     info = dict(rulings.info)
-    info["inserted"] = int(info.get("inserted", 0)) + int(np.isin(new_u, u, invert=True).sum())
+    info["inserted"] = int(info.get("inserted", 0)) + int((~member(new_u, u)).sum())
     if len(creases):
         info["crease_generators"] = np.searchsorted(new_u, u[creases]).tolist()
     bands = [(int(np.searchsorted(new_u, p)), int(np.searchsorted(new_u, q))) for p, q in pairs]

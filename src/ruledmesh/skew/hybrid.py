@@ -43,6 +43,7 @@ from typing import Any
 
 import numpy as np
 
+from .._arrays import member, unique
 from .._validation import check_bool, check_int, check_points
 from ..budget import HYBRID_BYTES_PER_NODE, MAX_BUILD_BYTES, MAX_DIVISIONS, MAX_GRID_NODES, gib
 from ..errors import GeometryError, ParameterError
@@ -213,7 +214,7 @@ def _merge_coincident(V: np.ndarray, faces: list[np.ndarray], radius: float,
     from scipy.spatial import cKDTree
 
     n = len(V)
-    used = np.unique(np.concatenate([f.ravel() for f in faces]))
+    used = unique(np.concatenate([f.ravel() for f in faces]))
     pairs = used[cKDTree(V[used]).query_pairs(radius, output_type="ndarray")].reshape(-1, 2)
     if len(pairs) == 0:
         return np.arange(n)
@@ -477,7 +478,7 @@ def _bare_generators(quads: np.ndarray, tris: np.ndarray, members: np.ndarray,
                         np.stack([tris, np.roll(tris, -1, axis=1)], axis=2).reshape(-1, 2)])
     e.sort(axis=1)
     mm = np.sort(members, axis=1)
-    is_edge = np.isin(mm[:, 0] * n_vertices + mm[:, 1], e[:, 0] * n_vertices + e[:, 1])
+    is_edge = member(mm[:, 0] * n_vertices + mm[:, 1], e[:, 0] * n_vertices + e[:, 1])
     return sorted(set(member_id[~is_edge].tolist()))
 
 

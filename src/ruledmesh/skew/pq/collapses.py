@@ -25,7 +25,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..._arrays import cross, diagonal
+from ..._arrays import cross, diagonal, member, unique
 from ...analysis.faces import min_corner_angles
 from ...mesh import FaceKind, Mesh
 from ...tolerances import COLLAPSE_MAX_SAG, FLIP_MAX_BEND_DEG, FLIP_MIN_GAIN_DEG, RESTART_ANGLE_DEG, TINY
@@ -117,8 +117,9 @@ def _directed(tri: np.ndarray, free: np.ndarray) -> tuple[np.ndarray, np.ndarray
     v = np.concatenate([tri, np.roll(tri, -1, axis=1)], axis=0).reshape(-1)
     u = np.concatenate([np.roll(tri, -1, axis=1), tri], axis=0).reshape(-1)
     ok = free[v]
-    pairs = np.unique(np.stack([v[ok], u[ok]], axis=1), axis=0)
-    return pairs[:, 0], pairs[:, 1]
+    n = np.int64(len(free))
+    pairs = unique(v[ok] * n + u[ok])
+    return pairs // n, pairs % n
 
 
 def _touching(mesh: Mesh, mark: np.ndarray) -> np.ndarray:
@@ -225,7 +226,7 @@ def _keeps_ghosts(V, tri, stars: _Stars, v, u, ghosts, anchors, scale) -> np.nda
         return np.ones(C, bool)
     g = np.concatenate(pairs_g)
     cand = rep[row]
-    key = np.unique(cand * len(anchors) + g)
+    key = unique(cand * len(anchors) + g)
     cand, g = key // len(anchors), key % len(anchors)
     bound = COLLAPSE_MAX_SAG * scale
     # Distance to the collapse's new faces.
@@ -392,7 +393,7 @@ def collapse_splinters(mesh: Mesh, removable: np.ndarray | None = None,
         watch = _rings(mesh, new_index[u[take]], 2)
         waiting = np.ones(v.size, bool)
         waiting[take] = False
-        waiting &= ~np.isin(v, v[take])
+        waiting &= ~member(v, v[take])
         watch[new_index[v[waiting]]] = True
     return mesh, total
 

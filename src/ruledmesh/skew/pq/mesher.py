@@ -381,7 +381,7 @@ def _cut(a, d, rows, ptol, scale, tol, creases, crease_generators, warnings):
     # A sign change across a strip much narrower than a row step (the generators
     # nearly coincide) is shared instead: a zipper there would be all slivers.
     narrow = change & ~flat & ~crease & _narrow_strips(a, d, rows)
-    segs = _segments(m, np.union1d(np.flatnonzero(narrow), cg),
+    segs = _segments(m, unique(np.r_[np.flatnonzero(narrow), cg]),
                      np.flatnonzero(flat | crease | (change & ~narrow)))
     return flat, torsal, cg, segs
 

@@ -18,7 +18,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..._arrays import ranks
+from ..._arrays import member, ranks, unique
 from ...mesh import FaceKind, Mesh
 
 __all__ = ["adjacent_triangles", "pair_triangles"]
@@ -93,7 +93,7 @@ def pair_triangles(mesh: Mesh, ptol: float, kinds: tuple[int, ...] | None = None
     if kinds is None:
         kinds = (FaceKind.FILL, FaceKind.BORDER, FaceKind.SPLIT)
     val = mesh.valences
-    ids = np.flatnonzero((val == 3) & np.isin(mesh.face_kind, np.asarray(kinds, np.uint8)))
+    ids = np.flatnonzero((val == 3) & member(mesh.face_kind, np.asarray(kinds, np.uint8)))
     if ids.size < 2 or ptol <= 0:
         return mesh, 0
     V = mesh.vertices
@@ -109,7 +109,7 @@ def pair_triangles(mesh: Mesh, ptol: float, kinds: tuple[int, ...] | None = None
     sq, tq, _ = quad_diagonal_crossing(P)
     ang = min_corner_angles(V, quad)
     tri_min = np.zeros(len(tri))
-    near = np.unique(np.concatenate([t1, t2]))
+    near = unique(np.concatenate([t1, t2]))
     tri_min[near] = min_corner_angles(V, tri[near])
     ok = (sq > _MIN_CROSSING) & (sq < 1 - _MIN_CROSSING) \
         & (tq > _MIN_CROSSING) & (tq < 1 - _MIN_CROSSING) \

@@ -26,7 +26,7 @@ from dataclasses import replace
 
 import numpy as np
 
-from ..._arrays import diagonal
+from ..._arrays import diagonal, unique
 from ...analysis.faces import face_min_angles, face_normals
 from ...mesh import FaceKind, Mesh
 from ...tolerances import BORDER_TRIM_MAX_GAP, ON_BORDER, RESTART_ANGLE_DEG, SPLINTER_AREA_WORTH
@@ -51,7 +51,7 @@ def _splinter_edges(mesh: Mesh, amin: np.ndarray) -> np.ndarray:
     nxt = idx[mesh.next_corners()]
     face_of = np.repeat(np.arange(mesh.n_faces), mesh.valences)
     bad = ((amin < RESTART_ANGLE_DEG) & (mesh.valences == 3))[face_of]
-    return np.unique(np.minimum(idx, nxt)[bad] * n + np.maximum(idx, nxt)[bad])
+    return unique(np.minimum(idx, nxt)[bad] * n + np.maximum(idx, nxt)[bad])
 
 
 def snap_to_border(mesh: Mesh) -> tuple[Mesh, int]:
@@ -187,7 +187,7 @@ def trim_border_needles(mesh: Mesh, scale: float | None = None) -> tuple[Mesh, i
     pinch[rim_owner[on_border[rim] & ~along]] = True
     ok &= ~pinch
     inner = ok[rim_owner] & ~along
-    pairs = np.unique(rim_owner[inner] * n + rim[inner])
+    pairs = unique(rim_owner[inner] * n + rim[inner])
     fans = np.bincount(pairs % n, minlength=n)            # fans each vertex is inside the rim of
     ok &= np.bincount(rim_owner[inner & (fans[rim] > 1)], minlength=n) == 0
     if not ok.any():
@@ -236,8 +236,9 @@ def _around_min(mesh: Mesh, groups: list[np.ndarray]) -> tuple[np.ndarray, np.nd
     out = np.full(groups[0].size, 180.0)
     angles = face_min_angles(mesh)
     np.minimum.at(out, s[s >= 0], angles[face_of[s >= 0]])
-    pairs = np.unique(np.stack([s[s >= 0], face_of[s >= 0]], axis=1), axis=0)
-    thin = np.bincount(pairs[:, 0][angles[pairs[:, 1]] < RESTART_ANGLE_DEG], minlength=groups[0].size)
+    n = np.int64(mesh.n_faces)
+    pairs = unique(s[s >= 0] * n + face_of[s >= 0])
+    thin = np.bincount((pairs // n)[angles[pairs % n] < RESTART_ANGLE_DEG], minlength=groups[0].size)
     return out, thin
 
 
