@@ -29,7 +29,7 @@ from typing import Any
 
 import numpy as np
 
-from .._arrays import unique
+from .._arrays import median, percentile, unique
 from ..errors import GeometryError
 from ..mesh import FaceKind, Mesh
 from ..progress import Progress, stages
@@ -130,8 +130,8 @@ def _quality(mesh: Mesh, tol: Tolerances) -> dict[str, Any]:
         "area_share": shares,
         "face_min_angle_deg": {
             "min": float(smallest.min()) if smallest.size else 0.0,
-            "p5": float(np.percentile(smallest, 5)) if smallest.size else 0.0,
-            "median": float(np.median(smallest)) if smallest.size else 0.0,
+            "p5": percentile(smallest, 5) if smallest.size else 0.0,
+            "median": median(smallest) if smallest.size else 0.0,
         },
         "faces_below_3deg": int(np.count_nonzero(smallest < F.SPLINTER_DEG)),
         "degenerate_faces": int(np.count_nonzero(F.degenerate_faces(mesh, tol.degenerate))),
