@@ -8,6 +8,7 @@ no scipy, no plotting, no exporter the command does not write.
 
 from __future__ import annotations
 
+import json
 import subprocess
 import sys
 from pathlib import Path
@@ -25,15 +26,24 @@ LAZY_OURS = ("ruledmesh.render", "ruledmesh.web", "ruledmesh.structure", "ruledm
              "ruledmesh.blender")
 
 
+# Printed after the code runs: the modules loaded through importlib.import_module (the
+# lazy attributes of ruledmesh, the CLI's subcommands, the report's hooks) are not in the
+# -X importtime trace, which logs only import statements.
+_MODULES = "\nimport json, sys\nprint('@@modules ' + json.dumps(sorted(sys.modules)))"
+
+
 def imported(code: str, cwd: Path) -> set[str]:
-    """Modules a fresh interpreter imports running ``code`` (from ``-X importtime``)."""
-    run = subprocess.run([sys.executable, "-X", "importtime", "-c", code], capture_output=True,
+    """Modules a fresh interpreter imports running ``code`` (``-X importtime`` and ``sys.modules``)."""
+    run = subprocess.run([sys.executable, "-X", "importtime", "-c", code + _MODULES], capture_output=True,
                          text=True, cwd=cwd, timeout=300, check=False)
     assert run.returncode == 0, run.stderr[-2000:]
     names = set()
     for line in run.stderr.splitlines():
         if line.startswith("import time:") and "|" in line and "self [us]" not in line:
             names.add(line.rsplit("|", 1)[1].strip())
+    listed = [line for line in run.stdout.splitlines() if line.startswith("@@modules ")]
+    assert len(listed) == 1, run.stdout[-2000:]
+    names |= set(json.loads(listed[0].split(" ", 1)[1]))
     assert "numpy" in names
     return names
 
