@@ -454,3 +454,22 @@ def test_no_module_outside_curves_calls_private_curve_methods():
                     and not (isinstance(node.value, ast.Name) and node.value.id in ("self", "cls"))):
                 used.append(f"{path.relative_to(src)}:{node.lineno} .{node.attr}")
     assert not used, used
+
+
+@pytest.mark.parametrize("degree", [1, 2, 3, 5])
+def test_speed_series_padded_for_newton_gives_the_same_numbers(degree):
+    """The inverse evaluates the arc-length and speed series in one Clenshaw pass, the speed
+    padded with a zero top coefficient: the values must be those of the speed series alone
+    (bit for bit), so the Newton iterates, and the generators, are the unpadded ones."""
+    from ruledmesh.curves import _clenshaw
+
+    rng = np.random.default_rng(40 + degree)
+    for _ in range(6):
+        cp, knots = _random_bspline(rng, degree)
+        curve = BSpline(cp, degree, knots)
+        _, _, speed, length = curve._length_series
+        both = curve._newton_series
+        k = rng.integers(0, len(speed), 500)
+        xi = rng.uniform(-1.0, 1.0, 500)
+        assert np.array_equal(_clenshaw(both[:, 1, k], xi), _clenshaw(speed.T[:, k], xi))
+        assert np.array_equal(_clenshaw(both[:, 0, k], xi), _clenshaw(length.T[:, k], xi))
