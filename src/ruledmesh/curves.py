@@ -286,6 +286,42 @@ def _de_boor(knots: np.ndarray, control: np.ndarray, degree: int, x: np.ndarray)
     return d[:, degree].reshape(x.shape + (control.shape[1],))
 
 
+# From this many points, curves are evaluated one coordinate at a time: numpy's loops over
+# the innermost axis of (N, 3) arrays run 3 numbers per call, several times slower than the
+# arithmetic on a few thousand points (the closeness analysis evaluates tens of thousands).
+# Below it the whole points are cheaper.  The numbers are the same either way.
+_BY_COLUMNS = 256
+
+
+def _by_columns(column: Callable[[int], np.ndarray], shape: tuple[int, ...]) -> np.ndarray:
+    """``(*shape, 3)`` points whose coordinate ``x`` is ``column(x)`` (an array of ``shape``)."""
+    out = np.empty(shape + (3,))
+    for x in range(3):
+        out[..., x] = column(x)
+    return out
+
+
+def _horner_by_columns(u: np.ndarray, start: np.ndarray, width: np.ndarray,
+                       coef: np.ndarray) -> np.ndarray:
+    """(N, 3): the span polynomials ``coef`` (spans, terms, 3) at ``u`` (N,), one coordinate at
+    a time, with the steps of :meth:`BSpline._poly`'s Horner rule (so the same numbers)."""
+    if len(start) == 1:
+        tau = (u - start[0]) / width[0]
+        terms = coef[0]
+    else:
+        k = np.clip(np.searchsorted(start, u, side="right") - 1, 0, len(start) - 1)
+        tau = (u - start[k]) / width[k]
+        terms = coef[k].transpose(1, 2, 0)  # (terms, 3, N): a row per coefficient and coordinate
+
+    def column(x: int) -> np.ndarray:
+        out = np.broadcast_to(terms[-1, x], u.shape)
+        for j in range(terms.shape[0] - 2, -1, -1):
+            out = out * tau + terms[j, x]
+        return out
+
+    return _by_columns(column, u.shape)
+
+
 # --------------------------------------------------------------------------
 # level functions: monotone pieces, all roots, branch following
 # --------------------------------------------------------------------------
@@ -1016,6 +1052,8 @@ class Polyline(Curve):
         i = self._segment(u)
         f = (u - k[i]) / (k[i + 1] - k[i])
         p = self.points
+        if f.size >= _BY_COLUMNS:
+            return _by_columns(lambda x: p[i, x] + f * (p[i + 1, x] - p[i, x]), f.shape)
         return p[i] + f[..., None] * (p[i + 1] - p[i])
 
     def _deriv(self, u, order):
@@ -1023,7 +1061,10 @@ class Polyline(Curve):
             return np.zeros(u.shape + (3,))
         k = self._knots
         i = self._segment(u)
-        return (self.points[i + 1] - self.points[i]) / (k[i + 1] - k[i])[..., None]
+        p, h = self.points, k[i + 1] - k[i]
+        if h.size >= _BY_COLUMNS:
+            return _by_columns(lambda x: (p[i + 1, x] - p[i, x]) / h, h.shape)
+        return (p[i + 1] - p[i]) / h[..., None]
 
     def _breaks(self):
         return self._knots
@@ -1328,6 +1369,8 @@ class BSpline(Curve):
         start, width, _ = self._pieces
         c = self._derivative_pieces[order]
         flat = u.ravel()
+        if flat.size >= _BY_COLUMNS:
+            return _horner_by_columns(flat, start, width, c).reshape(u.shape + (3,))
         if len(start) == 1:  # one span: no gather
             tau = ((flat - start[0]) / width[0])[:, None]
             out = np.broadcast_to(c[0, -1], (flat.size, 3))
