@@ -10,7 +10,9 @@ included), and the ratio of each to the floor; run alternately so load changes h
 all alike.  Generators: the minimum over repeats of ``rulings.between(c1, c2, n,
 "arc-length")`` on the director curves of examples/skew.toml (a cubic B-spline and a
 polyline), freshly parsed each time so no cached table helps, for designer sizes n = 50
-and 100, and of ``BSpline.arclength_params(n)`` alone (CPU time of this process).  The load average is recorded
+and 100, of ``BSpline.arclength_params(n)`` alone on a fresh curve (table and
+inverse), and of it again on the same curve (the inverse alone: Newton on the table)
+(CPU time of this process).  The load average is recorded
 with the figures (the machine may be shared).  ``--label`` names the run in the JSON,
 which keeps the runs already there (e.g. ``before`` and ``after``).
 """
@@ -77,7 +79,7 @@ def generators(repeats: int) -> dict[str, float]:
     spec = tomllib.loads(SKEW.read_text(encoding="utf-8"))["curves"]
     out = {}
     for n in (50, 100):
-        best_between = best_params = float("inf")
+        best_between = best_params = best_inverse = float("inf")
         for _ in range(repeats):
             c1, c2 = (curve_from_spec(spec[k], k) for k in ("c1", "c2"))
             t0 = time.process_time()
@@ -87,8 +89,13 @@ def generators(repeats: int) -> dict[str, float]:
             t0 = time.process_time()
             c1.arclength_params(n)
             best_params = min(best_params, time.process_time() - t0)
+            # The same curve again: its arc-length table is built, only the inverse is timed.
+            t0 = time.process_time()
+            c1.arclength_params(n)
+            best_inverse = min(best_inverse, time.process_time() - t0)
         out[f"between arc-length {n}"] = best_between
         out[f"bspline arclength_params {n}"] = best_params
+        out[f"bspline inverse only {n}"] = best_inverse
     return out
 
 

@@ -1,13 +1,18 @@
-"""ruledmesh._arrays against numpy: unique values, cross products and norms, bit for bit."""
+"""ruledmesh._arrays against numpy: unique values, cross products, norms, percentiles and medians,
+bit for bit."""
 
 from __future__ import annotations
 
+import subprocess
+import sys
+
 import numpy as np
+import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 from hypothesis.extra import numpy as hnp
 
-from ruledmesh._arrays import cross, member, norm, ranks, unique
+from ruledmesh._arrays import cross, median, member, norm, percentile, ranks, unique
 
 
 def _same(x: np.ndarray, y: np.ndarray) -> bool:
@@ -106,3 +111,32 @@ def test_member_of_integer_keys():
     values, among = rng.integers(0, 5000, 3000), rng.integers(0, 5000, 2000)
     assert np.array_equal(member(values, among), np.isin(values, among))
     assert not member(values, np.zeros(0, np.int64)).any()
+
+
+_ORDER_VALUES = st.one_of(st.floats(-1e6, 1e6), st.sampled_from([0.0, -0.0, 1.0, 3.0, 1e-300, 89.99]))
+
+
+@settings(max_examples=300, deadline=None)
+@given(hnp.arrays(np.float64, st.integers(1, 80), elements=_ORDER_VALUES),
+       st.one_of(st.sampled_from([0.0, 1.0, 5.0, 50.0, 95.0, 100.0]), st.floats(0.0, 100.0)))
+def test_percentile_is_numpys(a, q):
+    assert percentile(a, q) == float(np.percentile(a, q))
+
+
+@settings(max_examples=300, deadline=None)
+@given(hnp.arrays(np.float64, st.integers(1, 80), elements=_ORDER_VALUES))
+def test_median_is_numpys(a):
+    assert median(a) == float(np.median(a))
+
+
+@pytest.mark.parametrize("fn", [lambda a: percentile(a, 5), median])
+def test_order_statistics_of_nan_are_nan(fn):
+    assert np.isnan(fn(np.array([1.0, np.nan, 2.0])))
+
+
+def test_order_statistics_import_no_masked_arrays():
+    """The reason they exist: numpy's own import numpy.ma (see the module docstring)."""
+    code = ("import sys, numpy as np\nfrom ruledmesh._arrays import median, percentile\n"
+            "x = np.random.default_rng(0).random(101)\npercentile(x, 5), median(x)\n"
+            "assert 'numpy.ma' not in sys.modules\nnp.median(x)\nassert 'numpy.ma' in sys.modules")
+    subprocess.run([sys.executable, "-c", code], check=True)

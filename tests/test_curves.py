@@ -454,3 +454,41 @@ def test_no_module_outside_curves_calls_private_curve_methods():
                     and not (isinstance(node.value, ast.Name) and node.value.id in ("self", "cls"))):
                 used.append(f"{path.relative_to(src)}:{node.lineno} .{node.attr}")
     assert not used, used
+
+
+@pytest.mark.parametrize("degree", [1, 2, 3, 5])
+def test_speed_series_padded_for_newton_gives_the_same_numbers(degree):
+    """The inverse evaluates the arc-length and speed series in one Clenshaw pass, the speed
+    padded with a zero top coefficient: the values must be those of the speed series alone
+    (bit for bit), so the Newton iterates, and the generators, are the unpadded ones."""
+    from ruledmesh.curves import _clenshaw
+
+    rng = np.random.default_rng(40 + degree)
+    for _ in range(6):
+        cp, knots = _random_bspline(rng, degree)
+        curve = BSpline(cp, degree, knots)
+        _, _, speed, length = curve._length_series
+        both = curve._newton_series
+        k = rng.integers(0, len(speed), 500)
+        xi = rng.uniform(-1.0, 1.0, 500)
+        assert np.array_equal(_clenshaw(both[:, 1, k], xi), _clenshaw(speed.T[:, k], xi))
+        assert np.array_equal(_clenshaw(both[:, 0, k], xi), _clenshaw(length.T[:, k], xi))
+
+
+@pytest.mark.parametrize("degree", [1, 2, 3, 5])
+def test_many_points_by_columns_are_the_few_points_numbers(degree):
+    """From _BY_COLUMNS points on, B-splines and polylines are evaluated one coordinate at a
+    time; points and derivatives must be those of the same parameters in small batches."""
+    from ruledmesh.curves import _BY_COLUMNS
+
+    rng = np.random.default_rng(60 + degree)
+    for _ in range(4):
+        cp, knots = _random_bspline(rng, degree)
+        u = rng.uniform(-0.05, 1.05, (3, _BY_COLUMNS))  # outside [0, 1] too: the end spans continue
+        for curve in (BSpline(cp, degree, knots), BSpline(cp, degree), Polyline(cp)):
+            for order in (0, 1, 2):
+                many = curve._eval(u) if order == 0 else curve._deriv(u, order)
+                few = np.stack([curve._eval(row[i:i + 16]) if order == 0 else curve._deriv(row[i:i + 16], order)
+                                for row in u for i in range(0, len(row), 16)])
+                assert many.shape == u.shape + (3,)
+                assert np.array_equal(many.reshape(-1, 3), few.reshape(-1, 3))

@@ -8,6 +8,7 @@ no scipy, no plotting, no exporter the command does not write.
 
 from __future__ import annotations
 
+import json
 import subprocess
 import sys
 from pathlib import Path
@@ -25,34 +26,54 @@ LAZY_OURS = ("ruledmesh.render", "ruledmesh.web", "ruledmesh.structure", "ruledm
              "ruledmesh.blender")
 
 
+# Printed after the code runs: the modules loaded through importlib.import_module (the
+# lazy attributes of ruledmesh, the CLI's subcommands, the report's hooks) are not in the
+# -X importtime trace, which logs only import statements.
+_MODULES = "\nimport json, sys\nprint('@@modules ' + json.dumps(sorted(sys.modules)))"
+
+
 def imported(code: str, cwd: Path) -> set[str]:
-    """Modules a fresh interpreter imports running ``code`` (from ``-X importtime``)."""
-    run = subprocess.run([sys.executable, "-X", "importtime", "-c", code], capture_output=True,
+    """Modules a fresh interpreter imports running ``code`` (``-X importtime`` and ``sys.modules``)."""
+    run = subprocess.run([sys.executable, "-X", "importtime", "-c", code + _MODULES], capture_output=True,
                          text=True, cwd=cwd, timeout=300, check=False)
     assert run.returncode == 0, run.stderr[-2000:]
     names = set()
     for line in run.stderr.splitlines():
         if line.startswith("import time:") and "|" in line and "self [us]" not in line:
             names.add(line.rsplit("|", 1)[1].strip())
+    listed = [line for line in run.stdout.splitlines() if line.startswith("@@modules ")]
+    assert len(listed) == 1, run.stdout[-2000:]
+    names |= set(json.loads(listed[0].split(" ", 1)[1]))
     assert "numpy" in names
     return names
 
 
-def _offenders(names: set[str]) -> list[str]:
+# Parts of numpy a start or a build outside the §4 meshers has no use for: masked arrays
+# (numpy's np.unique, np.median and np.percentile import them: 10-25 ms cold) and the
+# polynomial classes (the Legendre nodes of the arc-length tables are computed when a
+# curve's length is first asked for).
+NUMPY_EXTRAS = ("numpy.ma", "numpy.polynomial")
+
+
+def _offenders(names: set[str], extras: tuple[str, ...] = ()) -> list[str]:
     return sorted(n for n in names if n.split(".")[0] in HEAVY
-                  or any(n == m or n.startswith(m + ".") for m in LAZY_OURS))
+                  or any(n == m or n.startswith(m + ".") for m in LAZY_OURS + extras))
 
 
 def test_import_ruledmesh_loads_no_heavy_module(tmp_path):
     names = imported("import ruledmesh", tmp_path)
-    assert _offenders(names) == []
+    assert _offenders(names, NUMPY_EXTRAS) == []
     assert not any(n.startswith(("ruledmesh.pq", "ruledmesh.skew", "ruledmesh.curves")) for n in names)
 
 
 def test_cli_help_loads_no_heavy_module(tmp_path):
     names = imported("from ruledmesh.cli import main\ntry:\n    main(['--help'])\n"
                      "except SystemExit:\n    pass", tmp_path)
-    assert _offenders(names) == []
+    assert _offenders(names, NUMPY_EXTRAS) == []
+    # Help text only: nothing that builds or measures a mesh.
+    assert not any(n.startswith(("ruledmesh.analysis", "ruledmesh.design", "ruledmesh.io.", "ruledmesh.pq",
+                                 "ruledmesh.skew", "ruledmesh.curves", "ruledmesh.rulings"))
+                   for n in names), sorted(n for n in names if n.startswith("ruledmesh."))
 
 
 @pytest.mark.parametrize("example", ["skew", "fig7b-hyperboloid-circular"])
@@ -63,3 +84,13 @@ def test_small_build_loads_no_scipy(tmp_path, example):
     names = imported(code, tmp_path)
     assert (tmp_path / "m.obj").is_file()
     assert _offenders(names) == []
+
+
+@pytest.mark.parametrize("example", ["fig7b-hyperboloid-circular", "fig8-helicoid", "fig6a-prism"])
+def test_small_build_outside_the_skew_mesher_loads_no_masked_arrays(tmp_path, example):
+    """The analysis and the exact constructions take order statistics and unique values
+    without numpy.ma (ruledmesh._arrays); the §4.3 mesher still asks numpy for them."""
+    code = (f"from ruledmesh.cli import main\n"
+            f"assert main(['build', {str(EXAMPLES / (example + '.toml'))!r}, '-o', 'm.obj']) == 0")
+    names = imported(code, tmp_path)
+    assert _offenders(names, ("numpy.ma",)) == []

@@ -1,19 +1,25 @@
-"""Array helpers that numpy has, but slowly: sorted unique values, cross products, box diagonals;
-and the ranks within groups of given sizes, which numpy has not.
+"""Array helpers that numpy has, but slowly: sorted unique values, cross products, box diagonals,
+percentiles and medians; and the ranks within groups of given sizes, which numpy has not.
 
 numpy 2.3+ finds the unique values of a plain ``np.unique(x)`` through a hash
 table and sorts them afterwards; on arrays of a million edge keys or vertex
 indices that is 30-70 times slower than sorting first (the table misses the
 cache at every insertion), and its first call imports ``numpy.ma`` (about 20 ms)
 to ask whether the array is masked.  :func:`unique` is numpy's own
-sorting method, so its result is the same array.
+sorting method, so its result is the same array.  ``np.percentile`` and
+``np.median`` import ``numpy.ma`` too (through ``np.unique`` and a masked-NaN
+check), which is a third of a small build's analysis on a cold start:
+:func:`percentile` and :func:`median` take the same order statistics and
+interpolate as numpy does, so their values are numpy's.
 """
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
 
-__all__ = ["cross", "diagonal", "member", "norm", "ranks", "unique"]
+__all__ = ["cross", "diagonal", "median", "member", "norm", "percentile", "ranks", "unique"]
 
 
 def unique(values: np.ndarray) -> np.ndarray:
@@ -69,6 +75,50 @@ def member(values: np.ndarray, among: np.ndarray) -> np.ndarray:
         return np.zeros(v.shape, dtype=bool)
     i = np.minimum(np.searchsorted(s, v), s.size - 1)
     return s[i] == v
+
+
+def percentile(values: np.ndarray, q: float) -> float:
+    """``np.percentile(values, q)`` (its default, linear method), without importing ``numpy.ma``.
+
+    Parameters
+    ----------
+    values : (n,) array_like of float, n >= 1
+        Flattened first.  A NaN among them makes the result NaN, as in numpy.
+    q : float in [0, 100]
+
+    Returns
+    -------
+    float
+        The same number as numpy's: the order statistics at ``floor`` and
+        ``ceil`` of ``(n - 1) q / 100``, blended by numpy's own lerp (from the
+        upper one when the weight is at least one half).
+    """
+    arr = np.sort(np.asarray(values, dtype=np.float64).ravel())
+    if np.isnan(arr[-1]):  # NaNs sort last
+        return float("nan")
+    virtual = (arr.size - 1) * (q / 100)
+    lo = min(math.floor(virtual), arr.size - 1)
+    hi = min(lo + 1, arr.size - 1)
+    a, b, t = arr[lo], arr[hi], virtual - lo
+    diff = b - a
+    return float(b - diff * (1 - t) if t >= 0.5 else a + diff * t)
+
+
+def median(values: np.ndarray) -> float:
+    """``np.median(values)`` without importing ``numpy.ma``: the middle value, or the mean of the two.
+
+    Parameters
+    ----------
+    values : (n,) array_like of float, n >= 1
+        Flattened first; a NaN among them makes the result NaN, as in numpy.
+    """
+    arr = np.sort(np.asarray(values, dtype=np.float64).ravel())
+    if np.isnan(arr[-1]):
+        return float("nan")
+    mid = arr.size // 2
+    # numpy takes the mean of the middle slice: (a + b) / 2 for an even count.
+    return float(arr[mid] if arr.size % 2 else (arr[mid - 1] + arr[mid]) / 2)
+
 
 # Up to this many numbers per operand, :func:`cross` gathers the components (faster on a
 # few vectors, much slower on many).

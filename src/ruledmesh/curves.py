@@ -146,19 +146,83 @@ _ALTERNATING = (-1.0) ** np.arange(_GL_NODES + 2)
 
 
 def _clenshaw(coef: np.ndarray, xi: np.ndarray) -> np.ndarray:
-    """(N,) values of Legendre series with per-point coefficients ``coef (N, n)`` at ``xi``."""
-    n = coef.shape[1]
+    """(N,) values at ``xi (N,)`` of Legendre series whose ``j``-th coefficients are ``coef[j]``.
+
+    ``coef`` is ``(n, N)``, coefficient first, so each step of the recurrence
+    reads one contiguous row (gathered per point from a table stored that way).
+    """
+    n = coef.shape[0]
     if n == 1:
-        return coef[:, 0] + xi * 0.0 - 0.0
+        return coef[0] + xi * 0.0 - 0.0
     # The first two steps with their zero terms left out: adding a product with a zero
     # b (or subtracting +0) changes no value but the sign of an exact zero.
-    b2 = coef[:, n - 1]
-    b1 = coef[:, n - 2] + (2 * n - 3) / (n - 1) * xi * b2 if n > 2 else b2
+    b2 = coef[n - 1]
+    b1 = coef[n - 2] + (2 * n - 3) / (n - 1) * xi * b2 if n > 2 else b2
     for j in range(n - 3, 0, -1):
-        b1, b2 = coef[:, j] + (2 * j + 1) / (j + 1) * xi * b1 - (j + 1) / (j + 2) * b2, b1
+        b1, b2 = coef[j] + (2 * j + 1) / (j + 1) * xi * b1 - (j + 1) / (j + 2) * b2, b1
     if n == 2:
-        return coef[:, 0] + xi * b1
-    return coef[:, 0] + xi * b1 - 0.5 * b2
+        return coef[0] + xi * b1
+    return coef[0] + xi * b1 - 0.5 * b2
+
+
+@dataclass
+class _Bracketed:
+    """Points of a bracketed Newton solve on the tabulated arc length: piece, iterate, bracket, target."""
+
+    piece: np.ndarray
+    u: np.ndarray
+    lo: np.ndarray
+    hi: np.ndarray
+    target: np.ndarray
+
+    def keep(self, live: np.ndarray) -> _Bracketed:
+        return _Bracketed(self.piece[live], self.u[live], self.lo[live], self.hi[live], self.target[live])
+
+
+def _newton_on_lengths(both: np.ndarray, pieces: np.ndarray, cum: np.ndarray, pts: _Bracketed,
+                       scale: float) -> np.ndarray:
+    """(N,) parameters where the arc-length series reach ``pts.target``: Newton kept in the bracket.
+
+    Parameters
+    ----------
+    both : (n, 2, p) float64
+        The arc-length and speed series per piece (:attr:`Curve._newton_series`).
+    pieces, cum : (p + 1,) float64
+        Piece ends and the arc length there.
+    pts : _Bracketed
+        The start: iterates inside their brackets ``[lo, hi]`` on their pieces.
+    scale : float
+        A residual below :data:`CONVERGED` times this is exact.
+
+    Returns
+    -------
+    (N,) float64
+        A step of at most :data:`_NEWTON_FINAL_STEP` ends a point's iteration (or
+        an exact residual, or :data:`_NEWTON_ITERATIONS` steps).
+    """
+    out = pts.u.copy()
+    todo = np.arange(out.size)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        for _ in range(_NEWTON_ITERATIONS):
+            k, u = pts.piece, pts.u
+            width = pieces[k + 1] - pieces[k]
+            xi = 2.0 * (u - pieces[k]) / width - 1.0
+            # Both series in one pass: the arc lengths, then the speeds, side by side.
+            m = k.size
+            series = _clenshaw(both[:, :, k].reshape(len(both), 2 * m), np.concatenate([xi, xi]))
+            f = cum[k] + width * series[:m] - pts.target
+            lo, hi = np.where(f < 0, u, pts.lo), np.where(f > 0, u, pts.hi)
+            new = u - f / series[m:]
+            new = np.where(~np.isfinite(new) | (new < lo) | (new > hi), 0.5 * (lo + hi), new)
+            exact = np.abs(f) <= CONVERGED * scale
+            step = np.where(exact, u, new)
+            out[todo] = step
+            live = ~(exact | (np.abs(new - u) <= _NEWTON_FINAL_STEP))
+            if not live.any():
+                break
+            pts = _Bracketed(k, step, lo, hi, pts.target).keep(live)
+            todo = todo[live]
+    return out
 
 
 class CubicHermite:
@@ -220,6 +284,42 @@ def _de_boor(knots: np.ndarray, control: np.ndarray, degree: int, x: np.ndarray)
         alpha = np.divide(flat[:, None] - left, denom, out=np.zeros(denom.shape), where=denom > 0)
         d[:, r:] = (1.0 - alpha)[..., None] * d[:, r - 1:-1] + alpha[..., None] * d[:, r:]
     return d[:, degree].reshape(x.shape + (control.shape[1],))
+
+
+# From this many points, curves are evaluated one coordinate at a time: numpy's loops over
+# the innermost axis of (N, 3) arrays run 3 numbers per call, several times slower than the
+# arithmetic on a few thousand points (the closeness analysis evaluates tens of thousands).
+# Below it the whole points are cheaper.  The numbers are the same either way.
+_BY_COLUMNS = 256
+
+
+def _by_columns(column: Callable[[int], np.ndarray], shape: tuple[int, ...]) -> np.ndarray:
+    """``(*shape, 3)`` points whose coordinate ``x`` is ``column(x)`` (an array of ``shape``)."""
+    out = np.empty(shape + (3,))
+    for x in range(3):
+        out[..., x] = column(x)
+    return out
+
+
+def _horner_by_columns(u: np.ndarray, start: np.ndarray, width: np.ndarray,
+                       coef: np.ndarray) -> np.ndarray:
+    """(N, 3): the span polynomials ``coef`` (spans, terms, 3) at ``u`` (N,), one coordinate at
+    a time, with the steps of :meth:`BSpline._poly`'s Horner rule (so the same numbers)."""
+    if len(start) == 1:
+        tau = (u - start[0]) / width[0]
+        terms = coef[0]
+    else:
+        k = np.clip(np.searchsorted(start, u, side="right") - 1, 0, len(start) - 1)
+        tau = (u - start[k]) / width[k]
+        terms = coef[k].transpose(1, 2, 0)  # (terms, 3, N): a row per coefficient and coordinate
+
+    def column(x: int) -> np.ndarray:
+        out = np.broadcast_to(terms[-1, x], u.shape)
+        for j in range(terms.shape[0] - 2, -1, -1):
+            out = out * tau + terms[j, x]
+        return out
+
+    return _by_columns(column, u.shape)
 
 
 # --------------------------------------------------------------------------
@@ -656,6 +756,17 @@ class Curve:
     def _length_pieces(self) -> np.ndarray:
         return self._breaks()
 
+    @cached_property
+    def _newton_series(self) -> np.ndarray:
+        """(n, 2, p) float64: coefficient ``j`` of each piece's arc-length series (``[j, 0]``)
+        and of its speed series (``[j, 1]``, a zero appended: a leading zero changes no
+        value of Clenshaw's sum), laid out for :func:`_clenshaw` to read rows of."""
+        _, _, speed, length = self._length_series
+        both = np.zeros((length.shape[1], 2, len(length)))
+        both[:, 0] = length.T
+        both[:speed.shape[1], 1] = speed.T
+        return both
+
     def length(self) -> float:
         """Total arc length."""
         return float(self._length_table[1][-1])
@@ -668,10 +779,10 @@ class Curve:
         return k, 2.0 * (u - pieces[k]) / width - 1.0, width
 
     def _arclength(self, u: np.ndarray) -> np.ndarray:
-        _, cum, _, length = self._length_series
+        cum = self._length_series[1]
         flat = u.ravel()
         k, xi, width = self._series_at(flat)
-        return (cum[k] + width * _clenshaw(length[k], xi)).reshape(u.shape)
+        return (cum[k] + width * _clenshaw(self._newton_series[:, 0, k], xi)).reshape(u.shape)
 
     def arclength(self, u: Any) -> np.ndarray:
         """Arc length from ``c(0)`` to ``c(u)``.
@@ -687,7 +798,7 @@ class Curve:
         return self._arclength(_unit_params(u))
 
     def _param_at_length(self, s: np.ndarray) -> np.ndarray:
-        pieces, cum, speed_c, length_c = self._length_series
+        pieces, cum, speed_c, _ = self._length_series
         total = cum[-1]
         flat = np.clip(s.ravel(), 0.0, total)
         # The piece holding each length, then Newton on the piece's arc-length series
@@ -709,24 +820,8 @@ class Curve:
                                   + (t * t - t) * t * m1)
         good = np.isfinite(guess) & (guess >= lo) & (guess <= hi) & (v0 > 0) & (v1 > 0)
         u = np.where(good, guess, u)
-        scale = max(total, TINY)
-        todo = np.arange(flat.size)
-        for _ in range(_NEWTON_ITERATIONS):
-            uu, kk = u[todo], k[todo]
-            xi = 2.0 * (uu - pieces[kk]) / width[todo] - 1.0
-            f = cum[kk] + width[todo] * _clenshaw(length_c[kk], xi) - flat[todo]
-            lo[todo] = np.where(f < 0, uu, lo[todo])
-            hi[todo] = np.where(f > 0, uu, hi[todo])
-            with np.errstate(divide="ignore", invalid="ignore"):
-                new = uu - f / _clenshaw(speed_c[kk], xi)
-            bad = ~np.isfinite(new) | (new < lo[todo]) | (new > hi[todo])
-            new = np.where(bad, 0.5 * (lo[todo] + hi[todo]), new)
-            exact = np.abs(f) <= CONVERGED * scale
-            u[todo] = np.where(exact, uu, new)
-            done = exact | (np.abs(new - uu) <= _NEWTON_FINAL_STEP)
-            todo = todo[~done]
-            if not todo.size:
-                break
+        u = _newton_on_lengths(self._newton_series, pieces, cum, _Bracketed(k, u, lo, hi, flat),
+                               max(total, TINY))
         u = np.where(flat <= 0.0, 0.0, np.where(flat >= total, 1.0, u))
         return u.reshape(s.shape)
 
@@ -957,6 +1052,8 @@ class Polyline(Curve):
         i = self._segment(u)
         f = (u - k[i]) / (k[i + 1] - k[i])
         p = self.points
+        if f.size >= _BY_COLUMNS:
+            return _by_columns(lambda x: p[i, x] + f * (p[i + 1, x] - p[i, x]), f.shape)
         return p[i] + f[..., None] * (p[i + 1] - p[i])
 
     def _deriv(self, u, order):
@@ -964,7 +1061,10 @@ class Polyline(Curve):
             return np.zeros(u.shape + (3,))
         k = self._knots
         i = self._segment(u)
-        return (self.points[i + 1] - self.points[i]) / (k[i + 1] - k[i])[..., None]
+        p, h = self.points, k[i + 1] - k[i]
+        if h.size >= _BY_COLUMNS:
+            return _by_columns(lambda x: (p[i + 1, x] - p[i, x]) / h, h.shape)
+        return (p[i + 1] - p[i]) / h[..., None]
 
     def _breaks(self):
         return self._knots
@@ -1269,6 +1369,8 @@ class BSpline(Curve):
         start, width, _ = self._pieces
         c = self._derivative_pieces[order]
         flat = u.ravel()
+        if flat.size >= _BY_COLUMNS:
+            return _horner_by_columns(flat, start, width, c).reshape(u.shape + (3,))
         if len(start) == 1:  # one span: no gather
             tau = ((flat - start[0]) / width[0])[:, None]
             out = np.broadcast_to(c[0, -1], (flat.size, 3))

@@ -148,11 +148,22 @@ def _dense_sigma(curve: BSpline, exact: _ArcLength, grid: np.ndarray,
     j = np.arange(1, k) / k
     p_mid = (p_gen[:-1, None] + (p_gen[1:] - p_gen[:-1])[:, None] * j[None, :])
     u_mid = curve.arclength(p_mid) / curve.length()
-    u = np.concatenate([np.c_[u_gen[:-1], u_mid].ravel(), u_gen[-1:]])
-    p = np.concatenate([np.c_[p_gen[:-1], p_mid].ravel(), p_gen[-1:]])
+    u = _interleaved(u_gen, u_mid)
+    p = _interleaved(p_gen, p_mid)
     if not (np.all(np.diff(u) > 0) and np.all(np.diff(p) > 0)):
         return None
     return u, p
+
+
+def _interleaved(ends: np.ndarray, between: np.ndarray) -> np.ndarray:
+    """``ends[0], between[0], ends[1], between[1], ..., ends[-1]``: (m + (m - 1) (k - 1),) float64.
+
+    ``between`` is ``(m - 1, k - 1)``: the values inside each interval of ``ends``.
+    """
+    rows = np.empty((len(between), between.shape[1] + 1))
+    rows[:, 0] = ends[:-1]
+    rows[:, 1:] = between
+    return np.concatenate([rows.ravel(), ends[-1:]])
 
 
 @dataclass(frozen=True, eq=False)

@@ -34,6 +34,7 @@ from functools import cache
 
 import numpy as np
 
+from ._arrays import unique
 from ._validation import check_choice
 from .mesh import Mesh
 from .tolerances import ROUNDING
@@ -281,7 +282,7 @@ def triangulate(mesh: Mesh, quads: QuadSplit | str = QuadSplit.SHORTER) -> Trian
     offsets = np.zeros(mesh.n_faces + 1, dtype=np.int64)
     np.cumsum(val - 2, out=offsets[1:])
     triangles = np.zeros((int(offsets[-1]), 3), dtype=np.int64)
-    for k in np.unique(val).tolist():
+    for k in unique(val).tolist():
         ids, faces = mesh.faces_of_valence(k)
         if k <= MAX_TEMPLATE_VALENCE:
             templates = polygon_templates(k)

@@ -24,6 +24,8 @@ __all__ = [
     "polygon_planarity",
     "planarity",
     "convexity",
+    "crossing_inside",
+    "polygon_convexity",
     "face_areas",
     "face_normals",
     "face_centroids",
@@ -296,23 +298,52 @@ def convexity(mesh: Mesh, tol: float = DEFAULT.convexity) -> np.ndarray:
     qid, quads = mesh.faces_of_valence(4)
     if qid.size:
         s, t, _ = quad_diagonal_crossing(mesh.vertices[quads])
-        ok[qid] = (s > tol) & (s < 1 - tol) & (t > tol) & (t < 1 - tol)
+        ok[qid] = crossing_inside(s, t, tol)
     other = np.flatnonzero(mesh.valences > 4)
     if other.size:
-        normals, _ = face_normals(mesh)
-        pts, mask = _padded_corners(mesh, other)
-        val = mesh.valences[other]
-        k = pts.shape[1]
-        cols = np.arange(k)
-        nxt = np.where(cols[None, :] + 1 < val[:, None], cols[None, :] + 1, 0)
-        prv = np.where(cols[None, :] > 0, cols[None, :] - 1, val[:, None] - 1)
-        rows = np.arange(len(other))[:, None]
-        e1 = pts - pts[rows, prv]
-        e2 = pts[rows, nxt] - pts
-        turn = np.einsum("fki,fi->fk", cross(e1, e2), normals[other])
-        scale = (np.linalg.norm(e1, axis=2) * np.linalg.norm(e2, axis=2))
-        ok[other] = np.all((turn >= -tol * scale) | ~mask, axis=1)
+        ok[other] = polygon_convexity(mesh, other, face_normals(mesh)[0][other], tol)
     return ok
+
+
+def crossing_inside(s: np.ndarray, t: np.ndarray, tol: float = DEFAULT.convexity) -> np.ndarray:
+    """(F,) bool: quads whose diagonals cross strictly inside both, from their crossing.
+
+    Parameters
+    ----------
+    s, t : (F,) float64
+        The first two results of :func:`quad_diagonal_crossing`.
+    tol : float
+        Margin from the diagonals' ends, relative to their lengths.
+    """
+    return (s > tol) & (s < 1 - tol) & (t > tol) & (t < 1 - tol)
+
+
+def polygon_convexity(mesh: Mesh, ids: np.ndarray, normals: np.ndarray,
+                      tol: float = DEFAULT.convexity) -> np.ndarray:
+    """(k,) bool: the faces ``ids`` whose corners all turn the same way about their normals.
+
+    Parameters
+    ----------
+    mesh : Mesh
+    ids : (k,) int
+        Faces of any valence (meant for those of 5 or more corners).
+    normals : (k, 3) float64
+        Their unit normals (:func:`face_normals`).
+    tol : float
+        A corner may turn back by this much relative to the product of its edges.
+    """
+    pts, mask = _padded_corners(mesh, ids)
+    val = mesh.valences[ids]
+    k = pts.shape[1]
+    cols = np.arange(k)
+    nxt = np.where(cols[None, :] + 1 < val[:, None], cols[None, :] + 1, 0)
+    prv = np.where(cols[None, :] > 0, cols[None, :] - 1, val[:, None] - 1)
+    rows = np.arange(len(ids))[:, None]
+    e1 = pts - pts[rows, prv]
+    e2 = pts[rows, nxt] - pts
+    turn = np.einsum("fki,fi->fk", cross(e1, e2), normals)
+    scale = (np.linalg.norm(e1, axis=2) * np.linalg.norm(e2, axis=2))
+    return np.all((turn >= -tol * scale) | ~mask, axis=1)
 
 
 def edge_lengths(mesh: Mesh) -> np.ndarray:

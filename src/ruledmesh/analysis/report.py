@@ -29,12 +29,13 @@ from typing import Any
 
 import numpy as np
 
-from .._arrays import unique
+from .._arrays import median, percentile, unique
 from ..errors import GeometryError
 from ..mesh import FaceKind, Mesh
 from ..progress import Progress, stages
 from ..tolerances import DEFAULT, Tolerances
 from . import faces as F
+from .live import face_measures, figure_warnings, min_max_mean, scaled_back, unit_copy, unit_figures
 
 __all__ = ["KIND_NOUNS", "METRIC_HOOKS", "MISMATCH", "analyze", "format_summary", "format_table",
            "kind_counts", "strict_json"]
@@ -83,12 +84,6 @@ def _load_hooks() -> None:
                 raise
 
 
-def _stats(values: np.ndarray) -> dict[str, float]:
-    if values.size == 0:
-        return {"min": 0.0, "max": 0.0, "mean": 0.0}
-    return {"min": float(values.min()), "max": float(values.max()), "mean": float(values.mean())}
-
-
 def kind_counts(counts: Mapping[str, int]) -> str:
     """Face counts by kind in words: ``"633 quads, 9 border faces, 306 fill triangles"``.
 
@@ -104,24 +99,6 @@ def kind_counts(counts: Mapping[str, int]) -> str:
     return ", ".join(words) or "no faces"
 
 
-def _planarity(plan: np.ndarray, mesh: Mesh, tol: Tolerances) -> dict[str, Any]:
-    """Planarity figures; faces exact (to rounding) told apart from those within a tolerance."""
-    from .planar import planarity_tolerance
-
-    ptol = planarity_tolerance(mesh, tol)
-    exact = plan <= tol.planarity
-    within = ~exact & (plan <= ptol)
-    return {
-        **_stats(plan),
-        "tolerance": ptol,
-        "above_tolerance": int(np.count_nonzero(plan > ptol)),
-        "exact": int(np.count_nonzero(exact)),
-        "within_tolerance": int(np.count_nonzero(within)),
-        "max_exact": float(plan[exact].max()) if exact.any() else 0.0,
-        "max_within_tolerance": float(plan[within].max()) if within.any() else 0.0,
-    }
-
-
 def _quality(mesh: Mesh, tol: Tolerances) -> dict[str, Any]:
     """What a fabricator reads first: area in quads, splinters, degenerate faces."""
     shares = F.area_shares(mesh)
@@ -130,8 +107,8 @@ def _quality(mesh: Mesh, tol: Tolerances) -> dict[str, Any]:
         "area_share": shares,
         "face_min_angle_deg": {
             "min": float(smallest.min()) if smallest.size else 0.0,
-            "p5": float(np.percentile(smallest, 5)) if smallest.size else 0.0,
-            "median": float(np.median(smallest)) if smallest.size else 0.0,
+            "p5": percentile(smallest, 5) if smallest.size else 0.0,
+            "median": median(smallest) if smallest.size else 0.0,
         },
         "faces_below_3deg": int(np.count_nonzero(smallest < F.SPLINTER_DEG)),
         "degenerate_faces": int(np.count_nonzero(F.degenerate_faces(mesh, tol.degenerate))),
@@ -176,10 +153,10 @@ def analyze(mesh: Mesh, reference=None, extras: Mapping[str, Any] | None = None,
     # so they do not depend on the scale of the mesh, and products of lengths never
     # overflow; absolute figures are scaled back.  Whatever still overflows (areas
     # of a mesh near 1e308) becomes null in the report, not a numpy warning.
-    work, scale = _unit_copy(mesh)
+    work, scale = unit_copy(mesh)
     names = ["faces"] + ["closeness"] * (reference is not None) + list(METRIC_HOOKS)
     with stages(progress, "analyse", names) as task, np.errstate(all="ignore"):
-        report = _scaled_back(_figures(work, tol), scale)
+        report = scaled_back(_figures(work, tol), scale)
         task.advance(note=names[1] if len(names) > 1 else None)
         if reference is not None:
             report.update(_closeness(mesh, reference, report["area"]["total"]))
@@ -196,27 +173,6 @@ def analyze(mesh: Mesh, reference=None, extras: Mapping[str, Any] | None = None,
         report.update(dict(extras))
     report["warnings"] = _warnings(work, report, tol)
     return strict_json(report)
-
-
-def _unit_copy(mesh: Mesh) -> tuple[Mesh, float]:
-    """``mesh`` moved to the origin and scaled by a power of two to unit size (:func:`unit_frame`)."""
-    from ..normalise import unit_frame
-
-    v = mesh.vertices
-    if not v.size or not np.all(np.isfinite(v)):
-        return mesh, 1.0
-    centre, scale = unit_frame(v)
-    return mesh.with_vertices((v - centre) / scale), scale
-
-
-def _scaled_back(report: dict[str, Any], scale: float) -> dict[str, Any]:
-    """The absolute figures of a report taken in the unit frame, in the mesh's units."""
-    if scale == 1.0:
-        return report
-    report["diagonal"] *= scale
-    report["area"] = {k: v * scale * scale for k, v in report["area"].items()}
-    report["edge_length"] = {k: v * scale for k, v in report["edge_length"].items()}
-    return report
 
 
 def strict_json(report: dict[str, Any]) -> dict[str, Any]:
@@ -251,33 +207,20 @@ def strict_json(report: dict[str, Any]) -> dict[str, Any]:
 
 def _figures(mesh: Mesh, tol: Tolerances) -> dict[str, Any]:
     """The figures every mesh has: counts, planarity, convexity, sizes, angles."""
-    diag = mesh.diagonal() or 1.0
-    from .planar import face_planarity
-
-    plan = face_planarity(mesh)
-    convex = F.convexity(mesh, tol.convexity)
-    _normals, areas = F.face_normals(mesh)
+    live = unit_figures(mesh, face_measures(mesh, tol), tol)
     angles = F.corner_angles(mesh)
     edges = mesh.edges()
     lengths = np.linalg.norm(mesh.vertices[edges[:, 1]] - mesh.vertices[edges[:, 0]], axis=1)
-    finite = bool(np.all(np.isfinite(mesh.vertices)))
-    report: dict[str, Any] = {
-        "vertices": mesh.n_vertices,
-        "faces": mesh.n_faces,
-        "members": len(mesh.members),
-        "kinds": mesh.count_kinds(),
-        "valences": {str(int(k)): int(c) for k, c in zip(*np.unique(mesh.valences, return_counts=True))},
-        "finite": finite,
-        "diagonal": diag,
-        "planarity": _planarity(plan, mesh, tol),
-        "non_convex": int(np.count_nonzero(~convex)),
-        "area": {**_stats(areas), "total": float(areas.sum())},
-        "edge_length": _stats(lengths),
+    report: dict[str, Any] = {k: live[k] for k in ("vertices", "faces", "members", "kinds")}
+    report["valences"] = {str(int(k)): int(c) for k, c in zip(*np.unique(mesh.valences, return_counts=True))}
+    report.update({k: live[k] for k in ("finite", "diagonal", "planarity", "non_convex", "area")})
+    report.update({
+        "edge_length": min_max_mean(lengths),
         "min_angle_deg": float(angles.min()) if angles.size else 0.0,
         "quality": _quality(mesh, tol),
         "euler_characteristic": mesh.euler_characteristic(len(edges)),
         "t_junctions": _t_junctions(mesh),
-    }
+    })
     return report
 
 
@@ -336,10 +279,8 @@ def _warnings(mesh: Mesh, report: dict[str, Any], tol: Tolerances) -> list[str]:
     from .guarantees import check_guarantee, format_guarantee
 
     warnings = list(mesh.info.get("warnings", []))
-    if not report["finite"]:
-        warnings.append("mesh has NaN or infinite coordinates")
-    if report["non_convex"]:
-        warnings.append(f"{report['non_convex']} faces are not convex")
+    nonfinite, non_convex, bent = figure_warnings(report)
+    warnings += [w for w in (nonfinite, non_convex) if w]
     share = report["quality"]["area_share"]
     said = any("of the area is not in quads" in w for w in warnings)
     if mesh.n_faces and 1.0 - share["quads"] > 0.3 and not said:
@@ -353,9 +294,8 @@ def _warnings(mesh: Mesh, report: dict[str, Any], tol: Tolerances) -> list[str]:
                         "welding or smoothing in another program would open a gap there)")
     if report["quality"]["degenerate_faces"]:
         warnings.append(f"{report['quality']['degenerate_faces']} faces have no area")
-    if report["planarity"]["above_tolerance"]:
-        warnings.append(f"{report['planarity']['above_tolerance']} faces are not planar to "
-                        f"{report['planarity']['tolerance']:g}")
+    if bent:
+        warnings.append(bent)
     if "closeness" in report:
         why = _design_mismatch(report)
         report["matches_design"] = not why

@@ -23,6 +23,7 @@ from typing import Any
 
 import numpy as np
 
+from .._arrays import median, percentile
 from ..errors import ParameterError
 from ..mesh import Mesh
 from ..tolerances import OCCT_FACE, TINY
@@ -106,11 +107,11 @@ def triangle_quality(vertices: np.ndarray, triangles: np.ndarray) -> dict[str, A
     return {
         "triangles": len(pts),
         "min_angle_deg": float(mins.min()),
-        "min_angle_percentiles": {f"p{q}": float(np.percentile(mins, q)) for q in (1, 5, 50)},
+        "min_angle_percentiles": {f"p{q}": percentile(mins, q) for q in (1, 5, 50)},
         "splinters": int(np.count_nonzero(mins < SPLINTER_ANGLE)),
         # Degenerate triangles (infinite ratio) are counted, not averaged: statistics of
         # infinities are NaN, and JSON has no infinity.
-        "aspect_ratio": ({"median": float(np.median(fin)), "p95": float(np.percentile(fin, 95)),
+        "aspect_ratio": ({"median": median(fin), "p95": percentile(fin, 95),
                           "max": float(fin.max())} if (fin := ar[np.isfinite(ar)]).size
                          else {"median": 0.0, "p95": 0.0, "max": 0.0}),
         "degenerate_triangles": int(np.count_nonzero(~np.isfinite(ar))),
