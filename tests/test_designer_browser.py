@@ -639,6 +639,85 @@ def test_quads_edges_generators_and_colourings_with_figures(page, designer):
     shot(page, "45-generators")
 
 
+# Counts the pixels of colour `rgb` (within `tol`) in a (2r+1)-square of the canvas around
+# the page point (x, y).
+PIXELS_NEAR_JS = """([x, y, r, rgb, tol]) => {
+  const src = document.getElementById('canvas');
+  const box = src.getBoundingClientRect();
+  const c = document.createElement('canvas');
+  c.width = c.height = 2 * r + 1;
+  const g = c.getContext('2d');
+  const sx = src.width / box.width, sy = src.height / box.height;
+  g.drawImage(src, (x - box.left - r) * sx, (y - box.top - r) * sy, (2 * r + 1) * sx, (2 * r + 1) * sy,
+              0, 0, 2 * r + 1, 2 * r + 1);
+  const d = g.getImageData(0, 0, 2 * r + 1, 2 * r + 1).data;
+  let n = 0;
+  for (let i = 0; i < d.length; i += 4) {
+    if (Math.abs(d[i] - rgb[0]) <= tol && Math.abs(d[i + 1] - rgb[1]) <= tol
+        && Math.abs(d[i + 2] - rgb[2]) <= tol) n += 1;
+  }
+  return n;
+}"""
+HIGHLIGHT_RGB = [0xB0, 0x20, 0x8A]
+
+
+def test_panel_figures_are_analyze_s_and_show_their_faces(page, designer):
+    from ruledmesh.analysis.faces import SPLINTER_DEG, face_min_angles
+
+    built = designer.session.built
+    mesh = built.mesh
+    report = analyze(mesh, extras=built.extras)
+    smallest = face_min_angles(mesh)
+    # the figures under the legend are those of ruledmesh analyze, each at its face
+    fig = page.evaluate("window.designer.panelFigures")
+    assert fig["quads"] == pytest.approx(report["quality"]["area_share"]["quads"], rel=1e-12)
+    assert fig["minAngle"] == pytest.approx(report["min_angle_deg"], rel=1e-12)
+    assert fig["planarity"] == pytest.approx(report["planarity"]["max"], rel=1e-12)
+    f = fig["minAngleFace"]
+    assert f == int(np.argmin(smallest))
+    assert fig["splinters"] == int(np.count_nonzero(smallest < SPLINTER_DEG)) > 0
+    text = page.inner_text("#panel-figures")
+    assert f"{100 * report['quality']['area_share']['quads']:.1f} %" in text
+    assert f"{report['min_angle_deg']:.2f}°" in text and f"P{f}" in text
+    # the face named is shown: its panel opens, its outline and centre drawn over the mesh
+    page.click('[data-view="top"]')
+    page.wait_for_function("window.designer.view === 'top'")
+    pos = page.evaluate(f"window.designer.faceScreen({f})")
+    assert page.evaluate(PIXELS_NEAR_JS, [pos["x"], pos["y"], 6, HIGHLIGHT_RGB, 40]) == 0
+    page.click(f'#panel-figures a[data-face="{f}"]')
+    page.wait_for_selector("#drawer:not([hidden])")
+    page.wait_for_function(f"window.designer.panel && window.designer.panel.face === {f}")
+    assert page.evaluate("window.designer.highlighted()") == f
+    row = page.evaluate("window.designer.panel.row")
+    assert row["label"] == f"P{f}"
+    assert row["min_angle_deg"] == pytest.approx(smallest[f], abs=1e-6)
+    page.evaluate("() => new Promise(requestAnimationFrame)")
+    assert page.evaluate(PIXELS_NEAR_JS, [pos["x"], pos["y"], 6, HIGHLIGHT_RGB, 40]) > 10
+    shot(page, "smallest-angle-face")
+    # colour by the smallest angle: a log ramp with the splinter limit marked
+    page.select_option("#colour", "angle")
+    legend = page.evaluate("window.designer.legend")
+    assert legend["min"] == pytest.approx(smallest.min(), rel=1e-6)
+    assert legend["max"] == pytest.approx(smallest.max(), rel=1e-6)
+    assert legend["below"] == int(np.count_nonzero(smallest.astype(np.float32) < SPLINTER_DEG))
+    assert page.locator("#legend .mark").count() == 1 and "splinter" in page.inner_text("#legend")
+    shot(page, "colour-angle")
+    # the kinds with their area shares
+    page.select_option("#colour", "kind")
+    text = page.inner_text("#legend")
+    for kind, share in report["quality"]["area_share"]["by_kind"].items():
+        assert f"{kind} {mesh.count_kinds()[kind]} ({100 * share:.1f} %)" in text, (kind, text)
+    # planarity of the faces that can be out of plane: triangles are grey, not counted
+    page.select_option("#colour", "planarity")
+    legend = page.evaluate("window.designer.legend")
+    assert legend["faces"] == int(np.count_nonzero(mesh.valences > 3)) < mesh.n_faces
+    # closing the panel takes the highlight away
+    page.click("#drawer-close")
+    assert page.evaluate("window.designer.highlighted()") is None
+    page.evaluate("() => new Promise(requestAnimationFrame)")
+    assert page.evaluate(PIXELS_NEAR_JS, [pos["x"], pos["y"], 6, HIGHLIGHT_RGB, 40]) == 0
+
+
 def test_insert_delete_points_and_type_coordinates_each_one_undo_step(page, designer):
     click_handle(page, "c1.points[1]")
     page.wait_for_function("window.designer.selection().join() === 'c1.points[1]'")
