@@ -659,6 +659,7 @@ PIXELS_NEAR_JS = """([x, y, r, rgb, tol]) => {
   return n;
 }"""
 HIGHLIGHT_RGB = [0xB0, 0x20, 0x8A]
+HOVER_RGB = [0xFF, 0xD4, 0x00]
 
 
 def test_panel_figures_are_analyze_s_and_show_their_faces(page, designer):
@@ -840,6 +841,12 @@ def test_hover_reads_a_face_and_click_opens_its_panel(page, designer):
     page.wait_for_function("window.designer.hover !== null")
     info = page.evaluate("window.designer.hover")
     g = info["face"]
+    # the face under the pointer is outlined: its corners, drawn over the mesh
+    outline = page.evaluate("window.designer.hoverOutline()")
+    assert outline["visible"]
+    np.testing.assert_array_equal(outline["corners"], mesh.vertices[mesh.face(g)].astype(np.float32))
+    page.evaluate("() => new Promise(requestAnimationFrame)")
+    assert page.evaluate(PIXELS_NEAR_JS, [pos["x"], pos["y"], 60, HOVER_RGB, 40]) > 20
     assert info["label"] == f"P{g}" == table["label"][g]
     assert info["kind"] == table["kind"][g]
     assert info["area"] == pytest.approx(abs(table["area"][g]), rel=1e-4)
@@ -856,7 +863,18 @@ def test_hover_reads_a_face_and_click_opens_its_panel(page, designer):
     assert page.locator("#drawer polygon").count() == 1
     assert len(panel["outline"]) == mesh.valences[g]
     assert f"P{g}" in page.inner_text("#drawer")
+    assert page.evaluate("window.designer.highlighted()") == g
     shot(page, "panel-drawer")
+    # the pointer off the view: no outline; new faces (more rows): the panel, whose number
+    # now names another face, closes
+    page.mouse.move(5, 5)
+    assert not page.evaluate("window.designer.hoverOutline().visible")
+    assert page.evaluate(PIXELS_NEAR_JS, [pos["x"], pos["y"], 60, HOVER_RGB, 40]) == 0
+    set_field(page, "mesh.rows", 13)
+    page.wait_for_selector("#drawer", state="hidden")
+    assert page.evaluate("window.designer.highlighted()") is None
+    assert page.evaluate("window.designer.panel") is None
+    assert f"panel P{g} closed" in page.inner_text("#status")
 
 
 def test_two_tabs_show_the_same_design_and_history(page, designer, browser):

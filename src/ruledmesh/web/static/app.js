@@ -841,8 +841,36 @@ function readoutHtml(info) {
     ? `<br>class ${info.cls}` : ''}`;
 }
 
+// The face under the pointer outlined (so the read-out says which face it is, also in a
+// dense mesh): one line loop whose buffer is rewritten, nothing made per pointer move.
+const HOVER_CORNERS = 64;
+// (Transparent, so it is drawn in the pass of the face edges, after them: they lie on it.)
+const hoverOutline = new THREE.LineLoop(new THREE.BufferGeometry(),
+  new THREE.LineBasicMaterial({ color: 0xffd400, depthTest: false, transparent: true }));
+hoverOutline.geometry.setAttribute('position',
+  new THREE.BufferAttribute(new Float32Array(3 * HOVER_CORNERS), 3));
+Object.assign(hoverOutline, { frustumCulled: false, renderOrder: 9, visible: false });
+scene.add(hoverOutline);
+function outlineFace(f) {
+  if (f === null) {
+    if (hoverOutline.visible) { hoverOutline.visible = false; requestRender(); }
+    return;
+  }
+  const { vertices: V, face_offsets: off, face_indices: idx } = current.arrays;
+  const n = Math.min(off[f + 1] - off[f], HOVER_CORNERS);
+  const attr = hoverOutline.geometry.getAttribute('position');
+  for (let k = 0; k < n; k++) {
+    for (let i = 0; i < 3; i++) attr.array[3 * k + i] = V[3 * idx[off[f] + k] + i];
+  }
+  attr.needsUpdate = true;
+  hoverOutline.geometry.setDrawRange(0, n);
+  hoverOutline.visible = true;
+  requestRender();
+}
+
 function showReadout(event, f) {
   const box = $('readout');
+  outlineFace(f);
   if (f === null) { box.hidden = true; window.designer.hover = null; return; }
   const info = faceInfo(f);
   box.innerHTML = readoutHtml(info);
@@ -875,9 +903,11 @@ function drawHighlight() {
   const outline = new THREE.BufferGeometry().setAttribute('position', new THREE.BufferAttribute(corners, 3));
   const dot = new THREE.BufferGeometry().setAttribute('position', new THREE.BufferAttribute(centre, 3));
   for (const o of [
-    new THREE.LineLoop(outline, new THREE.LineBasicMaterial({ color: HIGHLIGHT, depthTest: false })),
+    // transparent: drawn after the face edges, which lie on the outline
+    new THREE.LineLoop(outline, new THREE.LineBasicMaterial({ color: HIGHLIGHT, depthTest: false,
+                                                              transparent: true })),
     new THREE.Points(dot, new THREE.PointsMaterial({ color: HIGHLIGHT, size: 9, sizeAttenuation: false,
-                                                     depthTest: false }))]) {
+                                                     depthTest: false, transparent: true }))]) {
     o.renderOrder = 10;
     layers.highlight.add(o);
   }
@@ -886,6 +916,18 @@ function highlightFace(f) {
   highlighted = f === null ? null : { face: f, topology: current.header.topology };
   drawHighlight();
   requestRender();
+}
+
+// After a new state: the hovered face's read-out and outline with its new figures while
+// the faces are the same, else gone until the pointer moves.
+function followHover(sameFaces) {
+  const info = window.designer.hover;
+  if (!info) return;
+  if (!sameFaces) { showReadout(null, null); return; }
+  const now = faceInfo(info.face);
+  $('readout').innerHTML = readoutHtml(now);
+  window.designer.hover = now;
+  outlineFace(info.face);
 }
 
 async function openPanel(f) {
@@ -915,6 +957,28 @@ async function openPanel(f) {
   $('drawer-row').innerHTML = Object.entries(data.row).map(([k, v]) => `<tr><th>${k}</th><td>${
     typeof v === 'number' ? fmt(v) : v}</td></tr>`).join('');
   window.designer.panel = data;
+}
+
+function closePanel() {
+  $('drawer').hidden = true;
+  window.designer.panel = null;
+  highlightFace(null);
+}
+
+// The open panel follows the design: read again once edits pause while the faces are the
+// same (its edges and angles move with the points), closed when they change (the face
+// numbers then name other faces).
+let panelTimer = null;
+function followPanel(sameFaces) {
+  clearTimeout(panelTimer);
+  const open = window.designer.panel;
+  if ($('drawer').hidden || !open) return;
+  if (!sameFaces) {
+    closePanel();
+    status(`panel ${open.row.label} closed: the faces changed`);
+    return;
+  }
+  panelTimer = setTimeout(() => { if (window.designer.panel) openPanel(open.face); }, 350);
 }
 
 // Labels of the faces, on demand: the fabrication names (P0, P1, ... as on the cutting
@@ -1505,7 +1569,9 @@ function applyState(msg) {
     window.designer.sameTopology += 1;
   }
   const changed = !current || current.header.version !== msg.header.version;
+  const sameFaces = current !== null && current.header.topology === msg.header.topology;
   current = msg;
+  if (changed) followPanel(sameFaces);
   if (changed) { closeness = null; classes = null; }
   const h = msg.header;
   $('file').textContent = h.path || '(unsaved design)';
@@ -1527,6 +1593,7 @@ function applyState(msg) {
   buildKindChooser();
   buildControls();
   drawScene();
+  if (changed) followHover(sameFaces);
   if (firstState) { fitView(); firstState = false; }
   document.body.dataset.version = h.version;
   window.designer.version = h.version;
@@ -1720,7 +1787,7 @@ function endDrag(event) {
 }
 canvas.addEventListener('pointerup', endDrag);
 canvas.addEventListener('pointercancel', endDrag);
-canvas.addEventListener('pointerleave', () => { $('readout').hidden = true; });
+canvas.addEventListener('pointerleave', (event) => showReadout(event, null));
 
 // The axis arrows move the sphere themselves; the other selected points follow.
 let gizmoStarts = null;
@@ -1799,7 +1866,7 @@ for (const b of document.querySelectorAll('[data-view]')) {
 }
 $('ortho').addEventListener('change', () => useCamera($('ortho').checked ? orthographic : perspective));
 $('screenshot').addEventListener('click', screenshot);
-$('drawer-close').addEventListener('click', () => { $('drawer').hidden = true; highlightFace(null); });
+$('drawer-close').addEventListener('click', closePanel);
 $('panel-figures').addEventListener('click', (event) => {
   const link = event.target.closest('a.face');
   if (!link) return;
@@ -1923,6 +1990,12 @@ window.designer = {
   grid: () => layers.grid.children[0]?.userData.step,
   faceInfo: (f) => faceInfo(f),
   highlighted: () => highlighted?.face ?? null,
+  hoverOutline: () => {
+    const n = hoverOutline.geometry.drawRange.count;
+    const a = hoverOutline.geometry.getAttribute('position').array;
+    return { visible: hoverOutline.visible, corners: Array.from({ length: Math.min(n, HOVER_CORNERS) },
+      (_, k) => Array.from(a.subarray(3 * k, 3 * k + 3))) };
+  },
   faceScreen: (f) => {
     const { vertices: V, face_offsets: off, face_indices: idx } = current.arrays;
     const v = new THREE.Vector3();
