@@ -597,8 +597,8 @@ def test_quads_edges_generators_and_colourings_with_figures(page, designer):
     assert page.evaluate("window.designer.generatorsDashed()")
     # planarity: the legend counts the faces over the tolerance from the same figures
     legend = page.evaluate("window.designer.legend")
-    from ruledmesh.analysis.faces import planarity
-    plan = planarity(mesh)
+    from ruledmesh.analysis.planar import face_planarity
+    plan = face_planarity(mesh)
     tol = 1e-12  # the default planarity tolerance (ruledmesh.tolerances)
     assert legend["over"] == int(np.count_nonzero(plan.astype(np.float32) > tol))
     assert legend["max"] == pytest.approx(float(plan.max()), rel=1e-5, abs=1e-30)
@@ -717,6 +717,31 @@ def test_panel_figures_are_analyze_s_and_show_their_faces(page, designer):
     assert page.evaluate("window.designer.highlighted()") is None
     page.evaluate("() => new Promise(requestAnimationFrame)")
     assert page.evaluate(PIXELS_NEAR_JS, [pos["x"], pos["y"], 6, HIGHLIGHT_RGB, 40]) == 0
+
+
+def test_planarity_legend_marks_the_design_s_tolerance(page, designer):
+    from ruledmesh.analysis.planar import face_planarity
+
+    set_field(page, "mesh.planarity_tolerance", "0.001")
+    built = designer.session.built
+    mesh = built.mesh
+    report = analyze(mesh, extras=built.extras)["planarity"]
+    assert report["tolerance"] == 1e-3 and report["within_tolerance"] > 0
+    polygons = int(np.count_nonzero(mesh.valences > 3))
+    page.wait_for_function(f"window.designer.legend && window.designer.legend.faces === {polygons}")
+    legend = page.evaluate("window.designer.legend")
+    plan = face_planarity(mesh).astype(np.float32)[mesh.valences > 3]
+    # exact, within and over the tolerance as analyze tells them apart (triangles left out)
+    assert legend["over"] == report["above_tolerance"] == 0
+    assert legend["within"] == report["within_tolerance"] == int(np.count_nonzero(plan > 1e-12))
+    assert legend["exact"] == report["exact"] - int(np.count_nonzero(mesh.valences == 3))
+    assert legend["max"] == pytest.approx(report["max"], rel=1e-6)
+    assert "tolerance 1e-3" in page.inner_text("#legend")
+    assert "(tolerance 1e-3)" in page.inner_text("#panel-figures")
+    # the mark is where 1e-3 is on the ramp (1e-16 ... two decades past the tolerance)
+    left = page.eval_on_selector("#legend .mark", "m => parseFloat(m.style.left)")
+    assert left == pytest.approx(100 * 13 / 15)
+    shot(page, "planarity-tolerance")
 
 
 def test_insert_delete_points_and_type_coordinates_each_one_undo_step(page, designer):

@@ -277,20 +277,23 @@ def fast_figures(mesh: Mesh) -> tuple[dict[str, Any], np.ndarray, np.ndarray]:
     Returns
     -------
     figures : dict
-        Counts, ``planarity_max`` and the face it is at (``planarity_face``),
+        Counts, ``planarity_max`` and the face it is at (``planarity_face``), the
+        mesh's ``planarity_tolerance`` and the ``planarity_exact`` of rounding,
         ``min_angle_deg`` and its face (``min_angle_face``), ``splinters``
         (faces with an angle below ``splinter_deg``), ``area_share`` (as in the
         report's ``quality.area_share``), convexity and the mesher's warnings.
     planarity : (F,) float64
-        Per-face planarity (:func:`ruledmesh.analysis.faces.planarity`).
+        Per-face planarity as build, analyze and fabricate measure it
+        (:func:`ruledmesh.analysis.planar.face_planarity`).
     min_angle : (F,) float64
         Per-face smallest interior angle in degrees (:func:`~ruledmesh.analysis.faces.face_min_angles`).
     """
     from ..analysis import faces as F
+    from ..analysis.planar import face_planarity, planarity_tolerance
     from ..analysis.report import kind_counts
     from ..tolerances import DEFAULT
 
-    plan = F.planarity(mesh)
+    plan = face_planarity(mesh)
     angle = F.face_min_angles(mesh)
     convex = F.convexity(mesh, DEFAULT.convexity)
     worst = int(np.argmax(plan)) if plan.size else None
@@ -304,7 +307,9 @@ def fast_figures(mesh: Mesh) -> tuple[dict[str, Any], np.ndarray, np.ndarray]:
         "kinds_text": kind_counts(mesh.count_kinds()),
         "planarity_max": float(plan.max()) if plan.size else 0.0,
         "planarity_face": worst,
-        "planarity_tolerance": DEFAULT.planarity,
+        # The design's own ([mesh] planarity_tolerance) where it has one, as analyze says.
+        "planarity_tolerance": planarity_tolerance(mesh),
+        "planarity_exact": DEFAULT.planarity,
         "min_angle_deg": float(angle.min()) if angle.size else None,
         "min_angle_face": sharpest,
         "splinters": int(np.count_nonzero(angle < F.SPLINTER_DEG)),

@@ -91,6 +91,14 @@ function showError(message) {
   box.hidden = !message;
 }
 function status(text) { $('status').textContent = text; }
+// A note about what the state of `version` did (a panel closed): added to the status line,
+// and kept in that version's timing line, whichever of the two comes first.
+let updateNote = null;   // {version, text}
+function noteUpdate(version, text) {
+  updateNote = { version, text };
+  const line = $('status').textContent;
+  status(line ? `${line}; ${text}` : text);
+}
 
 // ------------------------------------------------------------------ scene
 const canvas = $('canvas');
@@ -975,7 +983,7 @@ function followPanel(sameFaces) {
   if ($('drawer').hidden || !open) return;
   if (!sameFaces) {
     closePanel();
-    status(`panel ${open.row.label} closed: the faces changed`);
+    noteUpdate(current.header.version, `panel ${open.row.label} closed: the faces changed`);
     return;
   }
   panelTimer = setTimeout(() => { if (window.designer.panel) openPanel(open.face); }, 350);
@@ -1463,7 +1471,8 @@ async function send(name, body, inputAt = null) {
     const ms = received - sentAt;
     timings.push(ms);
     if (timings.length > 50) timings.shift();
-    status(`updated in ${ms.toFixed(0)} ms (server ${msg.serverMs?.toFixed(0)} ms)`);
+    const note = updateNote?.version === mark.version ? `; ${updateNote.text}` : '';
+    status(`updated in ${ms.toFixed(0)} ms (server ${msg.serverMs?.toFixed(0)} ms)${note}`);
     return true;
   } catch (err) {
     // Superseded: another tab's newer edit won; show the design as it is now, not an error.

@@ -161,9 +161,14 @@ export function legend(state, mode) {
     figures = `min <b>${fmt(lo)}${unit}</b> · median <b>${fmt(stats.median)}${unit}</b> · max <b>${
       fmt(hi)}${unit}</b>`;
     if (mode === 'planarity') {
-      const tol = state.header.figures.planarity_tolerance;
+      // As analyze tells them apart: exact to rounding, within the design's tolerance, over.
+      const { planarity_tolerance: tol, planarity_exact: exact } = state.header.figures;
+      stats.exact = values.reduce((n, v) => n + (v <= exact), 0);
       stats.over = values.reduce((n, v) => n + (v > tol), 0);
-      figures += `<br>over the tolerance: <b data-legend="over">${stats.over}</b> of ${values.length}` +
+      stats.within = values.length - stats.exact - stats.over;
+      figures += `<br>exact <b data-legend="exact">${stats.exact}</b>${tol > exact
+        ? ` · within the tolerance <b data-legend="within">${stats.within}</b>` : ''}` +
+        ` · over the tolerance <b data-legend="over">${stats.over}</b> of ${values.length}` +
         ` (triangles, flat, in grey)`;
     } else if (mode === 'angle') {
       const below = state.header.figures.splinter_deg;
@@ -171,12 +176,13 @@ export function legend(state, mode) {
       figures += `<br>below ${below}°: <b data-legend="below">${stats.below}</b> of ${values.length}`;
     }
   }
+  // The mark's name beside it, on the side away from the nearer end (not over its tick).
   const at = sc.mark !== undefined ? 100 * (sc.mark - sc.lo) / (sc.hi - sc.lo) : null;
   const mark = at !== null ? `<div class="mark" style="left:${at}%" title="${sc.markName}"></div>` : '';
   const html = `${sc.label}${values ? '' : ' (computing...)'}<div class="ramp" style="background:${
     `linear-gradient(90deg,${rampCss()})`}">${mark}</div><div class="ticks"><span>${
-    sc.tick(sc.lo)}</span>${at !== null ? `<span class="tol" style="left:${at}%">${sc.markName}</span>`
-    : ''}<span>${sc.tick(sc.hi)}</span></div>${figures}`;
+    sc.tick(sc.lo)}</span>${at !== null ? `<span class="tol" style="left:${at}%;transform:translateX(${
+      at > 50 ? -100 : 0}%)">${sc.markName}</span>` : ''}<span>${sc.tick(sc.hi)}</span></div>${figures}`;
   return { html, stats };
 }
 
