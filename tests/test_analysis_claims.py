@@ -170,6 +170,6 @@ def test_designer_figures_use_the_same_words():
     from ruledmesh.web.session import fast_figures
 
     mesh = build_file(EXAMPLES / "skew.toml").mesh
-    figures, _ = fast_figures(mesh)
+    figures = fast_figures(mesh)[0]
     assert figures["kinds_text"] == kind_counts(mesh.count_kinds())
     assert figures["kinds_text"].startswith(f"{figures['kinds']['quad']} quads, ")

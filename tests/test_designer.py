@@ -227,10 +227,10 @@ def test_an_answer_with_the_same_faces_leaves_them_out():
     key = full["topology"]
     assert key == topology_key(s.built.mesh) and not full["same_topology"]
     assert {"triangles", "edges", "face_indices"} <= set(arrays)
-    # the same mesh again for a page that has these faces: vertices and planarity only
+    # the same mesh again for a page that has these faces: vertices and per-face figures only
     short, few = decode(s.payload(key))
-    assert short["same_topology"] and set(few) == {"vertices", "planarity", "generators",
-                                                   "torsal", "curve_points"}
+    assert short["same_topology"] and set(few) == {"vertices", "planarity", "min_angle",
+                                                   "generators", "torsal", "curve_points"}
     np.testing.assert_array_equal(few["vertices"], arrays["vertices"])
     # other faces (more rows): everything again, whatever the page says it has
     s.edit([(["mesh", "rows"], 7)])
@@ -291,6 +291,24 @@ def test_payload_matches_the_mesh():
     assert [c["name"] for c in header["curves"]] == ["c1", "c2"]
     assert arrays["curve_points"].shape == (sum(c["count"] for c in header["curves"]), 3)
     assert arrays["generators"].shape == (len(s.built.rulings.a), 2, 3)   # 9 + kink generators
+
+
+def test_payload_panel_figures_are_the_reports():
+    from ruledmesh.analysis.faces import face_min_angles
+    from ruledmesh.analysis.report import analyze
+
+    s = Session(SMALL)
+    header, arrays = decode(s.payload())
+    mesh = s.built.mesh
+    fig, report = header["figures"], analyze(mesh, extras=s.built.extras)
+    assert fig["area_share"] == report["quality"]["area_share"]
+    assert fig["min_angle_deg"] == report["min_angle_deg"]
+    assert fig["planarity_max"] == report["planarity"]["max"]
+    smallest = face_min_angles(mesh)
+    np.testing.assert_array_equal(arrays["min_angle"], smallest.astype(np.float32))
+    assert smallest[fig["min_angle_face"]] == smallest.min()
+    assert arrays["planarity"][fig["planarity_face"]] == arrays["planarity"].max()
+    assert fig["splinters"] == int(np.count_nonzero(smallest < fig["splinter_deg"]))
 
 
 # ---------------------------------------------------------------- HTTP

@@ -597,8 +597,8 @@ def test_quads_edges_generators_and_colourings_with_figures(page, designer):
     assert page.evaluate("window.designer.generatorsDashed()")
     # planarity: the legend counts the faces over the tolerance from the same figures
     legend = page.evaluate("window.designer.legend")
-    from ruledmesh.analysis.faces import planarity
-    plan = planarity(mesh)
+    from ruledmesh.analysis.planar import face_planarity
+    plan = face_planarity(mesh)
     tol = 1e-12  # the default planarity tolerance (ruledmesh.tolerances)
     assert legend["over"] == int(np.count_nonzero(plan.astype(np.float32) > tol))
     assert legend["max"] == pytest.approx(float(plan.max()), rel=1e-5, abs=1e-30)
@@ -637,6 +637,111 @@ def test_quads_edges_generators_and_colourings_with_figures(page, designer):
     assert not page.evaluate("window.designer.layer('generators')")
     assert page.evaluate("window.designer.edgeCount()") == len(designer.session.built.mesh.edges())
     shot(page, "45-generators")
+
+
+# Counts the pixels of colour `rgb` (within `tol`) in a (2r+1)-square of the canvas around
+# the page point (x, y).
+PIXELS_NEAR_JS = """([x, y, r, rgb, tol]) => {
+  const src = document.getElementById('canvas');
+  const box = src.getBoundingClientRect();
+  const c = document.createElement('canvas');
+  c.width = c.height = 2 * r + 1;
+  const g = c.getContext('2d');
+  const sx = src.width / box.width, sy = src.height / box.height;
+  g.drawImage(src, (x - box.left - r) * sx, (y - box.top - r) * sy, (2 * r + 1) * sx, (2 * r + 1) * sy,
+              0, 0, 2 * r + 1, 2 * r + 1);
+  const d = g.getImageData(0, 0, 2 * r + 1, 2 * r + 1).data;
+  let n = 0;
+  for (let i = 0; i < d.length; i += 4) {
+    if (Math.abs(d[i] - rgb[0]) <= tol && Math.abs(d[i + 1] - rgb[1]) <= tol
+        && Math.abs(d[i + 2] - rgb[2]) <= tol) n += 1;
+  }
+  return n;
+}"""
+HIGHLIGHT_RGB = [0xB0, 0x20, 0x8A]
+HOVER_RGB = [0xFF, 0xD4, 0x00]
+
+
+def test_panel_figures_are_analyze_s_and_show_their_faces(page, designer):
+    from ruledmesh.analysis.faces import SPLINTER_DEG, face_min_angles
+
+    built = designer.session.built
+    mesh = built.mesh
+    report = analyze(mesh, extras=built.extras)
+    smallest = face_min_angles(mesh)
+    # the figures under the legend are those of ruledmesh analyze, each at its face
+    fig = page.evaluate("window.designer.panelFigures")
+    assert fig["quads"] == pytest.approx(report["quality"]["area_share"]["quads"], rel=1e-12)
+    assert fig["minAngle"] == pytest.approx(report["min_angle_deg"], rel=1e-12)
+    assert fig["planarity"] == pytest.approx(report["planarity"]["max"], rel=1e-12)
+    f = fig["minAngleFace"]
+    assert f == int(np.argmin(smallest))
+    assert fig["splinters"] == int(np.count_nonzero(smallest < SPLINTER_DEG)) > 0
+    text = page.inner_text("#panel-figures")
+    assert f"{100 * report['quality']['area_share']['quads']:.1f} %" in text
+    assert f"{report['min_angle_deg']:.2f}°" in text and f"P{f}" in text
+    # the face named is shown: its panel opens, its outline and centre drawn over the mesh
+    page.click('[data-view="top"]')
+    page.wait_for_function("window.designer.view === 'top'")
+    pos = page.evaluate(f"window.designer.faceScreen({f})")
+    assert page.evaluate(PIXELS_NEAR_JS, [pos["x"], pos["y"], 6, HIGHLIGHT_RGB, 40]) == 0
+    page.click(f'#panel-figures a[data-face="{f}"]')
+    page.wait_for_selector("#drawer:not([hidden])")
+    page.wait_for_function(f"window.designer.panel && window.designer.panel.face === {f}")
+    assert page.evaluate("window.designer.highlighted()") == f
+    row = page.evaluate("window.designer.panel.row")
+    assert row["label"] == f"P{f}"
+    assert row["min_angle_deg"] == pytest.approx(smallest[f], abs=1e-6)
+    page.evaluate("() => new Promise(requestAnimationFrame)")
+    assert page.evaluate(PIXELS_NEAR_JS, [pos["x"], pos["y"], 6, HIGHLIGHT_RGB, 40]) > 10
+    shot(page, "smallest-angle-face")
+    # colour by the smallest angle: a log ramp with the splinter limit marked
+    page.select_option("#colour", "angle")
+    legend = page.evaluate("window.designer.legend")
+    assert legend["min"] == pytest.approx(smallest.min(), rel=1e-6)
+    assert legend["max"] == pytest.approx(smallest.max(), rel=1e-6)
+    assert legend["below"] == int(np.count_nonzero(smallest.astype(np.float32) < SPLINTER_DEG))
+    assert page.locator("#legend .mark").count() == 1 and "splinter" in page.inner_text("#legend")
+    shot(page, "colour-angle")
+    # the kinds with their area shares
+    page.select_option("#colour", "kind")
+    text = page.inner_text("#legend")
+    for kind, share in report["quality"]["area_share"]["by_kind"].items():
+        assert f"{kind} {mesh.count_kinds()[kind]} ({100 * share:.1f} %)" in text, (kind, text)
+    # planarity of the faces that can be out of plane: triangles are grey, not counted
+    page.select_option("#colour", "planarity")
+    legend = page.evaluate("window.designer.legend")
+    assert legend["faces"] == int(np.count_nonzero(mesh.valences > 3)) < mesh.n_faces
+    # closing the panel takes the highlight away
+    page.click("#drawer-close")
+    assert page.evaluate("window.designer.highlighted()") is None
+    page.evaluate("() => new Promise(requestAnimationFrame)")
+    assert page.evaluate(PIXELS_NEAR_JS, [pos["x"], pos["y"], 6, HIGHLIGHT_RGB, 40]) == 0
+
+
+def test_planarity_legend_marks_the_design_s_tolerance(page, designer):
+    from ruledmesh.analysis.planar import face_planarity
+
+    set_field(page, "mesh.planarity_tolerance", "0.001")
+    built = designer.session.built
+    mesh = built.mesh
+    report = analyze(mesh, extras=built.extras)["planarity"]
+    assert report["tolerance"] == 1e-3 and report["within_tolerance"] > 0
+    polygons = int(np.count_nonzero(mesh.valences > 3))
+    page.wait_for_function(f"window.designer.legend && window.designer.legend.faces === {polygons}")
+    legend = page.evaluate("window.designer.legend")
+    plan = face_planarity(mesh).astype(np.float32)[mesh.valences > 3]
+    # exact, within and over the tolerance as analyze tells them apart (triangles left out)
+    assert legend["over"] == report["above_tolerance"] == 0
+    assert legend["within"] == report["within_tolerance"] == int(np.count_nonzero(plan > 1e-12))
+    assert legend["exact"] == report["exact"] - int(np.count_nonzero(mesh.valences == 3))
+    assert legend["max"] == pytest.approx(report["max"], rel=1e-6)
+    assert "tolerance 1e-3" in page.inner_text("#legend")
+    assert "(tolerance 1e-3)" in page.inner_text("#panel-figures")
+    # the mark is where 1e-3 is on the ramp (1e-16 ... two decades past the tolerance)
+    left = page.eval_on_selector("#legend .mark", "m => parseFloat(m.style.left)")
+    assert left == pytest.approx(100 * 13 / 15)
+    shot(page, "planarity-tolerance")
 
 
 def test_insert_delete_points_and_type_coordinates_each_one_undo_step(page, designer):
@@ -761,6 +866,12 @@ def test_hover_reads_a_face_and_click_opens_its_panel(page, designer):
     page.wait_for_function("window.designer.hover !== null")
     info = page.evaluate("window.designer.hover")
     g = info["face"]
+    # the face under the pointer is outlined: its corners, drawn over the mesh
+    outline = page.evaluate("window.designer.hoverOutline()")
+    assert outline["visible"]
+    np.testing.assert_array_equal(outline["corners"], mesh.vertices[mesh.face(g)].astype(np.float32))
+    page.evaluate("() => new Promise(requestAnimationFrame)")
+    assert page.evaluate(PIXELS_NEAR_JS, [pos["x"], pos["y"], 60, HOVER_RGB, 40]) > 20
     assert info["label"] == f"P{g}" == table["label"][g]
     assert info["kind"] == table["kind"][g]
     assert info["area"] == pytest.approx(abs(table["area"][g]), rel=1e-4)
@@ -777,7 +888,18 @@ def test_hover_reads_a_face_and_click_opens_its_panel(page, designer):
     assert page.locator("#drawer polygon").count() == 1
     assert len(panel["outline"]) == mesh.valences[g]
     assert f"P{g}" in page.inner_text("#drawer")
+    assert page.evaluate("window.designer.highlighted()") == g
     shot(page, "panel-drawer")
+    # the pointer off the view: no outline; new faces (more rows): the panel, whose number
+    # now names another face, closes
+    page.mouse.move(5, 5)
+    assert not page.evaluate("window.designer.hoverOutline().visible")
+    assert page.evaluate(PIXELS_NEAR_JS, [pos["x"], pos["y"], 60, HOVER_RGB, 40]) == 0
+    set_field(page, "mesh.rows", 13)
+    page.wait_for_selector("#drawer", state="hidden")
+    assert page.evaluate("window.designer.highlighted()") is None
+    assert page.evaluate("window.designer.panel") is None
+    assert f"panel P{g} closed" in page.inner_text("#status")
 
 
 def test_two_tabs_show_the_same_design_and_history(page, designer, browser):

@@ -268,21 +268,36 @@ def fan_triangles(mesh: Mesh) -> tuple[np.ndarray, np.ndarray]:
     return tris, face
 
 
-def fast_figures(mesh: Mesh) -> tuple[dict[str, Any], np.ndarray]:
-    """The figures cheap enough for every edit (faces, triangles, planarity, convexity).
+def fast_figures(mesh: Mesh) -> tuple[dict[str, Any], np.ndarray, np.ndarray]:
+    """The figures cheap enough for every edit (counts, planarity, angles, area shares).
+
+    The panel figures are those of ``ruledmesh analyze`` (the same functions of
+    :mod:`ruledmesh.analysis.faces`), so the legend and the report agree.
 
     Returns
     -------
     figures : dict
+        Counts, ``planarity_max`` and the face it is at (``planarity_face``), the
+        mesh's ``planarity_tolerance`` and the ``planarity_exact`` of rounding,
+        ``min_angle_deg`` and its face (``min_angle_face``), ``splinters``
+        (faces with an angle below ``splinter_deg``), ``area_share`` (as in the
+        report's ``quality.area_share``), convexity and the mesher's warnings.
     planarity : (F,) float64
-        Per-face planarity (:func:`ruledmesh.analysis.faces.planarity`).
+        Per-face planarity as build, analyze and fabricate measure it
+        (:func:`ruledmesh.analysis.planar.face_planarity`).
+    min_angle : (F,) float64
+        Per-face smallest interior angle in degrees (:func:`~ruledmesh.analysis.faces.face_min_angles`).
     """
     from ..analysis import faces as F
+    from ..analysis.planar import face_planarity, planarity_tolerance
     from ..analysis.report import kind_counts
     from ..tolerances import DEFAULT
 
-    plan = F.planarity(mesh)
+    plan = face_planarity(mesh)
+    angle = F.face_min_angles(mesh)
     convex = F.convexity(mesh, DEFAULT.convexity)
+    worst = int(np.argmax(plan)) if plan.size else None
+    sharpest = int(np.argmin(angle)) if angle.size else None
     return {
         "vertices": mesh.n_vertices,
         "faces": mesh.n_faces,
@@ -291,11 +306,19 @@ def fast_figures(mesh: Mesh) -> tuple[dict[str, Any], np.ndarray]:
         # The same words as the command line: "633 quads, 9 border faces, 306 fill triangles".
         "kinds_text": kind_counts(mesh.count_kinds()),
         "planarity_max": float(plan.max()) if plan.size else 0.0,
-        "planarity_tolerance": DEFAULT.planarity,
+        "planarity_face": worst,
+        # The design's own ([mesh] planarity_tolerance) where it has one, as analyze says.
+        "planarity_tolerance": planarity_tolerance(mesh),
+        "planarity_exact": DEFAULT.planarity,
+        "min_angle_deg": float(angle.min()) if angle.size else None,
+        "min_angle_face": sharpest,
+        "splinters": int(np.count_nonzero(angle < F.SPLINTER_DEG)),
+        "splinter_deg": F.SPLINTER_DEG,
+        "area_share": F.area_shares(mesh) if mesh.n_faces else None,
         "non_convex": int(np.count_nonzero(~convex)),
         "members": len(mesh.members),
         "warnings": [str(w) for w in mesh.info.get("warnings", [])],
-    }, plan
+    }, plan, angle
 
 
 def slow_figures(built: Built) -> tuple[dict[str, Any], dict[str, np.ndarray]]:
@@ -407,7 +430,7 @@ def frame_data(design: Mapping[str, Any], built: Built) -> dict[str, Any]:
 
     Computed where the design is built (the build worker process, right after
     the build), so the server only encodes it.  Only the cheap figures are
-    here (planarity, convexity, counts); closeness, coverage and the panel
+    here (planarity, angles, area shares, convexity, counts); closeness, coverage and the panel
     count come from the figures process on request.
 
     Returns
@@ -415,12 +438,12 @@ def frame_data(design: Mapping[str, Any], built: Built) -> dict[str, Any]:
     dict
         ``key`` (:func:`topology_key`), ``header`` (figures, construction,
         curves, handles, bbox), and lists of ``(name, array)``: ``live``
-        (vertices, planarity), ``faces`` (triangles, edges, corners, kinds:
+        (vertices, planarity, smallest angles), ``faces`` (triangles, edges, corners, kinds:
         sent when the page has other faces) and ``rest`` (generators, torsal
         generators, sampled curves).
     """
     mesh = built.mesh
-    figures, plan = fast_figures(mesh)
+    figures, plan, angle = fast_figures(mesh)
     rulings = built.rulings
     if rulings is not None and getattr(rulings, "a", None) is not None:
         gens = np.stack([rulings.a, rulings.b], axis=1)
@@ -442,7 +465,8 @@ def frame_data(design: Mapping[str, Any], built: Built) -> dict[str, Any]:
                    "curves": [{"name": n, "count": c} for n, c in zip(names, counts)],
                    "handles": _handles(design, mesh), "bbox": bbox.tolist()},
         "live": [("vertices", mesh.vertices.astype(np.float32)),
-                 ("planarity", plan.astype(np.float32))],
+                 ("planarity", plan.astype(np.float32)),
+                 ("min_angle", angle.astype(np.float32))],
         "faces": [("triangles", tris.astype(np.uint32)),
                   ("triangle_face", tri_face.astype(np.uint32)),
                   ("kind", mesh.face_kind.astype(np.uint8)),

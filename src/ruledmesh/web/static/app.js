@@ -1,6 +1,7 @@
 // ruledmesh designer page: draws what the server builds and sends edits back.
 // The state (the design) lives on the server; this page keeps only view state.
 import * as THREE from './vendor/three-bundle.min.js';
+import { faceColours, fmt, legend, panelFigures } from './colours.js';
 
 const { OrbitControls, TransformControls } = THREE;
 const $ = (id) => document.getElementById(id);
@@ -90,6 +91,14 @@ function showError(message) {
   box.hidden = !message;
 }
 function status(text) { $('status').textContent = text; }
+// A note about what the state of `version` did (a panel closed): added to the status line,
+// and kept in that version's timing line, whichever of the two comes first.
+let updateNote = null;   // {version, text}
+function noteUpdate(version, text) {
+  updateNote = { version, text };
+  const line = $('status').textContent;
+  status(line ? `${line}; ${text}` : text);
+}
 
 // ------------------------------------------------------------------ scene
 const canvas = $('canvas');
@@ -140,7 +149,7 @@ for (const part of ['picker', 'gizmo']) {
 const layers = {
   faces: new THREE.Group(), edges: new THREE.Group(), generators: new THREE.Group(),
   curves: new THREE.Group(), construction: new THREE.Group(), handles: new THREE.Group(),
-  grid: new THREE.Group(), labels: new THREE.Group(),
+  grid: new THREE.Group(), labels: new THREE.Group(), highlight: new THREE.Group(),
 };
 for (const g of Object.values(layers)) scene.add(g);
 layers.labels.visible = false;
@@ -213,133 +222,20 @@ function freeRetired() {
 }
 
 // ------------------------------------------------------------------ colours
-const KIND_COLOURS = ['#4f86c6', '#7cb35a', '#e0a030', '#d05050', '#9060c0', '#909090'];
-const RAMP = [[0.23, 0.30, 0.75], [0.35, 0.70, 0.90], [0.55, 0.80, 0.45], [0.95, 0.80, 0.25],
-              [0.85, 0.25, 0.20]];
-const CLASS_PALETTE = ['#4e79a7', '#f28e2b', '#e15759', '#76b7b2', '#59a14f', '#edc948',
-                       '#b07aa1', '#ff9da7', '#9c755f', '#bab0ac', '#1f77b4', '#aec7e8'];
+// The colourings, legend and panel figures are in colours.js; they read this state.
 let closeness = null;     // per-face closeness of the current version (slow figures)
 let classes = null;       // per-face congruence class of the current version (slow figures)
 let areas = null;         // per-face area, computed here from the faces
+const colourState = () => ({ header: current.header, arrays: current.arrays, areas, closeness, classes });
 
-function ramp(t) {
-  t = Math.min(Math.max(t, 0), 1) * (RAMP.length - 1);
-  const i = Math.min(Math.floor(t), RAMP.length - 2), f = t - i;
-  return RAMP[i].map((c, k) => c + (RAMP[i + 1][k] - c) * f);
-}
-const rampCss = () => RAMP.map((c, i) => `rgb(${c.map((x) => Math.round(255 * x)).join(',')}) ${
-  100 * i / (RAMP.length - 1)}%`).join(',');
-
-// The scale of each colouring: {lo, hi, log, label, mark} from the current figures.
-function scaleOf(mode) {
-  const fig = current.header.figures;
-  if (mode === 'planarity') {
-    // From exact (1e-16) to two decades past the tolerance: the tolerance sits at 80 %, so
-    // faces within it are blue-green and the ones over it orange to red.
-    const tol = fig.planarity_tolerance || 1e-12;
-    const hi = Math.log10(tol) + 2;
-    return { lo: -16, hi, log: true, mark: Math.log10(tol),
-             label: `planarity (relative, log scale); tolerance ${tol.toExponential(0)}` };
-  }
-  if (mode === 'closeness') {
-    return { lo: -6, hi: -1, log: true, label: 'closeness: centroid distance / diagonal (log)' };
-  }
-  const [lo, hi] = range(areas);
-  return { lo, hi: hi > lo ? hi : lo + 1, log: false, label: 'panel area (design units²)' };
-}
-
-function range(values) {
-  let lo = Infinity, hi = -Infinity;
-  for (let i = 0; i < values.length; i++) {
-    const v = values[i];
-    if (v < lo) lo = v;
-    if (v > hi) hi = v;
-  }
-  return values.length ? [lo, hi] : [0, 1];
-}
-
-function valuesOf(mode) {
-  if (mode === 'planarity') return current.arrays.planarity;
-  if (mode === 'closeness') return closeness;
-  if (mode === 'area') return areas;
-  return null;
-}
-
-function faceColours(mode) {
-  const nf = current.arrays.kind.length;
-  const out = new Float32Array(nf * 3);
-  const values = valuesOf(mode);
-  if (mode === 'kind' || mode === 'class' || !values) {
-    const byClass = mode === 'class' && classes;
-    const grey = !byClass && mode !== 'kind';  // slow figures not there yet
-    const palette = (byClass ? CLASS_PALETTE : KIND_COLOURS).map((c) => new THREE.Color(c));
-    const kind = current.arrays.kind;
-    const g = new THREE.Color(KIND_COLOURS[5]);
-    for (let f = 0; f < nf; f++) {
-      const c = grey ? g : byClass ? palette[classes[f] % palette.length] : palette[kind[f]] || g;
-      out[3 * f] = c.r; out[3 * f + 1] = c.g; out[3 * f + 2] = c.b;
-    }
-    return out;
-  }
-  const { lo, hi, log } = scaleOf(mode);
-  for (let f = 0; f < nf; f++) {
-    const v = log ? Math.log10(Math.max(values[f], 1e-30)) : values[f];
-    const c = ramp((v - lo) / (hi - lo));
-    out[3 * f] = c[0]; out[3 * f + 1] = c[1]; out[3 * f + 2] = c[2];
-  }
-  return out;
-}
-
-function median(values) {
-  if (!values.length) return 0;
-  const sorted = Float64Array.from(values).sort();
-  return sorted[Math.floor(sorted.length / 2)];
-}
-
-// The legend names the scale and gives the figures of the faces drawn (min, median, max,
-// and for planarity how many faces exceed the tolerance).
+// The legend of the colouring and the panel figures under it; returns the legend's figures.
 function drawLegend(mode) {
-  const legend = $('legend');
-  const kinds = current.header.choices.face_kinds || [];
-  const stats = {};
-  if (mode === 'kind') {
-    const counts = new Array(kinds.length).fill(0);
-    for (const k of current.arrays.kind) counts[k] += 1;
-    legend.innerHTML = kinds.map((k, i) => (counts[i] ? `<span class="swatch" style="background:${
-      KIND_COLOURS[i]}"></span>${k} <b>${counts[i]}</b>` : '')).join('');
-    return stats;
-  }
-  if (mode === 'class') {
-    const n = classes ? Math.max(...classes) + 1 : null;
-    legend.innerHTML = classes ? `congruence classes: <b>${n}</b> different panels for ${
-      classes.length} faces (colours repeat every ${CLASS_PALETTE.length})`
-      : 'congruence classes (computing...)';
-    stats.classes = n;
-    return stats;
-  }
-  const values = valuesOf(mode);
-  const sc = scaleOf(mode);
-  const tick = (x) => (sc.log ? `1e${+x.toFixed(1)}` : fmt(x));
-  let figures = '';
-  if (values) {
-    const [lo, hi] = range(values);
-    Object.assign(stats, { min: lo, median: median(values), max: hi });
-    figures = `min <b>${fmt(lo)}</b> · median <b>${fmt(stats.median)}</b> · max <b>${fmt(hi)}</b>`;
-    if (mode === 'planarity') {
-      const tol = current.header.figures.planarity_tolerance;
-      let over = 0;
-      for (const v of values) if (v > tol) over += 1;
-      stats.over = over;
-      figures += `<br>over the tolerance: <b data-legend="over">${over}</b> of ${values.length}`;
-    }
-  }
-  const mark = sc.mark !== undefined
-    ? `<div class="mark" style="left:${100 * (sc.mark - sc.lo) / (sc.hi - sc.lo)}%" title="tolerance"></div>`
-    : '';
-  legend.innerHTML = `${sc.label}${values ? '' : ' (computing...)'}<div class="ramp" style="background:linear-gradient(90deg,${
-    rampCss()})">${mark}</div><div class="ticks"><span>${tick(sc.lo)}</span>${sc.mark !== undefined
-    ? `<span class="tol" style="left:${100 * (sc.mark - sc.lo) / (sc.hi - sc.lo)}%">tolerance</span>`
-    : ''}<span>${tick(sc.hi)}</span></div>${figures}`;
+  const state = colourState();
+  const { html, stats } = legend(state, mode);
+  $('legend').innerHTML = html;
+  const panel = panelFigures(state);
+  $('panel-figures').innerHTML = panel.html;
+  window.designer.panelFigures = panel.stats;
   return stats;
 }
 
@@ -470,7 +366,7 @@ function faceMaterial() {
 function drawFaces(sameFaces = false) {
   const { vertices: V, face_offsets: off, face_indices: idx } = current.arrays;
   const nf = off.length - 1, nc = idx.length;
-  const fc = faceColours($('colour').value);
+  const fc = faceColours(colourState(), $('colour').value);
   let mesh = layers.faces.children[0];
   if (!mesh) {
     mesh = new THREE.Mesh(new THREE.BufferGeometry(), faceMaterial());
@@ -727,6 +623,7 @@ function drawScene() {
     Array.from(arrays.torsal || []).map((i) => Array.from(G.subarray(6 * i, 6 * i + 6)))], drawConstruction);
   redrawIf('grid', [header.bbox], drawGrid);
   redrawIf('handles', [header.handles, size, [...selection], primaryLabel], drawHandles);
+  if (highlighted) drawHighlight();
   lap('construction');
   render(); lap('render');
   window.designer.drawTimes = times;
@@ -952,8 +849,36 @@ function readoutHtml(info) {
     ? `<br>class ${info.cls}` : ''}`;
 }
 
+// The face under the pointer outlined (so the read-out says which face it is, also in a
+// dense mesh): one line loop whose buffer is rewritten, nothing made per pointer move.
+const HOVER_CORNERS = 64;
+// (Transparent, so it is drawn in the pass of the face edges, after them: they lie on it.)
+const hoverOutline = new THREE.LineLoop(new THREE.BufferGeometry(),
+  new THREE.LineBasicMaterial({ color: 0xffd400, depthTest: false, transparent: true }));
+hoverOutline.geometry.setAttribute('position',
+  new THREE.BufferAttribute(new Float32Array(3 * HOVER_CORNERS), 3));
+Object.assign(hoverOutline, { frustumCulled: false, renderOrder: 9, visible: false });
+scene.add(hoverOutline);
+function outlineFace(f) {
+  if (f === null) {
+    if (hoverOutline.visible) { hoverOutline.visible = false; requestRender(); }
+    return;
+  }
+  const { vertices: V, face_offsets: off, face_indices: idx } = current.arrays;
+  const n = Math.min(off[f + 1] - off[f], HOVER_CORNERS);
+  const attr = hoverOutline.geometry.getAttribute('position');
+  for (let k = 0; k < n; k++) {
+    for (let i = 0; i < 3; i++) attr.array[3 * k + i] = V[3 * idx[off[f] + k] + i];
+  }
+  attr.needsUpdate = true;
+  hoverOutline.geometry.setDrawRange(0, n);
+  hoverOutline.visible = true;
+  requestRender();
+}
+
 function showReadout(event, f) {
   const box = $('readout');
+  outlineFace(f);
   if (f === null) { box.hidden = true; window.designer.hover = null; return; }
   const info = faceInfo(f);
   box.innerHTML = readoutHtml(info);
@@ -963,7 +888,58 @@ function showReadout(event, f) {
   window.designer.hover = info;
 }
 
+// The face of the open panel (clicked, or named in the panel figures): its outline and a
+// dot at its centre drawn over everything, since a small face of a dense mesh is hard to
+// find. Kept while the faces are the same; a new topology numbers them anew.
+let highlighted = null;   // {face, topology}
+const HIGHLIGHT = 0xb0208a;
+function drawHighlight() {
+  clearGroup(layers.highlight);
+  if (!highlighted || !current || highlighted.topology !== current.header.topology) {
+    highlighted = null;
+    return;
+  }
+  const { vertices: V, face_offsets: off, face_indices: idx } = current.arrays;
+  const f = highlighted.face, n = off[f + 1] - off[f];
+  const corners = new Float32Array(3 * n), centre = new Float32Array(3);
+  for (let k = 0; k < n; k++) {
+    for (let i = 0; i < 3; i++) {
+      corners[3 * k + i] = V[3 * idx[off[f] + k] + i];
+      centre[i] += corners[3 * k + i] / n;
+    }
+  }
+  const outline = new THREE.BufferGeometry().setAttribute('position', new THREE.BufferAttribute(corners, 3));
+  const dot = new THREE.BufferGeometry().setAttribute('position', new THREE.BufferAttribute(centre, 3));
+  for (const o of [
+    // transparent: drawn after the face edges, which lie on the outline
+    new THREE.LineLoop(outline, new THREE.LineBasicMaterial({ color: HIGHLIGHT, depthTest: false,
+                                                              transparent: true })),
+    new THREE.Points(dot, new THREE.PointsMaterial({ color: HIGHLIGHT, size: 9, sizeAttenuation: false,
+                                                     depthTest: false, transparent: true }))]) {
+    o.renderOrder = 10;
+    layers.highlight.add(o);
+  }
+}
+function highlightFace(f) {
+  highlighted = f === null ? null : { face: f, topology: current.header.topology };
+  drawHighlight();
+  requestRender();
+}
+
+// After a new state: the hovered face's read-out and outline with its new figures while
+// the faces are the same, else gone until the pointer moves.
+function followHover(sameFaces) {
+  const info = window.designer.hover;
+  if (!info) return;
+  if (!sameFaces) { showReadout(null, null); return; }
+  const now = faceInfo(info.face);
+  $('readout').innerHTML = readoutHtml(now);
+  window.designer.hover = now;
+  outlineFace(info.face);
+}
+
 async function openPanel(f) {
+  highlightFace(f);
   let data;
   try {
     data = await api('GET', `panel?face=${f}`);
@@ -989,6 +965,28 @@ async function openPanel(f) {
   $('drawer-row').innerHTML = Object.entries(data.row).map(([k, v]) => `<tr><th>${k}</th><td>${
     typeof v === 'number' ? fmt(v) : v}</td></tr>`).join('');
   window.designer.panel = data;
+}
+
+function closePanel() {
+  $('drawer').hidden = true;
+  window.designer.panel = null;
+  highlightFace(null);
+}
+
+// The open panel follows the design: read again once edits pause while the faces are the
+// same (its edges and angles move with the points), closed when they change (the face
+// numbers then name other faces).
+let panelTimer = null;
+function followPanel(sameFaces) {
+  clearTimeout(panelTimer);
+  const open = window.designer.panel;
+  if ($('drawer').hidden || !open) return;
+  if (!sameFaces) {
+    closePanel();
+    noteUpdate(current.header.version, `panel ${open.row.label} closed: the faces changed`);
+    return;
+  }
+  panelTimer = setTimeout(() => { if (window.designer.panel) openPanel(open.face); }, 350);
 }
 
 // Labels of the faces, on demand: the fabrication names (P0, P1, ... as on the cutting
@@ -1018,10 +1016,6 @@ function drawLabels() {
 }
 
 // ------------------------------------------------------------------ figures
-const fmt = (v, digits = 3) => (typeof v === 'number'
-  ? (Math.abs(v) !== 0 && (Math.abs(v) < 1e-3 || Math.abs(v) >= 1e6) ? v.toExponential(2)
-    : String(+v.toPrecision(digits + 1))) : String(v));
-
 function setFig(name, text, pending = false) {
   const cell = document.querySelector(`[data-fig="${name}"]`);
   cell.textContent = text;
@@ -1477,7 +1471,8 @@ async function send(name, body, inputAt = null) {
     const ms = received - sentAt;
     timings.push(ms);
     if (timings.length > 50) timings.shift();
-    status(`updated in ${ms.toFixed(0)} ms (server ${msg.serverMs?.toFixed(0)} ms)`);
+    const note = updateNote?.version === mark.version ? `; ${updateNote.text}` : '';
+    status(`updated in ${ms.toFixed(0)} ms (server ${msg.serverMs?.toFixed(0)} ms)${note}`);
     return true;
   } catch (err) {
     // Superseded: another tab's newer edit won; show the design as it is now, not an error.
@@ -1583,7 +1578,9 @@ function applyState(msg) {
     window.designer.sameTopology += 1;
   }
   const changed = !current || current.header.version !== msg.header.version;
+  const sameFaces = current !== null && current.header.topology === msg.header.topology;
   current = msg;
+  if (changed) followPanel(sameFaces);
   if (changed) { closeness = null; classes = null; }
   const h = msg.header;
   $('file').textContent = h.path || '(unsaved design)';
@@ -1605,6 +1602,7 @@ function applyState(msg) {
   buildKindChooser();
   buildControls();
   drawScene();
+  if (changed) followHover(sameFaces);
   if (firstState) { fitView(); firstState = false; }
   document.body.dataset.version = h.version;
   window.designer.version = h.version;
@@ -1798,7 +1796,7 @@ function endDrag(event) {
 }
 canvas.addEventListener('pointerup', endDrag);
 canvas.addEventListener('pointercancel', endDrag);
-canvas.addEventListener('pointerleave', () => { $('readout').hidden = true; });
+canvas.addEventListener('pointerleave', (event) => showReadout(event, null));
 
 // The axis arrows move the sphere themselves; the other selected points follow.
 let gizmoStarts = null;
@@ -1877,7 +1875,13 @@ for (const b of document.querySelectorAll('[data-view]')) {
 }
 $('ortho').addEventListener('change', () => useCamera($('ortho').checked ? orthographic : perspective));
 $('screenshot').addEventListener('click', screenshot);
-$('drawer-close').addEventListener('click', () => { $('drawer').hidden = true; });
+$('drawer-close').addEventListener('click', closePanel);
+$('panel-figures').addEventListener('click', (event) => {
+  const link = event.target.closest('a.face');
+  if (!link) return;
+  event.preventDefault();
+  openPanel(Number(link.dataset.face));
+});
 for (const [i, axis] of ['x', 'y', 'z'].entries()) {
   $(`sel-${axis}`).addEventListener('change', () => typeCoordinate(i));
 }
@@ -1942,7 +1946,7 @@ window.addEventListener('keydown', (event) => {
 // ------------------------------------------------------------------ test and debugging hooks
 window.designer = {
   version: null, renders: 0, frames: 0, figuresVersion: null, lastExport: null, timings,
-  breakdown, frameTimes, frameLog, liveFrames: 0, kept: {}, sameTopology: 0, legend: null, hover: null, panel: null, reused: false, view: null,
+  breakdown, frameTimes, frameLog, liveFrames: 0, kept: {}, sameTopology: 0, legend: null, panelFigures: null, hover: null, panel: null, reused: false, view: null,
   busy: () => inFlight || jobs.length > 0,
   softwareGL: SOFTWARE_GL,
   // The page's own part of an update, without the server: decode the last state message
@@ -1994,6 +1998,13 @@ window.designer = {
   construction: () => layers.construction.children.map((o) => o.userData.construction).filter(Boolean),
   grid: () => layers.grid.children[0]?.userData.step,
   faceInfo: (f) => faceInfo(f),
+  highlighted: () => highlighted?.face ?? null,
+  hoverOutline: () => {
+    const n = hoverOutline.geometry.drawRange.count;
+    const a = hoverOutline.geometry.getAttribute('position').array;
+    return { visible: hoverOutline.visible, corners: Array.from({ length: Math.min(n, HOVER_CORNERS) },
+      (_, k) => Array.from(a.subarray(3 * k, 3 * k + 3))) };
+  },
   faceScreen: (f) => {
     const { vertices: V, face_offsets: off, face_indices: idx } = current.arrays;
     const v = new THREE.Vector3();
