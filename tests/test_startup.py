@@ -86,10 +86,10 @@ def test_small_build_loads_no_scipy(tmp_path, example):
     assert _offenders(names) == []
 
 
-@pytest.mark.parametrize("example", ["fig7b-hyperboloid-circular", "fig8-helicoid", "fig6a-prism"])
-def test_small_build_outside_the_skew_mesher_loads_no_masked_arrays(tmp_path, example):
-    """The analysis and the exact constructions take order statistics and unique values
-    without numpy.ma (ruledmesh._arrays); the §4.3 mesher still asks numpy for them."""
+@pytest.mark.parametrize("example", ["fig7b-hyperboloid-circular", "fig8-helicoid", "fig6a-prism", "skew"])
+def test_small_build_loads_no_masked_arrays(tmp_path, example):
+    """The analysis, the exact constructions and the §4.3 mesher (the README's example) take
+    order statistics, unique values and memberships without numpy.ma (ruledmesh._arrays)."""
     code = (f"from ruledmesh.cli import main\n"
             f"assert main(['build', {str(EXAMPLES / (example + '.toml'))!r}, '-o', 'm.obj']) == 0")
     names = imported(code, tmp_path)

@@ -16,7 +16,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..._arrays import ranks
+from ..._arrays import median, ranks
 from ...mesh import FaceKind, Mesh, offsets_from_valences
 from ...tolerances import RESTART_ANGLE_DEG
 
@@ -53,11 +53,11 @@ def split_strip_quads(mesh: Mesh) -> tuple[Mesh, int]:
         return mesh, 0
     area = face_normals(mesh)[1]
     usual = area[quads & (mesh.face_kind != FaceKind.STRIP)]
-    median = float(np.median(usual if usual.size else area[quads]))
-    big = strip[area[strip] > _LARGE * median]
-    if big.size == 0 or median <= 0.0:
+    middle = median(usual if usual.size else area[quads])
+    big = strip[area[strip] > _LARGE * middle]
+    if big.size == 0 or middle <= 0.0:
         return mesh, 0
-    pieces = np.clip(np.rint(area[big] / median), 2, _MAX_PIECES).astype(np.int64)
+    pieces = np.clip(np.rint(area[big] / middle), 2, _MAX_PIECES).astype(np.int64)
     corners = _strip_corners(mesh, big)
     # The faces across the two generator edges a0 -> a1 and b1 -> b0.
     across = [_neighbours(mesh, corners[:, 0], corners[:, 1]), _neighbours(mesh, corners[:, 2], corners[:, 3])]
