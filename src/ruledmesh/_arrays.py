@@ -50,7 +50,6 @@ def unique(values: np.ndarray) -> np.ndarray:
     return arr[keep]
 
 
-
 def member(values: np.ndarray, among: np.ndarray) -> np.ndarray:
     """Which of ``values`` occur in ``among``: ``np.isin(values, among)``, by sorting.
 

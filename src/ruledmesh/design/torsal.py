@@ -129,8 +129,8 @@ def _denser_pair(surface, u: np.ndarray, lo: int, hi: int, scale: float):
             return None, np.zeros(0)
         pair = _pair(surface, local, g - 1, g + 1, scale)
         if pair is not None and _sag(surface, pair, scale) <= FLAT_PAIR_MAX_SAG:
-            added = unique(local)
-            return pair, added[~member(added, u)]
+            # local is sorted and unique already (the loop's unique).
+            return pair, local[~member(local, u)]
     return None, np.zeros(0)
 
 
