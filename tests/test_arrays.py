@@ -1,5 +1,5 @@
 """ruledmesh._arrays against numpy: unique values, cross products, norms, percentiles and medians,
-bit for bit."""
+bit for bit; corner angles against the C library's atan2, to two ulps."""
 
 from __future__ import annotations
 
@@ -12,7 +12,7 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 from hypothesis.extra import numpy as hnp
 
-from ruledmesh._arrays import cross, median, member, norm, percentile, ranks, unique
+from ruledmesh._arrays import corner_angle, cross, median, member, norm, percentile, ranks, unique
 
 
 def _same(x: np.ndarray, y: np.ndarray) -> bool:
@@ -140,3 +140,33 @@ def test_order_statistics_import_no_masked_arrays():
             "x = np.random.default_rng(0).random(101)\npercentile(x, 5), median(x)\n"
             "assert 'numpy.ma' not in sys.modules\nnp.median(x)\nassert 'numpy.ma' in sys.modules")
     subprocess.run([sys.executable, "-c", code], check=True)
+
+
+def _ulps(got: np.ndarray, want: np.ndarray) -> np.ndarray:
+    return np.abs(got - want) / np.spacing(np.maximum(np.abs(want), np.finfo(float).tiny))
+
+
+@settings(max_examples=200, deadline=None)
+@given(st.integers(0, 2**31), st.integers(1, 500), st.floats(-300, 300), st.floats(0, 30))
+def test_corner_angle_is_atan2(seed, n, scale, spread):
+    """Within two ulps of math.atan2 in degrees, from 0 to 180 and at any scale."""
+    import math
+
+    rng = np.random.default_rng(seed)
+    s = np.abs(rng.standard_normal(n)) * 10.0 ** scale
+    c = rng.standard_normal(n) * 10.0 ** scale * np.exp(rng.uniform(-spread, spread, n))
+    want = np.array([math.degrees(math.atan2(y, x)) for y, x in zip(s.tolist(), c.tolist())])
+    assert _ulps(corner_angle(s, c), want).max() <= 2.0
+
+
+def test_corner_angle_edges_of_its_domain():
+    """Zero edges (0 or 180 by the zero's sign, as atan2), right angles, NaN through, no warning."""
+    s = np.array([0.0, 0.0, 0.0, 1.0, 1.0, 2.0, np.nan, 1.0, 1e-310])
+    c = np.array([0.0, -0.0, -3.0, 0.0, -0.0, 2.0, 1.0, np.nan, 1.0])
+    with np.errstate(divide="raise", invalid="raise", over="raise"):
+        got = corner_angle(s, c)
+    assert got[:6].tolist() == [0.0, 180.0, 180.0, 90.0, 90.0, 45.0]
+    assert np.isnan(got[6:8]).all() and 0.0 < got[8] < 1e-300
+    # Each reduction interval of the atan, and its ends.
+    x = np.r_[np.linspace(0.0, 1.0, 20001), 0.4375, 0.6875, np.nextafter(0.4375, 0), np.nextafter(0.6875, 0)]
+    assert _ulps(corner_angle(x, np.ones_like(x)), np.degrees(np.arctan(x))).max() <= 2.0

@@ -34,7 +34,7 @@ from functools import cache
 
 import numpy as np
 
-from ._arrays import unique
+from ._arrays import corner_angle, unique
 from ._validation import check_choice
 from .mesh import Mesh
 from .tolerances import ROUNDING
@@ -131,7 +131,7 @@ def triangle_angles(points: np.ndarray) -> np.ndarray:
     e2 = np.roll(p, 1, axis=-2) - p
     cos = np.einsum("...i,...i->...", e1, e2)
     sin = np.linalg.norm(np.cross(e1, e2), axis=-1)
-    return np.degrees(np.arctan2(sin, cos))
+    return corner_angle(sin, cos)
 
 
 @cache

@@ -11,7 +11,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from .._arrays import cross, norm, unique
+from .._arrays import corner_angle, cross, norm, unique
 from ..kernels import wanted
 from ..mesh import Mesh
 from ..tolerances import DEFAULT, ROUNDING_SQ
@@ -248,7 +248,7 @@ def polygon_angles(corners: np.ndarray) -> np.ndarray:
     np.subtract(corners[:, :1], corners[:, -1:], out=e2[:, -1:])
     cosang = np.einsum("fkc,fkc->fk", e1, e2)
     sinang = norm(cross(e1, e2))
-    return np.degrees(np.arctan2(sinang, cosang))
+    return corner_angle(sinang, cosang)
 
 
 def min_corner_angles(vertices: np.ndarray, faces: np.ndarray) -> np.ndarray:
@@ -284,7 +284,7 @@ def corner_angles(mesh: Mesh) -> np.ndarray:
     e2 = v[idx[nxt]] - v[idx]
     cosang = np.einsum("ij,ij->i", e1, e2)
     sinang = norm(cross(e1, e2))
-    return np.degrees(np.arctan2(sinang, cosang))
+    return corner_angle(sinang, cosang)
 
 
 def convexity(mesh: Mesh, tol: float = DEFAULT.convexity) -> np.ndarray:

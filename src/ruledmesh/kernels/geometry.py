@@ -16,11 +16,13 @@ import math
 import numba as nb
 import numpy as np
 
+from .._arrays import ATAN_EVEN, ATAN_HI, ATAN_LO, ATAN_ODD, DEGREES, HALF_PI
 from ..tolerances import ROUNDING_SQ, TINY
 
 __all__ = ["crossing", "flip_pairs", "min_angles", "newell", "polygon_angles", "quad_planarity"]
 
-_DEG = 180.0 / math.pi
+E0, E1, E2, E3, E4, E5 = ATAN_EVEN
+O0, O1, O2, O3, O4 = ATAN_ODD
 # numpy's pairwise sum adds up to 128 terms in one unrolled block: the Newell kernel
 # follows its order for faces of up to 129 corners (the first plus 128).
 _MAX_CORNERS = 129
@@ -42,6 +44,42 @@ def _dot(x0: float, x1: float, x2: float, y0: float, y1: float, y2: float) -> fl
     sign of a zero cosine decides between 0 and 180 degrees in ``atan2``).
     """
     return 0.0 + ((x0 * y0 + x2 * y2) + x1 * y1)
+
+
+@nb.njit(cache=True, inline="always")
+def _corner_angle(sin: float, cos: float) -> float:
+    """:func:`ruledmesh._arrays.corner_angle` of one corner, operation for operation.
+
+    Not ``math.atan2``: numpy's ``arctan2`` differs from it in the last bit on
+    some machines, and the numpy path must decide as the kernels do.
+    """
+    ac = abs(cos)
+    steep = sin > ac
+    num, den = (ac, sin) if steep else (sin, ac)
+    x = 0.0 if den == 0.0 else num / den
+    if x < 0.4375:
+        y = x
+    elif x < 0.6875:
+        y = (2.0 * x - 1.0) / (2.0 + x)
+    else:
+        y = (x - 1.0) / (x + 1.0)
+    z = y * y
+    w = z * z
+    s1 = z * (E0 + w * (E1 + w * (E2 + w * (E3 + w * (E4 + w * E5)))))
+    s2 = w * (O0 + w * (O1 + w * (O2 + w * (O3 + w * O4))))
+    ys = y * (s1 + s2)
+    if x < 0.4375:
+        atan = y - ys
+    elif x < 0.6875:
+        atan = ATAN_HI[0] - ((ys - ATAN_LO[0]) - y)
+    else:
+        atan = ATAN_HI[1] - ((ys - ATAN_LO[1]) - y)
+    turn = math.copysign(1.0, cos) < 0.0
+    if steep:
+        rad = HALF_PI + atan if turn else HALF_PI - atan
+    else:
+        rad = 2.0 * HALF_PI - atan if turn else atan
+    return rad * DEGREES
 
 
 @nb.njit(cache=True, inline="always")
@@ -254,7 +292,7 @@ def _min_angles(V, idx, off):
             y0, y1, y2 = V[q, 0] - V[i, 0], V[q, 1] - V[i, 1], V[q, 2] - V[i, 2]
             cos = _dot(x0, x1, x2, y0, y1, y2)
             sin = _norm(x1 * y2 - x2 * y1, x2 * y0 - x0 * y2, x0 * y1 - x1 * y0)
-            ang = math.atan2(sin, cos) * _DEG
+            ang = _corner_angle(sin, cos)
             if ang != ang:
                 nan = True
             elif ang < best:
@@ -293,7 +331,7 @@ def _polygon_angles(P):
             y0, y1, y2 = P[f, q, 0] - P[f, j, 0], P[f, q, 1] - P[f, j, 1], P[f, q, 2] - P[f, j, 2]
             cos = _dot(x0, x1, x2, y0, y1, y2)
             sin = _norm(x1 * y2 - x2 * y1, x2 * y0 - x0 * y2, x0 * y1 - x1 * y0)
-            out[f, j] = math.atan2(sin, cos) * _DEG
+            out[f, j] = _corner_angle(sin, cos)
     return out
 
 
@@ -319,7 +357,7 @@ def _angle(X, p, j, q):
     y0, y1, y2 = X[q, 0] - X[j, 0], X[q, 1] - X[j, 1], X[q, 2] - X[j, 2]
     cos = _dot(x0, x1, x2, y0, y1, y2)
     sin = _norm(x1 * y2 - x2 * y1, x2 * y0 - x0 * y2, x0 * y1 - x1 * y0)
-    return math.atan2(sin, cos) * _DEG
+    return _corner_angle(sin, cos)
 
 
 @nb.njit(cache=True, inline="always")
