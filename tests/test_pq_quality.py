@@ -281,3 +281,36 @@ def test_no_warning_in_tolerance_mode_advises_the_tolerance():
     warnings = build_design(parse_design(text)).mesh.info["warnings"]
     assert any("carry no §4.3 rows" in w for w in warnings)
     assert not any("planarity_tolerance" in w for w in warnings), warnings
+
+
+def test_rounds_take_back_only_their_own_generators_next_to_splinters(monkeypatch):
+    """A refinement round with splinters is tried again without the generators it added near
+    them: never a generator the round started from, none farther than the reach, and the
+    Pluecker conoid's round with one splinter comes back without it."""
+    import ruledmesh.design.pq as refine
+
+    seen = []
+    real = refine._unsplintered
+
+    def spy(candidate, mesh, given_u, options):
+        out = real(candidate, mesh, given_u, options)
+        seen.append((candidate, mesh, np.asarray(given_u), out))
+        return out
+
+    monkeypatch.setattr(refine, "_unsplintered", spy)
+    built = build_design(parse_design((QUALITY / "plucker-conoid.toml").read_text()))
+    taken = [s for s in seen if s[3] is not None]
+    assert taken, "no round had splinters to take generators back from"
+    fewer = 0
+    for candidate, mesh, start, (rulings, new_mesh) in taken:
+        u, kept = np.asarray(candidate.u), np.asarray(rulings.u)
+        assert np.isin(start, kept).all() and np.isin(kept, u).all() and len(kept) < len(u)
+        angles = face_min_angles(mesh)
+        gen = np.asarray(mesh.vertex_data["generator"])[mesh.face_indices]
+        lo = np.minimum.reduceat(gen, mesh.face_offsets[:-1])[angles < 3.0]
+        hi = np.maximum.reduceat(gen, mesh.face_offsets[:-1])[angles < 3.0]
+        for k in np.flatnonzero(~np.isin(u, kept)):
+            assert ((lo - refine._TAKE_BACK_STRIPS <= k) & (k <= hi + refine._TAKE_BACK_STRIPS)).any()
+        fewer += int((face_min_angles(new_mesh) < 3.0).sum() < (angles < 3.0).sum())
+    assert fewer >= 1
+    assert face_min_angles(built.mesh).min() >= 3.0
