@@ -1006,6 +1006,104 @@ def test_hover_read_out_never_covers_its_face(page, designer):
     assert sides["left"] == sides["top-left"] == sides["bottom-left"] == "right", sides
 
 
+def test_panel_answer_for_faces_since_changed_is_never_shown(page, designer):
+    """A panel asked for while new faces are on their way opens only if it is the face clicked.
+
+    Its request is held (route interception) while an edit builds other faces: let through
+    then, the server answers it stale (its number names another face by now, which the
+    server used to send); answered before the edit but arriving after it, the page drops it.
+    An answer from an older build of the same faces is that face: shown, then read again.
+    A slower answer to an earlier click does not replace a later one's.
+    """
+    from ruledmesh.fabricate import panel_table
+    from ruledmesh.web.session import topology_key
+
+    held, hold = [], [True]
+
+    def route(r):
+        if hold[0]:
+            hold[0] = False
+            held.append(r)
+        else:
+            r.continue_()
+
+    def next_held(n):
+        for _ in range(1000):
+            if len(held) >= n:
+                return held[n - 1]
+            page.wait_for_timeout(10)
+        raise AssertionError("the panel request did not come")
+
+    page.route(re.compile(r"/api/panel\?"), route)
+    page.click('[data-view="top"]')
+    page.wait_for_function("window.designer.view === 'top'")
+    table = panel_table(designer.session.built.mesh)
+    pos = page.evaluate(f"window.designer.faceScreen({int(np.argmax(np.abs(table['area'])))})")
+    x, y = pos["x"], pos["y"]
+    under = f"window.designer.faceAt({x}, {y})"
+
+    # the same faces, moved (a point typed 0.01 higher): the older answer is the face clicked
+    key = topology_key(designer.session.built.mesh)
+    g = page.evaluate(under)
+    page.mouse.click(x, y)
+    answer = next_held(1).fetch()
+    assert f"face={g}&topology={key}" in held[0].request.url
+    h = next(o for o in page.evaluate("window.designer.handles()") if o["label"] == "c2.points[2]")
+    page.mouse.click(h["x"], h["y"])
+    page.wait_for_function("window.designer.selection().length === 1")
+    v = page.evaluate("window.designer.version")
+    page.fill("#sel-z", "3.01")
+    page.press("#sel-z", "Enter")
+    wait_version(page, v)
+    assert topology_key(designer.session.built.mesh) == key
+    held[0].fulfill(response=answer)
+    page.wait_for_selector("#drawer:not([hidden])")
+    version = designer.session.version
+    page.wait_for_function(f"window.designer.panel.face === {g} && window.designer.panel.version === {version}")
+    assert page.evaluate("window.designer.panel.row.area") == pytest.approx(
+        panel_table(designer.session.built.mesh)["area"][g])
+    page.click("#drawer-close")
+
+    # new faces built while the request waits: the server answers stale, the page drops it
+    hold[0] = True
+    g = page.evaluate(under)
+    page.mouse.click(x, y)
+    next_held(2)
+    set_field(page, "mesh.rows", 13)
+    assert topology_key(designer.session.built.mesh) != key
+    held[1].continue_()
+    page.wait_for_function("window.designer.panelsDropped === 1")
+    assert page.is_hidden("#drawer") and page.evaluate("window.designer.panel") is None
+    assert page.evaluate("window.designer.highlighted()") is None
+    assert f"panel P{g} not opened: the faces changed" in page.inner_text("#status")
+
+    # answered for the faces clicked, arriving after newer ones: dropped too
+    hold[0] = True
+    g = page.evaluate(under)
+    page.mouse.click(x, y)
+    answer = next_held(3).fetch()
+    set_field(page, "mesh.rows", 14)
+    held[2].fulfill(response=answer)
+    page.wait_for_function("window.designer.panelsDropped === 2")
+    assert page.is_hidden("#drawer") and page.evaluate("window.designer.panel") is None
+
+    # an earlier click's slower answer does not replace the later one's (a face name of the
+    # panel figures, clicked while the face's answer waits)
+    hold[0] = True
+    first = page.evaluate(under)
+    page.mouse.click(x, y)
+    next_held(4)
+    q = page.get_attribute("#panel-figures a.face", "data-face")
+    assert int(q) != first
+    page.click("#panel-figures a.face")
+    page.wait_for_function(f"window.designer.panel && window.designer.panel.face === {q}")
+    with page.expect_response(re.compile(r"/api/panel\?")):
+        held[3].continue_()
+    page.evaluate("() => new Promise((done) => setTimeout(done, 100))")  # the answer read
+    assert page.evaluate("window.designer.panel.face") == int(q)
+    assert page.evaluate("window.designer.panelsDropped") == 2  # left out, not counted stale
+
+
 def test_two_tabs_show_the_same_design_and_history(page, designer, browser):
     other = browser.new_page()
     errors = []

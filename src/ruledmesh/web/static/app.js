@@ -994,12 +994,29 @@ function followHover(sameFaces) {
   outlineFace(info.face);
 }
 
+// A face number names a face of one set of faces (a topology): the request says which, the
+// server answers {stale} when its faces are others by then, and an answer is shown only
+// while the page still draws those faces and no newer request (or a close) came after it.
+// An answer from an older build of the same faces is the right face: shown, and read again.
+let panelAsk = 0;   // the newest panel request; closing the drawer counts as one
 async function openPanel(f) {
+  const ask = ++panelAsk;
+  const topology = current.header.topology;
   highlightFace(f);
   let data;
   try {
-    data = await api('GET', `panel?face=${f}`);
-  } catch (err) { showError(err.message); return; }
+    data = await api('GET', `panel?face=${f}&topology=${encodeURIComponent(topology)}`);
+  } catch (err) {
+    if (ask === panelAsk) showError(err.message);
+    return;
+  }
+  if (ask !== panelAsk) return;
+  if (data.stale || data.topology !== topology || current.header.topology !== topology) {
+    window.designer.panelsDropped += 1;
+    if (highlighted?.face === f) highlightFace(null);
+    noteUpdate(current.header.version, `panel P${f} not opened: the faces changed`);
+    return;
+  }
   const drawer = $('drawer');
   drawer.hidden = false;
   $('drawer-title').textContent = `panel ${data.row.label}`;
@@ -1021,9 +1038,11 @@ async function openPanel(f) {
   $('drawer-row').innerHTML = Object.entries(data.row).map(([k, v]) => `<tr><th>${k}</th><td>${
     typeof v === 'number' ? fmt(v) : v}</td></tr>`).join('');
   window.designer.panel = data;
+  if (data.version < current.header.version) followPanel(true);  // built before the newest
 }
 
 function closePanel() {
+  panelAsk += 1;   // an answer still on its way does not open the drawer again
   $('drawer').hidden = true;
   window.designer.panel = null;
   highlightFace(null);
@@ -2002,7 +2021,7 @@ window.addEventListener('keydown', (event) => {
 // ------------------------------------------------------------------ test and debugging hooks
 window.designer = {
   version: null, renders: 0, frames: 0, figuresVersion: null, lastExport: null, timings,
-  breakdown, frameTimes, frameLog, liveFrames: 0, kept: {}, sameTopology: 0, legend: null, panelFigures: null, hover: null, readoutSide: null, panel: null, reused: false, view: null,
+  breakdown, frameTimes, frameLog, liveFrames: 0, kept: {}, sameTopology: 0, legend: null, panelFigures: null, hover: null, readoutSide: null, panel: null, panelsDropped: 0, reused: false, view: null,
   busy: () => inFlight || jobs.length > 0,
   softwareGL: SOFTWARE_GL,
   // The page's own part of an update, without the server: decode the last state message
