@@ -112,3 +112,22 @@ def test_tiny_run_writes_the_json_and_plot(bench, tmp_path, capsys):
     except ImportError:
         return
     assert out.with_suffix(".png").read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+
+
+def test_designer_benchmark_times_every_stage(capsys):
+    """benchmarks/designer.py at one step: a figure for each stage of the server's part."""
+    sys.path.insert(0, str(BENCH))
+    try:
+        import designer
+
+        assert designer.main(["--steps", "1"]) == 0
+    finally:
+        sys.path.remove(str(BENCH))
+        sys.modules.pop("designer", None)
+    out = capsys.readouterr().out
+    for stage in ("build (wall)", "build (CPU)", "frame_data", "Session.edit + payload",
+                  "Session.edit, worker", "POST /api/edit (client)", "POST /api/edit (server)"):
+        line = next(x for x in out.splitlines() if x.startswith(stage))
+        median = float(line.split("median")[1].split("ms")[0])
+        assert 0 < median < 60_000, line
+    assert "load average" in out

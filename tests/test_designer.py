@@ -23,7 +23,7 @@ from ruledmesh import io
 from ruledmesh.design import build_design, parse_design
 from ruledmesh.errors import DesignError, ExportError, ParameterError
 from ruledmesh.web.server import make_server
-from ruledmesh.web.session import Session, fan_triangles
+from ruledmesh.web.session import Session, fan_triangles, topology_key
 from ruledmesh.web.toml_writer import dumps
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -166,6 +166,30 @@ def test_panel_read_out_is_the_schedule_row_and_the_unrolled_outline():
                        np.linalg.norm(np.roll(corners, -1, 0) - corners, axis=1))
     with pytest.raises(ParameterError, match="face"):
         s.panel(mesh.n_faces)
+
+
+def test_panel_of_a_face_chosen_among_other_faces_is_stale():
+    """A face number names a face of one mesh: asked with the faces it was chosen among
+    (their fingerprint), the panel of a mesh with other faces is answered stale, never the
+    panel of the face that number names now (nor an error where it names none)."""
+    s = Session(SMALL)
+    mesh = s.built.mesh
+    key, f = topology_key(mesh), mesh.n_faces - 1
+    info = s.panel(f, key)
+    assert info["topology"] == key and info["row"]["label"] == f"P{f}" and "stale" not in info
+    s.edit([(["curves", "c2", "points", 2], [6, 3, 3.01])])  # the same faces, moved
+    assert topology_key(s.built.mesh) == key
+    moved = s.panel(f, key)
+    assert moved["version"] == s.version and moved["row"]["label"] == f"P{f}"
+    assert moved["outline"] != info["outline"]
+    s.edit([(["mesh", "rows"], 4)])  # fewer faces: f names none of them
+    now = topology_key(s.built.mesh)
+    assert now != key and s.built.mesh.n_faces <= f
+    assert s.panel(f, key) == {"version": s.version, "topology": now, "face": f, "stale": True}
+    g = s.built.mesh.n_faces // 2
+    assert s.panel(g, key)["stale"] is True
+    assert s.panel(g, now)["row"]["label"] == f"P{g}"
+    assert s.panel(g)["topology"] == now  # without a fingerprint: the current mesh's face
 
 
 def test_panel_read_out_is_bounded(monkeypatch):
@@ -390,6 +414,17 @@ def test_slow_figures_in_worker(server):
     assert arrays["closeness"].shape == (mesh.n_faces,)
     stale = decode(request(server, "GET", f"/api/figures?version={version - 1}")[2])[0]
     assert stale["stale"] is True
+
+
+def test_panel_request_names_the_faces_it_chose_among(server):
+    key = topology_key(server.session.built.mesh)
+    status, _, data = request(server, "GET", f"/api/panel?face=3&topology={key}")
+    assert status == 200 and json.loads(data)["row"]["label"] == "P3"
+    request(server, "POST", "/api/edit", {"changes": [[["mesh", "rows"], 8]]})
+    status, _, data = request(server, "GET", f"/api/panel?face=3&topology={key}")
+    answer = json.loads(data)
+    assert status == 200 and answer["stale"] is True and "row" not in answer
+    assert answer["topology"] == topology_key(server.session.built.mesh) != key
 
 
 def test_refuses_foreign_hosts_and_cross_site_posts(server):

@@ -902,6 +902,208 @@ def test_hover_reads_a_face_and_click_opens_its_panel(page, designer):
     assert f"panel P{g} closed" in page.inner_text("#status")
 
 
+# The view's box and the read-out's, in the page's pixels; the face's box from its corners as
+# the server's mesh has them, each projected by the page's camera.
+BOXES_JS = """(corners) => {
+  const box = (e) => { const r = e.getBoundingClientRect();
+    return {left: r.left, top: r.top, right: r.right, bottom: r.bottom}; };
+  const pts = corners.map((p) => window.designer.screen(p));
+  const xs = pts.map((p) => p.x), ys = pts.map((p) => p.y);
+  return {view: box(document.getElementById('view')), readout: box(document.getElementById('readout')),
+          face: {left: Math.min(...xs), top: Math.min(...ys), right: Math.max(...xs), bottom: Math.max(...ys)},
+          side: window.designer.readoutSide};
+}"""
+
+
+def hover_boxes(pg, mesh, x: float, y: float) -> tuple[int, dict]:
+    """Hover the view at (x, y) from off it; the face read out and the boxes (BOXES_JS)."""
+    pg.mouse.move(5, 5)                      # over the side panel: no read-out
+    pg.wait_for_function("window.designer.hover === null")
+    pg.mouse.move(x + 1, y + 1)
+    pg.mouse.move(x, y)
+    pg.wait_for_function("window.designer.hover !== null")
+    g = pg.evaluate("window.designer.hover.face")
+    return g, pg.evaluate(BOXES_JS, mesh.vertices[mesh.face(g)].tolist())
+
+
+def overlap(a: dict, b: dict) -> bool:
+    return a["left"] < b["right"] and b["left"] < a["right"] and \
+        a["top"] < b["bottom"] and b["top"] < a["bottom"]
+
+
+def inside(a: dict, b: dict) -> bool:
+    return b["left"] <= a["left"] and a["right"] <= b["right"] and \
+        b["top"] <= a["top"] and a["bottom"] <= b["bottom"]
+
+
+def on_face(pg, handles, points) -> tuple[float, float]:
+    """The first of ``points`` (page pixels) on a face and not on a handle."""
+    for x, y in points:
+        if all(abs(hd["x"] - x) > 20 or abs(hd["y"] - y) > 20 for hd in handles) and \
+                pg.evaluate(f"window.designer.faceAt({x}, {y})") is not None:
+            return x, y
+    raise AssertionError(f"no face at any of {points}")
+
+
+def pan(pg, x: float, y: float, dy: float) -> None:
+    """Drag the view up (``dy`` < 0) or down with the right button, as OrbitControls pans."""
+    pg.mouse.move(x, y)
+    pg.mouse.down(button="right")
+    pg.mouse.move(x, y + dy, steps=5)
+    pg.mouse.up(button="right")
+    pg.evaluate("() => new Promise(requestAnimationFrame)")
+
+
+def test_hover_read_out_never_covers_its_face(page, designer):
+    """The read-out goes beside the hovered face's box on screen, inside the view, also for
+    faces cut by the view's edges and in its corners (it sat 14 px below and right of the
+    pointer, over the face it describes, and ran past the view's edge)."""
+    mesh = designer.session.built.mesh
+    view = page.evaluate("document.getElementById('view').getBoundingClientRect().toJSON()")
+    centre = page.evaluate(f"window.designer.faceScreen({mesh.n_faces // 2})")
+    _, boxes = hover_boxes(page, mesh, centre["x"], centre["y"])
+    assert not overlap(boxes["readout"], boxes["face"]) and inside(boxes["readout"], boxes["view"])
+    # Close up in plan the faces are over 150 px across and the mesh runs past the view's
+    # left and right edges; panned up and down, past its top and bottom.
+    page.click('[data-view="top"]')
+    page.wait_for_function("window.designer.view === 'top'")
+    x0, y0, x1, y1 = view["left"], view["top"], view["right"], view["bottom"]
+    mx, my = (x0 + x1) / 2, (y0 + y1) / 2
+    for _ in range(30):
+        page.mouse.move(mx, my)
+        page.mouse.wheel(0, -100)
+        _, boxes = hover_boxes(page, mesh, mx, my)
+        if boxes["face"]["right"] - boxes["face"]["left"] > 150:
+            break
+    along = [8 + 12 * k for k in range(40)]   # from a corner along an edge, 8 px inside
+    spots = {
+        0: {"middle": [(mx, my)], "right": [(x1 - 8, my + d) for d in along],
+            "left": [(x0 + 8, my + d) for d in along]},
+        -350: {"top": [(mx + d, y0 + 8) for d in along],
+               "top-right": [(x1 - d, y0 + 8) for d in along],
+               "top-left": [(x0 + 8, y0 + d) for d in along]},
+        700: {"bottom": [(mx + d, y1 - 8) for d in along],
+              "bottom-right": [(x1 - 8, y1 - d) for d in along],
+              "bottom-left": [(x0 + d, y1 - 8) for d in along]},
+    }
+    sides = {}
+    for dy, named in spots.items():
+        if dy:
+            pan(page, mx, my, dy)
+        handles = page.evaluate("window.designer.handles()")
+        for name, points in named.items():
+            x, y = on_face(page, handles, points)
+            _, boxes = hover_boxes(page, mesh, x, y)
+            f, r = boxes["face"], boxes["readout"]
+            assert f["right"] - f["left"] > 100, (name, f)
+            assert not overlap(r, f), (name, boxes)
+            assert inside(r, boxes["view"]), (name, boxes)
+            sides[name] = boxes["side"]
+            if name == "bottom-right":
+                shot(page, "hover-readout-corner")
+    # by the right edge it goes left of the face, by the left edge right of it
+    assert sides["right"] == sides["top-right"] == sides["bottom-right"] == "left", sides
+    assert sides["left"] == sides["top-left"] == sides["bottom-left"] == "right", sides
+
+
+def test_panel_answer_for_faces_since_changed_is_never_shown(page, designer):
+    """A panel asked for while new faces are on their way opens only if it is the face clicked.
+
+    Its request is held (route interception) while an edit builds other faces: let through
+    then, the server answers it stale (its number names another face by now, which the
+    server used to send); answered before the edit but arriving after it, the page drops it.
+    An answer from an older build of the same faces is that face: shown, then read again.
+    A slower answer to an earlier click does not replace a later one's.
+    """
+    from ruledmesh.fabricate import panel_table
+    from ruledmesh.web.session import topology_key
+
+    held, hold = [], [True]
+
+    def route(r):
+        if hold[0]:
+            hold[0] = False
+            held.append(r)
+        else:
+            r.continue_()
+
+    def next_held(n):
+        for _ in range(1000):
+            if len(held) >= n:
+                return held[n - 1]
+            page.wait_for_timeout(10)
+        raise AssertionError("the panel request did not come")
+
+    page.route(re.compile(r"/api/panel\?"), route)
+    page.click('[data-view="top"]')
+    page.wait_for_function("window.designer.view === 'top'")
+    table = panel_table(designer.session.built.mesh)
+    pos = page.evaluate(f"window.designer.faceScreen({int(np.argmax(np.abs(table['area'])))})")
+    x, y = pos["x"], pos["y"]
+    under = f"window.designer.faceAt({x}, {y})"
+
+    # the same faces, moved (a point typed 0.01 higher): the older answer is the face clicked
+    key = topology_key(designer.session.built.mesh)
+    g = page.evaluate(under)
+    page.mouse.click(x, y)
+    answer = next_held(1).fetch()
+    assert f"face={g}&topology={key}" in held[0].request.url
+    h = next(o for o in page.evaluate("window.designer.handles()") if o["label"] == "c2.points[2]")
+    page.mouse.click(h["x"], h["y"])
+    page.wait_for_function("window.designer.selection().length === 1")
+    v = page.evaluate("window.designer.version")
+    page.fill("#sel-z", "3.01")
+    page.press("#sel-z", "Enter")
+    wait_version(page, v)
+    assert topology_key(designer.session.built.mesh) == key
+    held[0].fulfill(response=answer)
+    page.wait_for_selector("#drawer:not([hidden])")
+    version = designer.session.version
+    page.wait_for_function(f"window.designer.panel.face === {g} && window.designer.panel.version === {version}")
+    assert page.evaluate("window.designer.panel.row.area") == pytest.approx(
+        panel_table(designer.session.built.mesh)["area"][g])
+    page.click("#drawer-close")
+
+    # new faces built while the request waits: the server answers stale, the page drops it
+    hold[0] = True
+    g = page.evaluate(under)
+    page.mouse.click(x, y)
+    next_held(2)
+    set_field(page, "mesh.rows", 13)
+    assert topology_key(designer.session.built.mesh) != key
+    held[1].continue_()
+    page.wait_for_function("window.designer.panelsDropped === 1")
+    assert page.is_hidden("#drawer") and page.evaluate("window.designer.panel") is None
+    assert page.evaluate("window.designer.highlighted()") is None
+    assert f"panel P{g} not opened: the faces changed" in page.inner_text("#status")
+
+    # answered for the faces clicked, arriving after newer ones: dropped too
+    hold[0] = True
+    g = page.evaluate(under)
+    page.mouse.click(x, y)
+    answer = next_held(3).fetch()
+    set_field(page, "mesh.rows", 14)
+    held[2].fulfill(response=answer)
+    page.wait_for_function("window.designer.panelsDropped === 2")
+    assert page.is_hidden("#drawer") and page.evaluate("window.designer.panel") is None
+
+    # an earlier click's slower answer does not replace the later one's (a face name of the
+    # panel figures, clicked while the face's answer waits)
+    hold[0] = True
+    first = page.evaluate(under)
+    page.mouse.click(x, y)
+    next_held(4)
+    q = page.get_attribute("#panel-figures a.face", "data-face")
+    assert int(q) != first
+    page.click("#panel-figures a.face")
+    page.wait_for_function(f"window.designer.panel && window.designer.panel.face === {q}")
+    with page.expect_response(re.compile(r"/api/panel\?")):
+        held[3].continue_()
+    page.evaluate("() => new Promise((done) => setTimeout(done, 100))")  # the answer read
+    assert page.evaluate("window.designer.panel.face") == int(q)
+    assert page.evaluate("window.designer.panelsDropped") == 2  # left out, not counted stale
+
+
 def test_two_tabs_show_the_same_design_and_history(page, designer, browser):
     other = browser.new_page()
     errors = []

@@ -13,7 +13,8 @@ one's body; this module adds the designer's own rules.  The API:
 ``POST /api/export``        ``{"format": ".obj", "path", "overwrite"}`` -> ``{"path"}``
 ``GET /api/download?format=.glb``  the exported bytes as a download
 ``GET /api/figures?version=N``     binary message: closeness, coverage, panels, classes
-``GET /api/panel?face=F``   JSON: the face's unrolled outline and ``panels.csv`` row
+``GET /api/panel?face=F&topology=K``  JSON: the face's unrolled outline and ``panels.csv``
+                            row; ``{"stale": true}`` if the faces are no longer ``K``
 ``WS /api/live?token=T``    pushes the state (binary, as ``/api/state``) after every change
 ==========================  ==================================================
 
@@ -474,7 +475,8 @@ class _Api:
             face = int(query.get("face", ""))
         except ValueError:
             raise _HttpError(400, "expected face=<integer>") from None
-        return JSONResponse(self.session.panel(face))
+        # The faces the page chose ``face`` among; other faces by now: answered stale.
+        return JSONResponse(self.session.panel(face, query.get("topology")))
 
     def _stale(self, version: int) -> Response:
         return Response(encode_message({"version": version, "stale": True}, []),

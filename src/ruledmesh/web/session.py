@@ -911,14 +911,27 @@ class Session:
                 cached = self._frame = (snap.version, frame_data(snap.design, snap.built))
             return cached[1]
 
-    def panel(self, face: int) -> dict[str, Any]:
+    def panel(self, face: int, topology: str | None = None) -> dict[str, Any]:
         """The unrolled outline and the ``panels.csv`` row of one face of the current mesh.
+
+        Parameters
+        ----------
+        face : int
+            The face's number in the current mesh.
+        topology : str, optional
+            The fingerprint (:func:`topology_key`) of the faces ``face`` was
+            chosen among (the page's faces when it was clicked).  When the
+            current mesh has other faces, ``face`` may name another face (or
+            none): the answer is then ``{"stale": true}`` instead of a panel.
 
         Returns
         -------
         dict
-            ``{"version", "face", "outline": (k, 2) list, "row": {column: value}}``;
-            the row has the columns of ``ruledmesh fabricate``'s ``panels.csv``.
+            ``{"version", "topology", "face", "outline": (k, 2) list,
+            "row": {column: value}}``; the row has the columns of
+            ``ruledmesh fabricate``'s ``panels.csv``.  A stale request gets
+            ``{"version", "topology", "face", "stale": True}`` with the current
+            version and fingerprint.
 
         Raises
         ------
@@ -931,6 +944,9 @@ class Session:
         with self._lock:
             snap = self._current
         mesh = snap.built.mesh
+        key = snap.frame["key"] if snap.frame is not None else topology_key(mesh)
+        if topology is not None and topology != key:
+            return {"version": snap.version, "topology": key, "face": face, "stale": True}
         if isinstance(face, bool) or not isinstance(face, int) or not 0 <= face < mesh.n_faces:
             raise ParameterError(f"expected a face index 0 .. {mesh.n_faces - 1}, got {face!r}",
                                  "face")
@@ -947,7 +963,7 @@ class Session:
         _, table, unrolled = cached
         row = {k: v[face].item() if hasattr(v[face], "item") else v[face]
                for k, v in table.items()}
-        return {"version": snap.version, "face": face,
+        return {"version": snap.version, "topology": key, "face": face,
                 "outline": unrolled.polygon(face).tolist(), "row": row}
 
 

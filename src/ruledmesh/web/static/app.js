@@ -876,15 +876,70 @@ function outlineFace(f) {
   requestRender();
 }
 
+// The face's corners on screen, as a box in the view's pixels: {left, top, right, bottom}.
+// A corner behind a perspective camera projects mirrored, so then the box is the whole view.
+const corner = new THREE.Vector3(), eye = new THREE.Vector3();
+function faceBox(f) {
+  const { vertices: V, face_offsets: off, face_indices: idx } = current.arrays;
+  const w = canvas.clientWidth, h = canvas.clientHeight;
+  const box = { left: Infinity, top: Infinity, right: -Infinity, bottom: -Infinity };
+  for (let k = off[f]; k < off[f + 1]; k++) {
+    const v = 3 * idx[k];
+    corner.set(V[v], V[v + 1], V[v + 2]);
+    if (camera.isPerspectiveCamera && eye.copy(corner).applyMatrix4(camera.matrixWorldInverse).z >= 0) {
+      return { left: 0, top: 0, right: w, bottom: h };
+    }
+    corner.project(camera);
+    const x = (corner.x + 1) / 2 * w, y = (1 - corner.y) / 2 * h;
+    box.left = Math.min(box.left, x); box.right = Math.max(box.right, x);
+    box.top = Math.min(box.top, y); box.bottom = Math.max(box.bottom, y);
+  }
+  return box;
+}
+
+// The read-out goes beside the face's box on screen, never over it (it would hide the face
+// it describes): right of it, else left, below or above, the first side with room in the
+// view (left of the panel drawer when that is open), level with the pointer and kept
+// inside the view. Only a face whose box leaves no room on any side (zoomed in close) gets
+// the read-out in the view's corner farthest from the pointer, over the face.
+const READOUT_GAP = 12;     // pixels between the face's box and the read-out
+const READOUT_MARGIN = 4;   // pixels kept free at the view's edges
+function placeReadout(box, f, pointer) {
+  const r = faceBox(f);
+  const drawer = $('drawer');
+  const w = (drawer.hidden ? canvas.clientWidth : drawer.offsetLeft) - READOUT_MARGIN;
+  const h = canvas.clientHeight - READOUT_MARGIN, m = READOUT_MARGIN;
+  // Measured at the view's corner: placed near its right edge, the box would be narrower
+  // (its width shrinks to the room left of the edge) and grow again where it goes.
+  box.style.left = '0px';
+  box.style.top = '0px';
+  const bw = box.offsetWidth, bh = box.offsetHeight;
+  const clamp = (v, lo, hi) => Math.max(lo, Math.min(v, hi));
+  const x = clamp(pointer.x + 14, m, w - bw), y = clamp(pointer.y + 14, m, h - bh);
+  const sides = [
+    ['right', r.right + READOUT_GAP, y, r.right + READOUT_GAP + bw <= w],
+    ['left', r.left - READOUT_GAP - bw, y, r.left - READOUT_GAP - bw >= m],
+    ['below', x, r.bottom + READOUT_GAP, r.bottom + READOUT_GAP + bh <= h],
+    ['above', x, r.top - READOUT_GAP - bh, r.top - READOUT_GAP - bh >= m],
+  ];
+  let [side, left, top] = sides.find((s) => s[3])
+    || ['corner', pointer.x < (m + w) / 2 ? w - bw : m, pointer.y < (m + h) / 2 ? h - bh : m];
+  left = Math.max(m, left); top = Math.max(m, top);
+  box.style.left = `${left}px`;
+  box.style.top = `${top}px`;
+  window.designer.readoutSide = side;
+}
+
+let hoverPointer = { x: 0, y: 0 };   // where the pointer was over the view (its pixels)
 function showReadout(event, f) {
   const box = $('readout');
   outlineFace(f);
   if (f === null) { box.hidden = true; window.designer.hover = null; return; }
   const info = faceInfo(f);
   box.innerHTML = readoutHtml(info);
-  box.style.left = `${event.offsetX + 14}px`;
-  box.style.top = `${event.offsetY + 14}px`;
-  box.hidden = false;
+  box.hidden = false;   // shown before it is placed: its size is known only then
+  hoverPointer = { x: event.offsetX, y: event.offsetY };
+  placeReadout(box, f, hoverPointer);
   window.designer.hover = info;
 }
 
@@ -934,16 +989,34 @@ function followHover(sameFaces) {
   if (!sameFaces) { showReadout(null, null); return; }
   const now = faceInfo(info.face);
   $('readout').innerHTML = readoutHtml(now);
+  placeReadout($('readout'), info.face, hoverPointer);   // the face may have moved or grown
   window.designer.hover = now;
   outlineFace(info.face);
 }
 
+// A face number names a face of one set of faces (a topology): the request says which, the
+// server answers {stale} when its faces are others by then, and an answer is shown only
+// while the page still draws those faces and no newer request (or a close) came after it.
+// An answer from an older build of the same faces is the right face: shown, and read again.
+let panelAsk = 0;   // the newest panel request; closing the drawer counts as one
 async function openPanel(f) {
+  const ask = ++panelAsk;
+  const topology = current.header.topology;
   highlightFace(f);
   let data;
   try {
-    data = await api('GET', `panel?face=${f}`);
-  } catch (err) { showError(err.message); return; }
+    data = await api('GET', `panel?face=${f}&topology=${encodeURIComponent(topology)}`);
+  } catch (err) {
+    if (ask === panelAsk) showError(err.message);
+    return;
+  }
+  if (ask !== panelAsk) return;
+  if (data.stale || data.topology !== topology || current.header.topology !== topology) {
+    window.designer.panelsDropped += 1;
+    if (highlighted?.face === f) highlightFace(null);
+    noteUpdate(current.header.version, `panel P${f} not opened: the faces changed`);
+    return;
+  }
   const drawer = $('drawer');
   drawer.hidden = false;
   $('drawer-title').textContent = `panel ${data.row.label}`;
@@ -965,9 +1038,11 @@ async function openPanel(f) {
   $('drawer-row').innerHTML = Object.entries(data.row).map(([k, v]) => `<tr><th>${k}</th><td>${
     typeof v === 'number' ? fmt(v) : v}</td></tr>`).join('');
   window.designer.panel = data;
+  if (data.version < current.header.version) followPanel(true);  // built before the newest
 }
 
 function closePanel() {
+  panelAsk += 1;   // an answer still on its way does not open the drawer again
   $('drawer').hidden = true;
   window.designer.panel = null;
   highlightFace(null);
@@ -1946,7 +2021,7 @@ window.addEventListener('keydown', (event) => {
 // ------------------------------------------------------------------ test and debugging hooks
 window.designer = {
   version: null, renders: 0, frames: 0, figuresVersion: null, lastExport: null, timings,
-  breakdown, frameTimes, frameLog, liveFrames: 0, kept: {}, sameTopology: 0, legend: null, panelFigures: null, hover: null, panel: null, reused: false, view: null,
+  breakdown, frameTimes, frameLog, liveFrames: 0, kept: {}, sameTopology: 0, legend: null, panelFigures: null, hover: null, readoutSide: null, panel: null, panelsDropped: 0, reused: false, view: null,
   busy: () => inFlight || jobs.length > 0,
   softwareGL: SOFTWARE_GL,
   // The page's own part of an update, without the server: decode the last state message
@@ -1998,6 +2073,7 @@ window.designer = {
   construction: () => layers.construction.children.map((o) => o.userData.construction).filter(Boolean),
   grid: () => layers.grid.children[0]?.userData.step,
   faceInfo: (f) => faceInfo(f),
+  faceAt: (x, y) => faceAt({ clientX: x, clientY: y }),   // the face under page point (x, y)
   highlighted: () => highlighted?.face ?? null,
   hoverOutline: () => {
     const n = hoverOutline.geometry.drawRange.count;
