@@ -426,9 +426,74 @@ def reference_of(design: Path, n_ref: int = REF_GENERATORS, rows: int = REF_ROWS
 
 
 def line_distance(p: np.ndarray, a: np.ndarray, b: np.ndarray, chunk: int = 4096) -> np.ndarray:
-    """(n,) distance of each point ``p`` (n, 3) to the nearest of the lines ``a_i b_i`` (m, 3)."""
+    """(n,) distance of each point ``p`` (n, 3) to the nearest of the lines ``a_i b_i`` (m, 3).
+
+    The lines worth measuring are found per cell of a grid over the points: a
+    line farther from the cell's centre than the nearest one plus twice the
+    cell's reach (and a margin far above rounding) is farther from each of the
+    cell's points too.  The nearest line of every point is among the others,
+    whose distances are the same numbers as from all pairs (:func:`_line_pairs`).
+    """
     d = b - a
     dd = np.einsum("ij,ij->i", d, d)
+    n, m = len(p), len(a)
+    if n * m <= 64 * chunk or not (np.all(dd > 0) and np.isfinite(p).all() and np.isfinite(dd).all()):
+        return _line_distance_all(p, a, d, dd, chunk)
+    lo = p.min(axis=0)
+    extent = float(_norm(p.max(axis=0) - lo))
+    # About eight points a cell on a surface (the cells it meets grow as the square).
+    h = max(extent / max(np.sqrt(n / 8.0), 1.0), 1e-300)
+    cell = np.floor((p - lo) / h).astype(np.int64)
+    keys, inv = np.unique(cell, axis=0, return_inverse=True)
+    inv = inv.ravel()
+    centre = lo + (keys + 0.5) * h
+    reach = np.zeros(len(keys))
+    np.maximum.at(reach, inv, _norm(p - centre[inv]))
+    dc = _line_distance_table(centre, a, d, dd, chunk)                    # (cells, m)
+    margin = 1e-9 * (extent + float(np.abs(p).max()) + float(np.abs(a).max()))
+    near = dc <= (dc.min(axis=1) + 2.0 * reach + margin)[:, None]
+    counts = near.sum(axis=1)
+    lines = np.nonzero(near)[1]                                          # by cell, then line
+    starts = np.cumsum(counts) - counts
+    out = np.empty(n)
+    order = np.argsort(inv, kind="stable")
+    per = counts[inv[order]]
+    step = max(1, (64 * chunk) // max(int(per.max()), 1))
+    for s in range(0, n, step):
+        pts = order[s:s + step]
+        k = per[s:s + step]
+        first = np.cumsum(k) - k
+        rank = np.arange(int(k.sum())) - np.repeat(first, k)
+        li = lines[np.repeat(starts[inv[pts]], k) + rank]
+        r2 = _line_pairs(p[np.repeat(pts, k)], a[li], d[li], dd[li])
+        out[pts] = np.sqrt(np.minimum.reduceat(r2, first))
+    return out
+
+
+def _line_pairs(p: np.ndarray, a: np.ndarray, d: np.ndarray, dd: np.ndarray) -> np.ndarray:
+    """Squared distance of points ``p`` to lines ``(a, d)`` paired row by row: the arithmetic
+    of :func:`_line_distance_all`, term for term."""
+    w = p - a
+    tt = np.einsum("ki,ki->k", w, d) / dd
+    r = w - tt[:, None] * d
+    return np.einsum("ki,ki->k", r, r)
+
+
+def _line_distance_table(p: np.ndarray, a: np.ndarray, d: np.ndarray, dd: np.ndarray,
+                         chunk: int) -> np.ndarray:
+    """(n, m) distance of every point to every line."""
+    out = np.empty((len(p), len(a)))
+    for s in range(0, len(p), chunk):
+        w = p[s:s + chunk, None, :] - a[None, :, :]            # (c, m, 3)
+        tt = np.einsum("cmi,mi->cm", w, d) / dd
+        r = w - tt[..., None] * d
+        out[s:s + chunk] = np.sqrt(np.einsum("cmi,cmi->cm", r, r))
+    return out
+
+
+def _line_distance_all(p: np.ndarray, a: np.ndarray, d: np.ndarray, dd: np.ndarray,
+                       chunk: int) -> np.ndarray:
+    """:func:`line_distance` over all pairs (few points or lines, or degenerate input)."""
     out = np.empty(len(p))
     for s in range(0, len(p), chunk):
         w = p[s:s + chunk, None, :] - a[None, :, :]            # (c, m, 3)
@@ -460,25 +525,39 @@ def surface_generator_distance(p: np.ndarray, ref: Reference, iters: int = 100
     _, idx = cKDTree(ref.grid.reshape(-1, 3)).query(p)
     u = ref.grid_u[idx // T].astype(float)
     lo, hi = float(ref.grid_u[0]), float(ref.grid_u[-1])
+    # A point whose step left its u unchanged is at a fixed point: every later step would
+    # start from the same u and compute the same step again.  So only the others are
+    # iterated (most points settle in a few steps, a few take many), with the same stop
+    # rule over all points: the u found are the same to the bit, for a fraction of the work.
+    moving = np.arange(len(p))
     for _ in range(iters):
-        a, b = surf.a(u), surf.b(u)
-        da, db = surf.rail_a.deriv(u), surf.rail_b.deriv(u)
+        um, pm = u[moving], p[moving]
+        a, da = _rail_value_deriv(surf.rail_a, um)
+        b, db = _rail_value_deriv(surf.rail_b, um)
         d = b - a
-        w = p - a
+        w = pm - a
         t = np.einsum("ij,ij->i", w, d) / np.einsum("ij,ij->i", d, d)
         r = w - t[:, None] * d
         jac = -(da + t[:, None] * (db - da))                     # dr/du with t held (envelope)
         jj = np.einsum("ij,ij->i", jac, jac)
         step = -np.einsum("ij,ij->i", r, jac) / np.where(jj > 0, jj, 1.0)
-        u_new = np.clip(u + step, lo, hi)
-        done = np.all(np.abs(u_new - u) <= 1e-15)
-        u = u_new
+        u_new = np.clip(um + step, lo, hi)
+        done = np.all(np.abs(u_new - um) <= 1e-15)
+        u[moving] = u_new
+        moving = moving[u_new != um]
         if done:
             break
     a, b = surf.a(u), surf.b(u)
     d = b - a
     t = np.einsum("ij,ij->i", p - a, d) / np.einsum("ij,ij->i", d, d)
     return _norm(p - a - t[:, None] * d), t, _norm(d)
+
+
+def _rail_value_deriv(rail: Any, u: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """``(rail.value(u), rail.deriv(u))``, through the rail's ``value_deriv`` where it has one
+    (a curve's rail evaluates its correspondence once there, with the same numbers)."""
+    both = getattr(rail, "value_deriv", None)
+    return both(u) if both is not None else (rail.value(u), rail.deriv(u))
 
 
 def quadric_distance(p: np.ndarray, ref: Reference) -> np.ndarray:
@@ -555,79 +634,102 @@ def _bisect_large(tris: np.ndarray, target: float, max_rounds: int = 24) -> np.n
     """Split triangles at the midpoint of their longest edge until each radius <= ``target``.
 
     The pieces cover exactly the same points, so distances are unchanged; the
-    search below only gets tighter bounding spheres.
+    search below only gets tighter bounding spheres.  Each round looks at the
+    pieces the round before made only: a piece small enough stays so.
     """
+    small = []
     for _ in range(max_rounds):
         cen = tris.mean(axis=1)
         big = _norm(tris - cen[:, None, :]).max(axis=1) > target
         if not big.any():
             break
+        small.append(tris[~big])
         t = tris[big]
         e = _norm(t[:, [1, 2, 0]] - t)                        # edge i: corner i -> i + 1
         k = e.argmax(axis=1)
         rows = np.arange(len(t))
         p0, p1, p2 = t[rows, k], t[rows, (k + 1) % 3], t[rows, (k + 2) % 3]
         mid = 0.5 * (p0 + p1)
-        halves = np.concatenate([np.stack([p0, mid, p2], 1), np.stack([mid, p1, p2], 1)])
-        tris = np.concatenate([tris[~big], halves])
-    return tris
+        tris = np.concatenate([np.stack([p0, mid, p2], 1), np.stack([mid, p1, p2], 1)])
+    return np.concatenate(small + [tris])
 
 
 def distance_to_mesh(p: np.ndarray, tris: np.ndarray) -> np.ndarray:
     """(n,) exact distance from points to the nearest of the triangles (n_t, 3, 3).
 
-    Large triangles are first bisected (same point set) to a few times the
-    median size or 1/64 of the extent, whichever is smaller; then an upper bound from the triangles with the nearest
-    centroids, then every triangle whose bounding sphere reaches within that
-    bound, by classes of triangle size (so a few long slivers do not widen
-    every query).
+    ``MeshDistance(tris)(p)``: to ask for several point sets, prepare the
+    triangles once with :class:`MeshDistance`.
     """
-    if len(tris) == 0:
-        return np.full(len(p), np.inf)
-    rad0 = _norm(tris - tris.mean(axis=1)[:, None, :]).max(axis=1)
-    flat = tris.reshape(-1, 3)
-    extent = float(_norm(flat.max(axis=0) - flat.min(axis=0)))
-    # Pieces of at most twice the median size and 1/64 of the extent: meshes of a few
-    # long strips (developable surfaces) otherwise make every triangle a candidate.
-    tris = _bisect_large(tris, min(2.0 * float(np.median(rad0)), extent / 64))
-    cen = tris.mean(axis=1)
-    rad = _norm(tris - cen[:, None, :]).max(axis=1)
-    tree = cKDTree(cen)
-    kk = min(4, len(tris))
-    _, near = tree.query(p, k=kk)
-    near = near.reshape(len(p), kk)
-    ub = np.full(len(p), np.inf)
-    for j in range(kk):
-        tr = tris[near[:, j]]
-        ub = np.minimum(ub, point_triangle_distance(p, tr[:, 0], tr[:, 1], tr[:, 2]))
-    best = ub.copy()
-    # Size classes a factor 4 apart; within one, the k nearest centroids, k growing only
-    # for the points whose k-th is still within reach.
-    cls = np.floor(np.log(np.maximum(rad, 1e-300) / max(rad.min(), 1e-300)) / np.log(4.0))
-    for c in np.unique(cls):
-        ids = np.flatnonzero(cls == c)
-        ctree = cKDTree(cen[ids])
-        rmax = rad[ids].max()
-        todo, k, seen = np.arange(len(p)), 8, 0
-        while todo.size:
-            kk = min(k, len(ids))
-            dist, nb = ctree.query(p[todo], k=kk)
-            dist, nb = dist.reshape(len(todo), kk)[:, seen:], nb.reshape(len(todo), kk)[:, seen:]
-            # The best distance so far bounds the answer: farther spheres cannot matter.
-            ok = dist <= (best[todo] * (1 + 1e-9) + rmax)[:, None]
-            counts = ok.sum(axis=1)
-            pi = np.repeat(todo, counts)
-            if pi.size:
-                tr = tris[ids[nb[ok]]]
-                d = point_triangle_distance(p[pi], tr[:, 0], tr[:, 1], tr[:, 2])
-                has = counts > 0                       # pairs come grouped by point
-                starts = (np.cumsum(counts) - counts)[has]
-                hit = todo[has]
-                best[hit] = np.minimum(best[hit], np.minimum.reduceat(d, starts))
-            if kk == len(ids):
-                break
-            todo, seen, k = todo[ok[:, -1]], kk, 4 * k
-    return best
+    return MeshDistance(tris)(p)
+
+
+class MeshDistance:
+    """Exact distances from points to the nearest of triangles (n_t, 3, 3), prepared once.
+
+    Large triangles are first bisected (same point set) to a few times the
+    median size or 1/64 of the extent, whichever is smaller; then an upper
+    bound from the triangles with the nearest centroids, then every triangle
+    whose bounding sphere reaches within that bound, by classes of triangle
+    size (so a few long slivers do not widen every query).  The bisection and
+    the centroid trees depend on the triangles only: :func:`max_gap` asks twice.
+    """
+
+    def __init__(self, tris: np.ndarray) -> None:
+        self.empty = len(tris) == 0
+        if self.empty:
+            return
+        rad0 = _norm(tris - tris.mean(axis=1)[:, None, :]).max(axis=1)
+        flat = tris.reshape(-1, 3)
+        extent = float(_norm(flat.max(axis=0) - flat.min(axis=0)))
+        # Pieces of at most twice the median size and 1/64 of the extent: meshes of a few
+        # long strips (developable surfaces) otherwise make every triangle a candidate.
+        self.tris = tris = _bisect_large(tris, min(2.0 * float(np.median(rad0)), extent / 64))
+        cen = tris.mean(axis=1)
+        rad = _norm(tris - cen[:, None, :]).max(axis=1)
+        self.tree = cKDTree(cen)
+        # Size classes a factor 4 apart, each with its own tree of centroids.
+        cls = np.floor(np.log(np.maximum(rad, 1e-300) / max(rad.min(), 1e-300)) / np.log(4.0))
+        self.classes = []
+        for c in np.unique(cls):
+            ids = np.flatnonzero(cls == c)
+            self.classes.append((ids, cKDTree(cen[ids]), rad[ids].max()))
+
+    def __call__(self, p: np.ndarray) -> np.ndarray:
+        """(n,) distance of each point ``p`` (n, 3) to the nearest triangle."""
+        if self.empty:
+            return np.full(len(p), np.inf)
+        tris = self.tris
+        kk = min(4, len(tris))
+        _, near = self.tree.query(p, k=kk)
+        near = near.reshape(len(p), kk)
+        ub = np.full(len(p), np.inf)
+        for j in range(kk):
+            tr = tris[near[:, j]]
+            ub = np.minimum(ub, point_triangle_distance(p, tr[:, 0], tr[:, 1], tr[:, 2]))
+        best = ub.copy()
+        # Within a class, the k nearest centroids, k growing only for the points whose k-th
+        # is still within reach.
+        for ids, ctree, rmax in self.classes:
+            todo, k, seen = np.arange(len(p)), 8, 0
+            while todo.size:
+                kk = min(k, len(ids))
+                dist, nb = ctree.query(p[todo], k=kk)
+                dist, nb = dist.reshape(len(todo), kk)[:, seen:], nb.reshape(len(todo), kk)[:, seen:]
+                # The best distance so far bounds the answer: farther spheres cannot matter.
+                ok = dist <= (best[todo] * (1 + 1e-9) + rmax)[:, None]
+                counts = ok.sum(axis=1)
+                pi = np.repeat(todo, counts)
+                if pi.size:
+                    tr = tris[ids[nb[ok]]]
+                    d = point_triangle_distance(p[pi], tr[:, 0], tr[:, 1], tr[:, 2])
+                    has = counts > 0                       # pairs come grouped by point
+                    starts = (np.cumsum(counts) - counts)[has]
+                    hit = todo[has]
+                    best[hit] = np.minimum(best[hit], np.minimum.reduceat(d, starts))
+                if kk == len(ids):
+                    break
+                todo, seen, k = todo[ok[:, -1]], kk, 4 * k
+        return best
 
 
 def patch_samples(ref: Reference, n_u: int = GAP_U) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
@@ -668,7 +770,8 @@ def max_gap(ref: Reference, tris: np.ndarray, worst: int = 12, fine: int = 12
     is found to a small fraction of the sample spacing.
     """
     pts, gen, tt = patch_samples(ref)
-    gap = distance_to_mesh(pts, tris)
+    to_mesh = MeshDistance(tris)
+    gap = to_mesh(pts)
     N = len(ref.grid)
     du = max(1, int(np.ceil((N - 1) / max(GAP_U - 1, 1))))
     dt = 1.0 / (GAP_T - 1)
@@ -679,7 +782,7 @@ def max_gap(ref: Reference, tris: np.ndarray, worst: int = 12, fine: int = 12
     t2 = np.clip(tt[top, None, None] + off_t[None, None, :], 0.0, 1.0)
     g2, t2 = np.broadcast_arrays(g2, t2)
     g2, t2 = g2.ravel(), t2.ravel()
-    gap2 = distance_to_mesh(_on_generators(ref, g2, t2), tris)
+    gap2 = to_mesh(_on_generators(ref, g2, t2))
     allg = np.concatenate([gap, gap2])
     k = int(np.argmax(allg))
     where_g = np.concatenate([gen, g2])[k]

@@ -221,9 +221,13 @@ def test_fabricate_standard_sheet_gcode_and_small_machine(built, tmp_path):
     if name != "millimetres":
         pytest.skip("the fabrication check runs on the millimetre design")
     out = tmp_path / "fab"
-    nesting = "true-shape" if _has_spyrrow() else "shelf"
+    # Shelf nesting: what is checked here (the units, the gap, the utilisation figures, the
+    # G-code) does not depend on the packer, and true-shape nesting took 31 solves of a second
+    # or more for its 26 sheets (37 of the test's 40 s).  True-shape layouts are checked panel
+    # by panel in tests/test_nesting.py, and through the CLI's default in test_api.py and the
+    # help examples.
     assert main(["fabricate", str(files["obj"]), "-o", str(out), "--sheet", "2500x1250",
-                 "--nesting", nesting, "--nest-time", "1", "--travel", "11000x6000", "-q"]) == 0
+                 "--nesting", "shelf", "--travel", "11000x6000", "-q"]) == 0
     summary = json.loads((out / "summary.json").read_text())
     assert summary["sheets"]["unit"] == "mm" and summary["sheets"]["gap"] == 3.0
     assert 0 < summary["sheets"]["utilisation"] <= summary["sheets"]["utilisation_trimmed"] < 1
@@ -238,8 +242,3 @@ def test_fabricate_standard_sheet_gcode_and_small_machine(built, tmp_path):
                  "--nesting", "shelf", "--travel", "1000x500"]) == 2
     assert not small.exists()
 
-
-def _has_spyrrow() -> bool:
-    from ruledmesh.fabricate.true_shape import available
-
-    return available()

@@ -220,39 +220,36 @@ def test_fuzz_hybrid_random_generators(gens, midpoints, divisions, flip):
 
 
 # --------------------------------------------- ruled designs from curves
-def curve_specs():
-    pts = st.lists(st.lists(coord, min_size=3, max_size=3), min_size=2, max_size=6)
-    return st.one_of(
-        st.fixed_dictionaries({"type": st.just("line"),
-                               "points": st.lists(st.lists(coord, min_size=3, max_size=3),
-                                                  min_size=2, max_size=2)}),
-        st.fixed_dictionaries({"type": st.just("polyline"), "points": pts}),
-        st.fixed_dictionaries({"type": st.just("bspline"), "points": pts,
-                               "degree": st.integers(1, 3)}),
-        st.fixed_dictionaries({"type": st.just("arc"),
-                               "points": st.lists(st.lists(coord, min_size=3, max_size=3),
-                                                  min_size=3, max_size=3)}),
-        st.fixed_dictionaries({"type": st.just("helix"), "center": st.lists(coord, min_size=3,
-                                                                           max_size=3),
-                               "axis": st.lists(coord, min_size=3, max_size=3),
-                               "radius": st.floats(0.1, 5), "pitch": st.floats(-3, 3),
-                               "turns": st.floats(0.1, 2)}),
-    )
+# The strategies are built once, here: built inside the composite, every draw made new
+# strategy objects, which Hypothesis validates and analyses on first use (about a third of
+# the test's time went to that). The same strategies draw the same designs.
+xyz = st.lists(coord, min_size=3, max_size=3)
+CURVE_SPECS = st.one_of(
+    st.fixed_dictionaries({"type": st.just("line"), "points": st.lists(xyz, min_size=2, max_size=2)}),
+    st.fixed_dictionaries({"type": st.just("polyline"), "points": st.lists(xyz, min_size=2, max_size=6)}),
+    st.fixed_dictionaries({"type": st.just("bspline"), "points": st.lists(xyz, min_size=2, max_size=6),
+                           "degree": st.integers(1, 3)}),
+    st.fixed_dictionaries({"type": st.just("arc"), "points": st.lists(xyz, min_size=3, max_size=3)}),
+    st.fixed_dictionaries({"type": st.just("helix"), "center": xyz, "axis": xyz,
+                           "radius": st.floats(0.1, 5), "pitch": st.floats(-3, 3),
+                           "turns": st.floats(0.1, 2)}),
+)
+DISTRIBUTIONS = st.sampled_from(["arc-length", "parameter", "director-plane", "linear-directrix",
+                                 None])
+DIRECTRIX = st.lists(xyz, min_size=2, max_size=2)
 
 
 @st.composite
 def ruled_designs(draw):
-    c1, c2 = draw(curve_specs()), draw(curve_specs())
+    c1, c2 = draw(CURVE_SPECS), draw(CURVE_SPECS)
     rulings = {"between": ["c1", "c2"], "count": draw(st.integers(3, 12))}
-    dist = draw(st.sampled_from(["arc-length", "parameter", "director-plane",
-                                 "linear-directrix", None]))
+    dist = draw(DISTRIBUTIONS)
     if dist is not None:
         rulings["distribution"] = dist
     if dist == "director-plane":
-        rulings["director_plane"] = draw(st.lists(coord, min_size=3, max_size=3))
+        rulings["director_plane"] = draw(xyz)
     if dist == "linear-directrix":
-        rulings["directrix"] = draw(st.lists(st.lists(coord, min_size=3, max_size=3),
-                                             min_size=2, max_size=2))
+        rulings["directrix"] = draw(DIRECTRIX)
     if draw(st.booleans()):
         mesh = {"method": "pq", "rows": draw(st.integers(1, 6)),
                 "option": draw(st.integers(0, 1)), "trim": True}

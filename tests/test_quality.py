@@ -268,6 +268,68 @@ def test_distance_to_mesh_is_exact():
     assert np.all(brute.min(axis=1) <= dense + 1e-12)
 
 
+def test_line_distance_by_cells_is_the_all_pairs_figure():
+    # The cells only choose which lines to measure: the distances are the all-pairs numbers,
+    # to the bit, for points on the lines, near them and anywhere, near the origin and far.
+    import numpy as np
+
+    rng = np.random.default_rng(3)
+    a = rng.normal(size=(40, 3)) * 3
+    b = a + rng.normal(size=(40, 3))
+    g = rng.integers(0, 40, 3000)
+    on = a[g] + rng.uniform(-1, 2, (3000, 1)) * (b[g] - a[g]) + rng.normal(size=(3000, 3)) * 1e-3
+    p = np.concatenate([on, rng.normal(size=(1000, 3)) * 5])
+    for shift in (0.0, 2.6e6):
+        pa, aa, bb = p + shift, a + shift, b + shift
+        d = bb - aa
+        every = quality._line_distance_all(pa, aa, d, np.einsum("ij,ij->i", d, d), 4096)
+        assert np.array_equal(quality.line_distance(pa, aa, bb, chunk=16), every)   # by cells
+        assert np.array_equal(quality.line_distance(pa, aa, bb), every)             # few: all pairs
+    # ... and they are the distances to the lines (|w x d| / |d|, another formula).
+    across = np.cross(p[:, None, :] - a, b - a) / np.linalg.norm(b - a, axis=1)[:, None]
+    assert np.allclose(quality.line_distance(p, a, b, chunk=16),
+                       np.linalg.norm(across, axis=2).min(axis=1), rtol=0, atol=1e-12)
+
+
+def test_generator_distance_iterates_the_moving_points_only():
+    # Points left where they were by a step are not stepped again: the u found, and so the
+    # distances, are those of stepping every point until all have stopped.
+    import numpy as np
+
+    ref = quality.reference_of(quality.SURFACES / "skew-bspline-51x30.toml")
+    surf = ref.surface
+    rng = np.random.default_rng(4)
+    u = rng.uniform(ref.grid_u[0], ref.grid_u[-1], 400)
+    off = rng.normal(size=(400, 3)) * 1e-3 * ref.diagonal
+    p = surf.point(u, rng.uniform(-0.1, 1.1, 400)) + off
+    dist, t, length = quality.surface_generator_distance(p, ref)
+    T = ref.grid.shape[1]
+    from scipy.spatial import cKDTree
+
+    w = ref.grid_u[cKDTree(ref.grid.reshape(-1, 3)).query(p)[1] // T].astype(float)
+    lo, hi = float(ref.grid_u[0]), float(ref.grid_u[-1])
+    for _ in range(100):
+        a, b = surf.a(w), surf.b(w)
+        da, db = surf.rail_a.deriv(w), surf.rail_b.deriv(w)
+        d = b - a
+        tt = np.einsum("ij,ij->i", p - a, d) / np.einsum("ij,ij->i", d, d)
+        r = p - a - tt[:, None] * d
+        jac = -(da + tt[:, None] * (db - da))
+        jj = np.einsum("ij,ij->i", jac, jac)
+        w_new = np.clip(w - np.einsum("ij,ij->i", r, jac) / np.where(jj > 0, jj, 1.0), lo, hi)
+        stop = np.all(np.abs(w_new - w) <= 1e-15)
+        w = w_new
+        if stop:
+            break
+    a, b = surf.a(w), surf.b(w)
+    d = b - a
+    tt = np.einsum("ij,ij->i", p - a, d) / np.einsum("ij,ij->i", d, d)
+    assert np.array_equal(dist, quality._norm(p - a - tt[:, None] * d))
+    assert np.array_equal(t, tt) and np.array_equal(length, quality._norm(d))
+    # Each point is off its own generator by its offset: the nearest one is no farther.
+    assert np.all(dist <= np.linalg.norm(off, axis=1) * (1 + 1e-9))
+
+
 def test_the_smooth_patch_itself_passes_and_a_hole_is_found(tmp_path):
     # A mesh made of the reference grid's own cells, coarsened: full coverage, on the
     # generators, no gap; the same mesh with one cell left out is caught by the gap.

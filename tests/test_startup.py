@@ -94,3 +94,56 @@ def test_small_build_loads_no_masked_arrays(tmp_path, example):
             f"assert main(['build', {str(EXAMPLES / (example + '.toml'))!r}, '-o', 'm.obj']) == 0")
     names = imported(code, tmp_path)
     assert _offenders(names, ("numpy.ma",)) == []
+
+
+QUALITY = Path(__file__).parents[1] / "benchmarks" / "quality"
+
+# numpy.ma replaced by a module that hands out the real one's attributes and notes who asked:
+# numpy's own functions ask it whether an array is masked (a plain np.unique, np.isin of many
+# values, np.median), so the first frame outside numpy is the code that called them.
+_ASKERS = """\
+import json, os, sys, traceback, types
+import numpy as np
+import numpy.ma as _real
+
+_asked = set()
+
+
+class _Recorder(types.ModuleType):
+    def __getattr__(self, name):
+        caller = [f for f in traceback.extract_stack()[:-1]
+                  if os.sep + "numpy" + os.sep not in f.filename][-1]
+        parts = caller.filename.split(os.sep)
+        # The innermost package folder of the caller's path (a checkout may sit in a folder
+        # named ruledmesh, with scipy installed below it); our own frames with their line.
+        unit = next((p for p in reversed(parts) if p in ("ruledmesh", "scipy", "numba")), None)
+        if unit == "ruledmesh":
+            where = parts[len(parts) - 1 - parts[::-1].index("ruledmesh"):]
+            unit = "/".join(where) + f":{caller.lineno}"
+        _asked.add(unit or caller.filename)
+        return getattr(_real, name)
+
+
+sys.modules["numpy.ma"] = np.ma = _Recorder("numpy.ma")
+"""
+
+
+@pytest.mark.parametrize("design", ["skew-bspline-b-51x30", "plucker-lines-tol1e-3"])
+def test_torsal_and_tolerance_builds_ask_nothing_of_masked_arrays(tmp_path, design):
+    """Builds with torsal pairs (skew-bspline-b) and in tolerance mode load numpy.ma all the same:
+    scipy's array-API layer imports it with the smooth surface's spline or the analysis' tree, and
+    numba's argument typing asks every array whether it is masked.  None of the asking is ours:
+    the builds' order statistics, unique values and memberships are ruledmesh._arrays'."""
+    code = (_ASKERS + "from ruledmesh.cli import main\n"
+            f"assert main(['build', {str(QUALITY / (design + '.toml'))!r}, '-o', 'm.obj', '-q']) == 0\n"
+            "np.unique(np.arange(3))  # asked from here: the recorder sees a plain np.unique\n"
+            "print('@@asked ' + json.dumps(sorted(_asked)))")
+    run = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, cwd=tmp_path,
+                         timeout=300, check=False)
+    assert run.returncode == 0, run.stderr[-2000:]
+    assert (tmp_path / "m.obj").is_file()
+    listed = [line for line in run.stdout.splitlines() if line.startswith("@@asked ")]
+    assert len(listed) == 1, run.stdout[-2000:]
+    asked = set(json.loads(listed[0].split(" ", 1)[1]))
+    assert "<string>" in asked, asked
+    assert sorted(asked - {"<string>", "scipy", "numba"}) == []
