@@ -182,7 +182,7 @@ def test_panel_of_a_face_chosen_among_other_faces_is_stale():
     moved = s.panel(f, key)
     assert moved["version"] == s.version and moved["row"]["label"] == f"P{f}"
     assert moved["outline"] != info["outline"]
-    s.edit([(["mesh", "rows"], 4)])  # fewer faces: f names none of them
+    s.edit([(["mesh", "rows"], 4), (["mesh", "refine"], False)])  # fewer faces: f names none
     now = topology_key(s.built.mesh)
     assert now != key and s.built.mesh.n_faces <= f
     assert s.panel(f, key) == {"version": s.version, "topology": now, "face": f, "stale": True}

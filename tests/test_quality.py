@@ -58,7 +58,6 @@ SHORT_OF_ANGLE: dict[str, str] = {}
 SHORT_OF_SHARE = {
     "plucker-lines-tol1e-3": "18.7% of the area in triangles",
     "skew-bspline-301x300": "17.9% of the area in triangles",
-    "skew-bspline-b-51x30": "25.7% of the area in triangles",
 }
 
 

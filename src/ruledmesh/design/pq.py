@@ -75,16 +75,23 @@ _TROUBLE_SHARE = 0.3
 # 13.2 % but with a splinter, and the small test design from three builds (68 ms) to five
 # (155 ms): so only while a goal is missed.
 _TROUBLE_SHARE_BROAD = 0.15
-# With a planarity tolerance the two shares are these: the rounds reach strips with less of
-# their area outside quads.  Measured with the take-back of splinters (_unsplintered): on 60
-# random two-B-spline surfaces at planarity_tolerance = 1e-3 the mean share in triangles
-# 8.5 -> 7.1 %, none above 10 % (2 before) and none with a splinter (1), for 12 % more faces;
-# building-offset 10.2 -> 6.0 %, the 17 tolerance-mode quality designs 6.4 -> 5.6 % on average
-# (skew-bspline-b-51x30 7.5 -> 8.0 %, the only one worse).  In exact mode the same shares took
-# the random surfaces from 16.6 to 14.7 % but two bundled examples got worse
-# (conoidal-director-plane 16.0 -> 20.5 %, skew 6.0 -> 6.9 %): exact mode keeps the ones above.
-_TROUBLE_SHARE_TOLERANCE = 0.15
-_TROUBLE_SHARE_BROAD_TOLERANCE = 0.08
+# Lower shares: the rounds reach strips with less of their area outside quads.  With a
+# planarity tolerance they are the only ones.  Measured with the take-back of splinters
+# (_unsplintered): on 60 random two-B-spline surfaces at planarity_tolerance = 1e-3 the mean
+# share in triangles 8.5 -> 7.1 %, none above 10 % (2 before) and none with a splinter (1),
+# for 12 % more faces; building-offset 10.2 -> 6.0 %, the 17 tolerance-mode quality designs
+# 6.4 -> 5.6 % on average (skew-bspline-b-51x30 7.5 -> 8.0 %, the only one worse).  In exact
+# mode alone they took the random surfaces from 16.6 to 14.7 % but two bundled examples got
+# worse (conoidal-director-plane 16.0 -> 20.5 %, skew 6.0 -> 6.9 %), so there they are a second
+# chance: their rounds run as well, where the mesh kept so far has more than
+# _TYPICAL_TRIANGLES of its area in triangles, and the better mesh is kept (random surfaces
+# 16.6 -> 14.7 %, 39 of 60 above 12 % instead of 54, 10 % more faces, about twice the build
+# time of those surfaces; skew-bspline-b-51x30 25.7 -> 22.0 %, skew-bspline-51x30 21.5 ->
+# 17.9 %, no design worse).
+_TROUBLE_SHARE_LOW = 0.15
+_TROUBLE_SHARE_BROAD_LOW = 0.08
+# The share of the area in triangles a general skew surface should typically stay within.
+_TYPICAL_TRIANGLES = 0.12
 # A torsal band reaches over the strips with more than this share outside quads (.torsal).
 _TROUBLE_SHARE_SPAN = 0.5
 _BROAD_ROUNDS = 1
@@ -161,29 +168,59 @@ def _refined(rulings, mesh, options: dict):
 
 
 def _candidates(rulings, mesh, options: dict, grid: np.ndarray, user: int, goal: float) -> list[tuple]:
-    """The rounds from ``rulings`` and its ``mesh``, and those from its torsal bands spanned."""
+    """The rounds from ``rulings`` and its ``mesh``, and those from its torsal bands spanned.
+
+    In exact mode at the shares :data:`_TROUBLE_SHARE` and :data:`_TROUBLE_SHARE_BROAD`, and
+    also at the lower ones where the best mesh of those has more than
+    :data:`_TYPICAL_TRIANGLES` of its area in triangles; with a planarity tolerance at the
+    lower ones only.
+    """
     measured = _measured(mesh)
-    rounds = _rounds(rulings, mesh, measured, options, grid, user, goal)
+    starts = [(rulings, mesh, measured, ())]
     spanned = _spanned(rulings, mesh, measured[1], options)
     if spanned is not None:
         sp_rulings, sp_mesh, sp_pairs = spanned
-        rounds += _rounds(sp_rulings, sp_mesh, _measured(sp_mesh), options, grid, user, goal, sp_pairs)
+        starts.append((sp_rulings, sp_mesh, _measured(sp_mesh), sp_pairs))
+    low = (_TROUBLE_SHARE_LOW, _TROUBLE_SHARE_BROAD_LOW)
+    tiers = [low] if options["planarity_tolerance"] > DEFAULT.planarity \
+        else [(_TROUBLE_SHARE, _TROUBLE_SHARE_BROAD), low]
+    rounds: list[tuple] = []
+    for shares in tiers:
+        best = max(rounds, key=lambda r: _fabricable(r, goal)) if rounds else None
+        if best is not None and 1.0 - best[0] <= _TYPICAL_TRIANGLES:
+            break
+        more = [r for start_rulings, start_mesh, start_measured, pairs in starts
+                for r in _rounds(start_rulings, start_mesh, start_measured, options, grid, user, goal,
+                                 shares, pairs)]
+        if best is None or _pays(max(more, key=lambda r: _fabricable(r, goal)), best, goal):
+            rounds += more
     return rounds
 
 
+def _pays(better: tuple, best: tuple, goal: float) -> bool:
+    """Whether the rounds at the lower shares, whose best mesh is ``better``, are worth their
+    panels against ``best``: more goals met, or half a point more of the area in quads for
+    every tenth more generators (as a broad round in :func:`_rounds`)."""
+    gained, kept = _fabricable(better, goal), _fabricable(best, goal)
+    if gained[0] != kept[0]:
+        return gained[0] > kept[0]
+    need = _MIN_GAIN * max(1.0, 10.0 * (len(better[3].u) / len(best[3].u) - 1.0))
+    return better[0] >= best[0] + need
+
+
 def _rounds(rulings, mesh, measured: tuple[float, np.ndarray], options: dict, grid: np.ndarray,
-            user: int, goal: float, pairs: tuple = ()) -> list[tuple]:
+            user: int, goal: float, shares: tuple[float, float], pairs: tuple = ()) -> list[tuple]:
     """The meshes of the refinement rounds from ``rulings`` and its ``mesh``, the first included.
 
     Each is ``(quad share, splinters, their cost, rulings, mesh, pairs)`` (the cost: see
-    :func:`_splinters`); ``measured`` is the
-    quad share and (F,) face areas of ``mesh``, ``pairs`` what :func:`_spanned` made of
-    ``rulings`` (empty if nothing).
+    :func:`_splinters`); ``measured`` is the quad share and (F,) face areas of ``mesh``,
+    ``shares`` the share of a strip's area outside quads that asks for a generator in the
+    first rounds and in the broad one, ``pairs`` what :func:`_spanned` made of ``rulings``
+    (empty if nothing).
     """
     cur = (*measured, rulings, mesh)
     rounds = [(cur[0], *_splinters(mesh), rulings, mesh, pairs)]
-    first, broader = (_TROUBLE_SHARE_TOLERANCE, _TROUBLE_SHARE_BROAD_TOLERANCE) \
-        if options["planarity_tolerance"] > DEFAULT.planarity else (_TROUBLE_SHARE, _TROUBLE_SHARE_BROAD)
+    first, broader = shares
     bars = [first] * _REFINE_ROUNDS + [broader] * _BROAD_ROUNDS
     k = 0
     while k < len(bars):
