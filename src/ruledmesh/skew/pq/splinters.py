@@ -29,7 +29,13 @@ import numpy as np
 from ..._arrays import diagonal, unique
 from ...analysis.faces import face_min_angles, face_normals
 from ...mesh import FaceKind, Mesh
-from ...tolerances import BORDER_TRIM_MAX_GAP, ON_BORDER, RESTART_ANGLE_DEG, SPLINTER_AREA_WORTH
+from ...tolerances import (
+    BORDER_TRIM_MAX_GAP,
+    ON_BORDER,
+    RESTART_ANGLE_DEG,
+    SNAP_MIN_GAIN_DEG,
+    SPLINTER_AREA_WORTH,
+)
 from .collapses import _apply, _border_vertices, _near, _rejoined, _rings, _segment_distance, _touching
 from .pairing import _rebuilt
 
@@ -110,7 +116,7 @@ def snap_to_border(mesh: Mesh) -> tuple[Mesh, int]:
     # once some are left out the rest are measured again, until every one left gains.
     while v.size:
         _, gain = _snapped(_near(mesh, np.concatenate([v, b])), v, b)
-        keep = gain > 0
+        keep = gain > SNAP_MIN_GAIN_DEG
         if keep.all():
             break
         v, b = v[keep], b[keep]
