@@ -84,10 +84,11 @@ _TROUBLE_SHARE_BROAD = 0.15
 # mode alone they took the random surfaces from 16.6 to 14.7 % but two bundled examples got
 # worse (conoidal-director-plane 16.0 -> 20.5 %, skew 6.0 -> 6.9 %), so there they are a second
 # chance: their rounds run as well, where the mesh kept so far has more than
-# _TYPICAL_TRIANGLES of its area in triangles, and the better mesh is kept (random surfaces
-# 16.6 -> 14.7 %, 39 of 60 above 12 % instead of 54, 10 % more faces, about twice the build
-# time of those surfaces; skew-bspline-b-51x30 25.7 -> 22.0 %, skew-bspline-51x30 21.5 ->
-# 17.9 %, no design worse).
+# _TYPICAL_TRIANGLES of its area in triangles, from the generators (given or spanned) of the
+# best mesh so far, and their best is kept where it pays (_pays).  Random surfaces 16.6 ->
+# 14.9 %, 42 of 60 above 12 % instead of 54, 11 % more faces, twice the build time of the 60
+# (10.9 -> 21.4 s, load 1.1; from both starts it was 14.9 % in 31 s); skew-bspline-b-51x30
+# 25.7 -> 22.0 %, skew-bspline-51x30 21.5 -> 17.9 %, no bundled or quality design worse.
 _TROUBLE_SHARE_LOW = 0.15
 _TROUBLE_SHARE_BROAD_LOW = 0.08
 # The share of the area in triangles a general skew surface should typically stay within.
@@ -189,7 +190,9 @@ def _candidates(rulings, mesh, options: dict, grid: np.ndarray, user: int, goal:
         best = max(rounds, key=lambda r: _fabricable(r, goal)) if rounds else None
         if best is not None and 1.0 - best[0] <= _TYPICAL_TRIANGLES:
             break
-        more = [r for start_rulings, start_mesh, start_measured, pairs in starts
+        # After the first tier, from the start (given or spanned generators) of its best only.
+        from_ = starts if best is None else [s for s in starts if s[3] == best[5]] or starts
+        more = [r for start_rulings, start_mesh, start_measured, pairs in from_
                 for r in _rounds(start_rulings, start_mesh, start_measured, options, grid, user, goal,
                                  shares, pairs)]
         if best is None or _pays(max(more, key=lambda r: _fabricable(r, goal)), best, goal):
