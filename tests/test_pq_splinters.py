@@ -67,7 +67,10 @@ def check(name, before, after, n):
     assert _point_keys(after.vertices) <= _point_keys(before.vertices)
     _quads_sound(after)
     assert _splinters(after) <= _splinters(before)
-    assert face_min_angles(after).min() >= face_min_angles(before).min() - 1e-9
+    # The opening keeps a piece with fewer splinters even where one of them got thinner
+    # (splinters.open_walled_splinters); the other passes never make the thinnest face thinner.
+    if name != "open_walled_splinters" or _splinters(after) == _splinters(before):
+        assert face_min_angles(after).min() >= face_min_angles(before).min() - 1e-9
     assert _manifold(after) <= _manifold(before)
     _, a0 = face_normals(before)
     _, a1 = face_normals(after)
