@@ -207,8 +207,14 @@ def _pays(better: tuple, best: tuple, goal: float) -> bool:
     gained, kept = _fabricable(better, goal), _fabricable(best, goal)
     if gained[0] != kept[0]:
         return gained[0] > kept[0]
-    need = _MIN_GAIN * max(1.0, 10.0 * (len(better[3].u) / len(best[3].u) - 1.0))
-    return better[0] >= best[0] + need
+    return better[0] >= best[0] + _price(len(better[3].u), len(best[3].u))
+
+
+def _price(more: int, fewer: int) -> float:
+    """The quad area share a mesh of ``more`` generators must gain over one of ``fewer`` to
+    pay for its panels: half a point (:data:`_MIN_GAIN`) per tenth more generators, at
+    least half a point."""
+    return _MIN_GAIN * max(1.0, 10.0 * (more / fewer - 1.0))
 
 
 def _rounds(rulings, mesh, measured: tuple[float, np.ndarray], options: dict, grid: np.ndarray,
@@ -247,9 +253,9 @@ def _rounds(rulings, mesh, measured: tuple[float, np.ndarray], options: dict, gr
                 # One more mesh to choose from; the rounds go on from the round's own, whose
                 # later rounds may lose their splinters anyway.
                 rounds.append((_measured(taken[1])[0], *_splinters(taken[1]), *taken, pairs))
-        # A broad round pays for its panels: half a point per tenth more generators.
-        need = _MIN_GAIN * max(1.0, 10.0 * (len(candidate.u) / len(cur_rulings.u) - 1.0)) \
-            if broad and candidate is not None else _MIN_GAIN
+        # A broad round pays for its panels (see _price).
+        need = _price(len(candidate.u), len(cur_rulings.u)) if broad and candidate is not None \
+            else _MIN_GAIN
         if cand is None or cand[0] <= share + need:
             # Nothing to add or no gain at this share: on with the broader one, if any.
             k = next((i for i in range(k + 1, len(bars)) if bars[i] < bars[k]), len(bars))
@@ -338,9 +344,7 @@ def _unsplintered(candidate, mesh, given_u: np.ndarray, options: dict):
         if bad.size == 0:
             break
         u = np.asarray(candidate.u)
-        gen = np.asarray(mesh.vertex_data["generator"])[mesh.face_indices]
-        first = np.minimum.reduceat(gen, mesh.face_offsets[:-1])[bad]
-        last = np.maximum.reduceat(gen, mesh.face_offsets[:-1])[bad]
+        first, last = (g[bad] for g in _generator_span(mesh))
         # Generators within reach of a splinter: +1 where a reach starts, -1 past its end.
         step = np.zeros(len(u) + 1, np.int64)
         np.add.at(step, np.maximum(first - _TAKE_BACK_STRIPS, 0), 1)
@@ -416,12 +420,9 @@ def _trouble_strips(mesh, m: int, area: np.ndarray, share: float = _TROUBLE_SHAR
 
     ``area`` : (F,) the face areas of ``mesh``.
     """
-    gen = np.asarray(mesh.vertex_data["generator"])
     if mesh.n_faces == 0 or m < 2:
         return np.zeros(0, np.int64)
-    g = gen[mesh.face_indices]
-    g0 = np.minimum.reduceat(g, mesh.face_offsets[:-1])
-    g1 = np.maximum.reduceat(g, mesh.face_offsets[:-1])
+    g0, g1 = _generator_span(mesh)
     span = np.maximum(g1 - g0, 1)
     off = mesh.valences != 4
     # Faces span one or two strips: each adds its share to the strips it spans, in the
@@ -433,3 +434,9 @@ def _trouble_strips(mesh, m: int, area: np.ndarray, share: float = _TROUBLE_SHAR
     total = np.bincount(s, weights=w, minlength=m - 1)
     other = np.bincount(s, weights=np.where(off[sel], w, 0.0), minlength=m - 1)
     return np.flatnonzero(other > share * np.maximum(total, TINY))
+
+
+def _generator_span(mesh) -> tuple[np.ndarray, np.ndarray]:
+    """(F,) the lowest and (F,) the highest generator index among each face's corners."""
+    g = np.asarray(mesh.vertex_data["generator"])[mesh.face_indices]
+    return np.minimum.reduceat(g, mesh.face_offsets[:-1]), np.maximum.reduceat(g, mesh.face_offsets[:-1])
