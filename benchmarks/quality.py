@@ -496,10 +496,8 @@ def _line_distance_all(p: np.ndarray, a: np.ndarray, d: np.ndarray, dd: np.ndarr
     """:func:`line_distance` over all pairs (few points or lines, or degenerate input)."""
     out = np.empty(len(p))
     for s in range(0, len(p), chunk):
-        w = p[s:s + chunk, None, :] - a[None, :, :]            # (c, m, 3)
-        tt = np.einsum("cmi,mi->cm", w, d) / dd
-        r = w - tt[..., None] * d
-        out[s:s + chunk] = np.sqrt(np.einsum("cmi,cmi->cm", r, r).min(axis=1))
+        # The square root is monotone: the nearest of the roots is the root of the nearest.
+        out[s:s + chunk] = _line_distance_table(p[s:s + chunk], a, d, dd, chunk).min(axis=1)
     return out
 
 
