@@ -12,8 +12,8 @@ from ruledmesh.analysis.faces import face_min_angles, planarity
 from ruledmesh.design import build_design, build_file, parse_design
 from ruledmesh.mesh import FaceKind, Mesh
 from ruledmesh.pq import pq_mesh
-from ruledmesh.skew.pq.flips import flip_triangles
-from ruledmesh.tolerances import RESTART_ANGLE_DEG
+from ruledmesh.skew.pq.flips import flip_splinters, flip_triangles
+from ruledmesh.tolerances import RESTART_ANGLE_DEG, SPLINTER_FLIP_MAX_SAG
 
 ROOT = Path(__file__).resolve().parents[1]
 
@@ -83,6 +83,42 @@ def test_flips_do_not_cut_across_a_ridge():
     mesh = Mesh.from_faces(V, [[0, 1, 2], [1, 0, 3]], face_kind=np.full(2, FaceKind.FILL, np.uint8))
     _, n = flip_triangles(mesh)
     assert n == 0
+
+
+def _bent_sliver(lift: float, generators=(0, 2, 1, 1)) -> Mesh:
+    """A sliver ``(B, C, A)`` (2.4 degrees) whose far corner is lifted by ``lift`` out of the
+    plane of its fat neighbour ``(C, B, D)``: for a small sliver, 45 degrees of bend."""
+    V = np.array([[0.1, 0.003, lift], [0.0, 0.0, 0.0], [0.2, 0.0, 0.0], [0.1, -0.2, 0.0]])
+    return Mesh.from_faces(V, [[1, 2, 0], [2, 1, 3]], face_kind=np.full(2, FaceKind.FILL, np.uint8),
+                           vertex_data={"generator": np.asarray(generators)})
+
+
+def test_a_sliver_bent_against_its_neighbour_is_flipped_by_flip_splinters_only():
+    """The linear-directrix example kept a 2.99 degree triangle this way: the flip rounds
+    refuse a pair bent by more than FLIP_MAX_BEND_DEG, and a sliver's normal says little."""
+    mesh = _bent_sliver(0.003)
+    assert flip_triangles(mesh)[1] == 0
+    flipped, n = flip_splinters(mesh, scale=10.0)
+    assert n == 1
+    assert face_min_angles(mesh).min() < 3.0 < face_min_angles(flipped).min()
+    assert np.array_equal(flipped.vertices, mesh.vertices)
+    assert set(map(tuple, np.sort(flipped.face_indices.reshape(-1, 3), axis=1))) == {(0, 1, 3), (0, 2, 3)}
+    assert (flipped.face_kind == FaceKind.FILL).all()
+
+
+def test_flip_splinters_keeps_ridges_generator_segments_and_the_sag_bound():
+    # The same sliver on a mesh whose diagonal is the sliver's own: the new diagonal lies
+    # 3e-3 from the old one, more than SPLINTER_FLIP_MAX_SAG of it.
+    assert SPLINTER_FLIP_MAX_SAG < 0.003 / 0.3
+    assert flip_splinters(_bent_sliver(0.003))[1] == 0
+    # Along a generator (B and C on generator 0): the member stays an edge.
+    assert flip_splinters(_bent_sliver(0.003, (1, 0, 0, 2)), scale=10.0)[1] == 0
+    # Two slivers folded at 90 degrees: no flip cuts the ridge off.
+    V = np.array([[0.0, 0.0, 0.0], [10.0, 0.0, 0.0], [5.0, 0.2, 0.0], [5.0, 0.0, 0.2]])
+    ridge = Mesh.from_faces(V, [[0, 1, 2], [1, 0, 3]], face_kind=np.full(2, FaceKind.FILL, np.uint8),
+                            vertex_data={"generator": np.array([0, 1, 2, 3])})
+    assert face_min_angles(ridge).max() < 3.0
+    assert flip_splinters(ridge, scale=1e6)[1] == 0
 
 
 @settings(max_examples=40, deadline=None)

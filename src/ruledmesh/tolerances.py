@@ -29,7 +29,7 @@ __all__ = ["BORDER_TRIM_MAX_GAP", "BRENTQ_XTOL", "COLLINEAR", "COLLINEAR_SQ", "C
            "MIN_EXTENT", "MIN_HALF_ANGLE", "MIN_RELATIVE_EXTENT", "MITRE_FLOOR", "NEARLY_DEVELOPABLE", "OCCT_FACE",
            "ON_BORDER", "PARAMETER_SLACK", "PLANARITY_FLOOR", "RESTART_ANGLE_DEG", "ROOT_RTOL", "ROOT_XTOL",
            "ROUNDING", "ROUNDING_SQ", "SAME_ROOT", "SETTLED", "SNAP_GAP", "SNAP_MIN_GAIN_DEG",
-           "SPLINTER_AREA_WORTH", "TINY",
+           "SPLINTER_AREA_WORTH", "SPLINTER_FLIP_MAX_SAG", "TINY",
            "ULPS", "Tolerances"]
 
 
@@ -186,6 +186,10 @@ FLIP_MAX_BEND_DEG = 20.0
 #: The new diagonal may lie at most this share of the patch diagonal off the old pair, so
 #: the mesh keeps to the surface (the gap goal is 2e-3).
 FLIP_MAX_SAG = 2.5e-4
+#: A splinter left by the flips may still be flipped (ruledmesh.skew.pq.flips.flip_splinters)
+#: where the two diagonals lie at most this share of the patch diagonal apart: a quarter of
+#: the gap goal (2e-3), and only where the mesh had a splinter.
+SPLINTER_FLIP_MAX_SAG = 5e-4
 # Only triangles with an angle below this (and their neighbours) are worth flipping.
 FLIP_ACTIVE_DEG = 20.0
 #: A triangle-only vertex collapsed into a neighbour (ruledmesh.skew.pq.collapses) may lie

@@ -22,10 +22,17 @@ from ..._arrays import cross, diagonal, unique
 from ...analysis.faces import min_corner_angles
 from ...kernels import wanted
 from ...mesh import FaceKind, Mesh
-from ...tolerances import FLIP_ACTIVE_DEG, FLIP_MAX_BEND_DEG, FLIP_MAX_SAG, FLIP_MIN_GAIN_DEG, TINY
+from ...tolerances import (
+    FLIP_ACTIVE_DEG,
+    FLIP_MAX_BEND_DEG,
+    FLIP_MAX_SAG,
+    FLIP_MIN_GAIN_DEG,
+    SPLINTER_FLIP_MAX_SAG,
+    TINY,
+)
 from .pairing import _adjacent
 
-__all__ = ["flip_triangles"]
+__all__ = ["flip_splinters", "flip_triangles"]
 
 _ROUNDS = 40
 
@@ -149,15 +156,7 @@ def _round(V: np.ndarray, tri: np.ndarray, tmin: np.ndarray, fixed: np.ndarray, 
     cand = np.flatnonzero(ok)
     if cand.size == 0:
         return done
-    gain = new - old
-    best = np.full(len(tri), -np.inf)
-    np.maximum.at(best, t1[cand], gain[cand])
-    np.maximum.at(best, t2[cand], gain[cand])
-    top = cand[(gain[cand] >= best[t1[cand]]) & (gain[cand] >= best[t2[cand]])]
-    first = np.full(len(tri), len(t1))
-    np.minimum.at(first, t1[top], top)
-    np.minimum.at(first, t2[top], top)
-    take = top[(first[t1[top]] == top) & (first[t2[top]] == top)]
+    take = cand[_mutual_best(t1[cand], t2[cand], (new - old)[cand], len(tri))]
     # Two flips of one round making the same diagonal: keep the first.
     _, keep = np.unique(new_key[take], return_index=True)
     take = take[keep]
@@ -212,6 +211,31 @@ def _restricted(adjacency: tuple, live: np.ndarray) -> tuple | None:
     keep = np.flatnonzero(live[t1] & live[t2])
     rank = np.cumsum(live) - 1
     return rank[t1[keep]], rank[t2[keep]], a[keep], b[keep], c[keep], d[keep], keys
+
+
+def _mutual_best(t1: np.ndarray, t2: np.ndarray, gain: np.ndarray, n: int) -> np.ndarray:
+    """The pairs (indices into ``t1``, ``t2``) both of whose ``n`` triangles name them their
+    best flip by ``gain``, ties to the first pair: no triangle is in two flips taken."""
+    best = np.full(n, -np.inf)
+    np.maximum.at(best, t1, gain)
+    np.maximum.at(best, t2, gain)
+    top = np.flatnonzero((gain >= best[t1]) & (gain >= best[t2]))
+    first = np.full(n, len(t1))
+    np.minimum.at(first, t1[top], top)
+    np.minimum.at(first, t2[top], top)
+    return top[(first[t1[top]] == top) & (first[t2[top]] == top)]
+
+
+def _retriangulated(mesh: Mesh, ids: np.ndarray, tri: np.ndarray, before: np.ndarray) -> Mesh:
+    """``mesh`` with its triangles ``ids`` now ``tri`` (were ``before``); those that changed
+    are of kind :attr:`FaceKind.FILL` (no longer halves of a quad)."""
+    changed = (tri != before).any(axis=1)
+    kind = mesh.face_kind.copy()
+    kind[ids[changed]] = FaceKind.FILL
+    idx = mesh.face_indices.copy()
+    idx[mesh.face_offsets[ids][:, None] + np.arange(3)] = tri
+    return Mesh(mesh.vertices, mesh.face_offsets, idx, kind, mesh.members, mesh.member_id,
+                mesh.vertex_data, mesh.info)
 
 
 def flip_triangles(mesh: Mesh, changeable: np.ndarray | None = None,
@@ -269,11 +293,90 @@ def flip_triangles(mesh: Mesh, changeable: np.ndarray | None = None,
             break
     if flips == 0:
         return mesh, 0
-    changed = (tri != before).any(axis=1)
-    sel = ids[live]
-    kind = mesh.face_kind.copy()
-    kind[sel[changed]] = FaceKind.FILL
-    idx = mesh.face_indices.copy()
-    idx[mesh.face_offsets[sel][:, None] + np.arange(3)] = tri
-    return Mesh(V, mesh.face_offsets, idx, kind, mesh.members, mesh.member_id, mesh.vertex_data,
-                mesh.info), flips
+    return _retriangulated(mesh, ids[live], tri, before), flips
+
+
+def _splinter_pairs(V: np.ndarray, tri: np.ndarray, tmin: np.ndarray, on_generator: np.ndarray,
+                    fixed: np.ndarray, scale: float) -> tuple[np.ndarray, ...]:
+    """The flips a splinter may take: (k,) first and second triangle, (k,) corners ``a, b, c, d``
+    as in :func:`_pair_measures`, (k,) angle gained.
+
+    Pairs of :func:`.pairing._adjacent` with a splinter among the two whose flip
+    makes the pair's smaller smallest angle larger and keeps it flat and on the
+    side of the fatter old triangle, moving the surface by at most
+    :data:`SPLINTER_FLIP_MAX_SAG` of ``scale`` (the distance of the two diagonals);
+    the edge given up is no generator segment (``on_generator`` (V,) int: the
+    generator of each vertex) and the new one no edge of ``fixed``.
+    """
+    from ...analysis.faces import SPLINTER_DEG
+
+    n = len(V)
+    t1, t2, a, b, c, d, keys = _adjacent(tri, n)
+    old = np.minimum(tmin[t1], tmin[t2])
+    sel = np.flatnonzero((old < SPLINTER_DEG) & (a != d) & (on_generator[b] != on_generator[c]))
+    t1, t2, a, b, c, d, old = t1[sel], t2[sel], a[sel], b[sel], c[sel], d[sel], old[sel]
+    A, B, C, D = V[a], V[b], V[c], V[d]
+    new = np.minimum(_angles(np.stack([A, B, D], 1)), _angles(np.stack([A, D, C], 1)))
+    # A splinter's own normal says little (its corners nearly lie on a line): the
+    # flipped pair is held to the fatter old triangle's.
+    fat = np.where((tmin[t1] >= tmin[t2])[:, None], _unit_normals(A, B, C), _unit_normals(B, D, C))
+    m1, m2 = _unit_normals(A, B, D), _unit_normals(A, D, C)
+    bend = np.cos(np.radians(FLIP_MAX_BEND_DEG))
+    across = cross(D - A, C - B)
+    height = np.abs(np.einsum("ij,ij->i", B - A, across)) / np.maximum(np.linalg.norm(across, axis=1), TINY)
+    new_key = np.minimum(a, d) * n + np.maximum(a, d)
+    ok = (new > old + FLIP_MIN_GAIN_DEG) & (np.einsum("ij,ij->i", m1, m2) >= bend) \
+        & (np.einsum("ij,ij->i", m1, fat) >= bend) & (np.einsum("ij,ij->i", m2, fat) >= bend) \
+        & (height <= SPLINTER_FLIP_MAX_SAG * scale) \
+        & ~_member(new_key, fixed) & ~_member(np.minimum(a, d) * (n + 1) + np.maximum(a, d), keys)
+    return t1[ok], t2[ok], a[ok], b[ok], c[ok], d[ok], (new - old)[ok]
+
+
+def flip_splinters(mesh: Mesh, scale: float | None = None) -> tuple[Mesh, int]:
+    """Flip the edges of the triangular splinters :func:`flip_triangles` leaves.
+
+    Those rounds keep every pair within :data:`FLIP_MAX_BEND_DEG` before the
+    flip; a splinter's normal is ill-defined, so a splinter bent against its
+    neighbour stays.  Here a pair with a splinter is flipped where the new pair
+    is flat and faces as the fatter old triangle does, and the two diagonals lie
+    within :data:`SPLINTER_FLIP_MAX_SAG` of ``scale`` (default: the mesh's
+    diagonal): the mesh moves that little, and only where it had a splinter.
+
+    Returns the mesh (flipped triangles of kind :attr:`FaceKind.FILL`) and the
+    number of flips.
+    """
+    from ...analysis.faces import SPLINTER_DEG
+
+    val = mesh.valences
+    ids = np.flatnonzero(val == 3)
+    if ids.size < 2:
+        return mesh, 0
+    V = mesh.vertices
+    tri_all = mesh.face_indices[mesh.face_offsets[ids][:, None] + np.arange(3)].astype(np.int64)
+    ang = min_corner_angles(V, tri_all)
+    if not (ang < SPLINTER_DEG).any():
+        return mesh, 0
+    scale = scale or diagonal(V) or 1.0
+    # The triangles a few steps from a splinter take part; the others' edges stay.
+    live = _around(tri_all, len(V), ang < SPLINTER_DEG, 3)
+    ids, tri, tmin = ids[live], tri_all[live], ang[live]
+    others = [tri_all[~live]] + [mesh.face_indices[mesh.face_offsets[f][:, None] + np.arange(k)]
+                                 for k in unique(val[val != 3]).tolist() for f in [np.flatnonzero(val == k)]]
+    fixed = _edge_keys(others, len(V))
+    on_generator = np.asarray(mesh.vertex_data["generator"])
+    before = tri.copy()
+    flips = 0
+    for _ in range(_ROUNDS):
+        t1, t2, a, b, c, d, gain = _splinter_pairs(V, tri, tmin, on_generator, fixed, scale)
+        if t1.size == 0:
+            break
+        take = _mutual_best(t1, t2, gain, len(tri))
+        a, b, c, d = a[take], b[take], c[take], d[take]
+        tri[t1[take]] = np.stack([a, b, d], axis=1)
+        tri[t2[take]] = np.stack([a, d, c], axis=1)
+        done = np.r_[t1[take], t2[take]]
+        tmin[done] = min_corner_angles(V, tri[done])
+        flips += take.size
+    if flips == 0:
+        return mesh, 0
+    return _retriangulated(mesh, ids, tri, before), flips

@@ -15,7 +15,7 @@ from ...normalise import normalised
 from ...tolerances import DEFAULT, NEARLY_DEVELOPABLE, PARAMETER_SLACK, Tolerances
 from .assemble import assemble
 from .collapses import _border_vertices, _touching, collapse_splinters
-from .flips import flip_triangles
+from .flips import flip_splinters, flip_triangles
 from .maps import HopMaps, hop_maps
 from .pairing import pair_triangles
 from .panels import split_strip_quads
@@ -414,6 +414,8 @@ def _fattened(mesh: Mesh, ptol: float, tol: Tolerances) -> tuple[Mesh, dict[str,
     if opened:
         mesh, more = _paired(mesh, ptol, tol)
         paired += more
+    mesh, more = flip_splinters(mesh)
+    flips += more
     mesh, cut = split_strip_quads(mesh)
     return mesh, {"flips": flips, "collapsed": collapsed, "paired": paired, "snapped": snapped,
                   "trimmed": trimmed, "opened": opened, "cut": cut}, (measured if mesh is before else None)
