@@ -216,21 +216,17 @@ def _worth_its_panels(best: tuple, rounds: list[tuple], goal: float) -> tuple:
     """``best``, or the best of the meshes with fewer generators that meet the same goals, cost
     no more in splinters and against which ``best`` does not pay for its panels (:func:`_price`).
 
-    Beyond the typical share in triangles (:data:`_TYPICAL_TRIANGLES`, or the goal if that is
-    lower) the rounds add generators to get there, so a mesh that stays above it is preferred
-    only where ``best`` pays not even :data:`_PRICE_ABOVE_TYPICAL` of its price.
+    Beyond the typical share in triangles (:func:`_typical`) the rounds add generators to get
+    there, so a mesh that stays above it is preferred only where ``best`` pays not even
+    :data:`_PRICE_ABOVE_TYPICAL` of its price.
     """
-    def met(r: tuple) -> tuple[bool, bool]:
-        return r[1] == 0, 1.0 - r[0] <= goal
-
-    typical = min(goal, _TYPICAL_TRIANGLES)
-
     def price(r: tuple) -> float:
         full = _price(len(best[3].u), len(r[3].u))
-        return full if 1.0 - r[0] <= typical else _PRICE_ABOVE_TYPICAL * full
+        return full if 1.0 - r[0] <= _typical(goal) else _PRICE_ABOVE_TYPICAL * full
 
+    met = _goals_met(best, goal)
     cheaper = [r for r in rounds if len(r[3].u) < len(best[3].u)
-               and met(r) == met(best) and r[2] <= best[2] and best[0] < r[0] + price(r)]
+               and _goals_met(r, goal) == met and r[2] <= best[2] and best[0] < r[0] + price(r)]
     return max(cheaper, key=lambda r: _fabricable(r, goal)) if cheaper else best
 
 
@@ -272,7 +268,7 @@ def _rounds(rulings, mesh, measured: tuple[float, np.ndarray], options: dict, gr
         # and from the third round on only while it misses one or has more than the typical
         # share in triangles (_worth_its_panels then weighs what they cost).
         broad = bars[k] < first
-        limit = _ROOM * goal if k < _REFINE_ROUNDS - 1 else min(goal, _TYPICAL_TRIANGLES)
+        limit = _ROOM * goal if k < _REFINE_ROUNDS - 1 else _typical(goal)
         if rounds[-1][1] == 0 and 1.0 - share <= limit:
             break
         candidate = _with_generators(cur_rulings, cur_mesh, area, bars[k], grid, options["rows"])
@@ -429,9 +425,21 @@ def _fabricable(round_: tuple, goal: float) -> tuple[int, float, float]:
     (:func:`_splinters`): of two meshes that meet one goal each, 47 % triangles and no face
     below 3 degrees misses by far more than 8 % with two faces at 2.96 degrees.
     """
-    share, splinters, cost = round_[0], round_[1], round_[2]
+    share, cost = round_[0], round_[2]
     excess = max(1.0 - share - goal, 0.0)
-    return int(splinters == 0) + int(excess == 0.0), -(cost + excess), share
+    return sum(_goals_met(round_, goal)), -(cost + excess), share
+
+
+def _goals_met(round_: tuple, goal: float) -> tuple[bool, bool]:
+    """A fabricator's two goals for a round's mesh: no splinter, at most ``goal`` of the area
+    in triangles."""
+    return round_[1] == 0, 1.0 - round_[0] <= goal
+
+
+def _typical(goal: float) -> float:
+    """The share in triangles the rounds work towards: :data:`_TYPICAL_TRIANGLES`, or the goal
+    where that is lower (tolerance mode)."""
+    return min(goal, _TYPICAL_TRIANGLES)
 
 
 def _splinters(mesh) -> tuple[int, float]:
