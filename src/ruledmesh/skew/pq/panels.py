@@ -139,8 +139,8 @@ def _cut(mesh: Mesh, faces: np.ndarray, corners: np.ndarray, pieces: np.ndarray,
     m = pieces
     inner = m - 1
     first = mesh.n_vertices + np.r_[0, np.cumsum(2 * inner)[:-1]]
-    s = np.concatenate([np.arange(1, k) / k for k in m.tolist()])
     owner = np.repeat(np.arange(len(m)), inner)
+    s = (ranks(inner) + 1) / m[owner]
 
     def points(p, q):
         return V[p[owner]] + s[:, None] * (V[q[owner]] - V[p[owner]]), t[p[owner]] + s * (t[q[owner]] - t[p[owner]])
@@ -158,20 +158,23 @@ def _cut(mesh: Mesh, faces: np.ndarray, corners: np.ndarray, pieces: np.ndarray,
     gg = np.empty(len(vertices), dtype=gen.dtype)
     gg[:mesh.n_vertices] = gen
     gg[ia], gg[ib] = gen[a0[owner]], gen[b0[owner]]
-    chain_a = [np.r_[a0[j], ia[owner == j], a1[j]] for j in range(len(m))]
-    chain_b = [np.r_[b0[j], ib[owner == j], b1[j]] for j in range(len(m))]
+    # Both chains of quad j, ends included, at the same places of two flat arrays.
+    start, chain_a = _chains(a0, ia, a1, inner)
+    _, chain_b = _chains(b0, ib, b1, inner)
+    step = np.delete(np.arange(len(chain_a)), start[1:] - 1)   # every point but a chain's last
+    piece_of = np.repeat(np.arange(len(m)), m)   # the quad each piece (and fan triangle) comes from
     drop = np.zeros(mesh.n_faces, bool)
     drop[faces] = True
-    polys = [np.stack([ca[:-1], ca[1:], cb[1:], cb[:-1]], axis=1) for ca, cb in zip(chain_a, chain_b, strict=True)]
-    kinds = [np.full(len(p), FaceKind.STRIP) for p in polys]
-    for chains, (face, apex), forward in zip((chain_a, chain_b), across, (False, True), strict=True):
-        for j in np.flatnonzero(apex >= 0).tolist():
-            c = chains[j]
-            fan = np.stack([np.full(len(c) - 1, apex[j]), c[:-1], c[1:]], axis=1)
-            polys.append(fan if forward else fan[:, [0, 2, 1]])
-            kinds.append(np.full(len(fan), mesh.face_kind[face[j]]))
-            drop[face[j]] = True
-    members, member_id = _split_members(mesh, chain_a + chain_b)
+    polys = [np.stack([chain_a[step], chain_a[step + 1], chain_b[step + 1], chain_b[step]], axis=1)]
+    kinds = [np.full(len(step), FaceKind.STRIP)]
+    for chain, (face, apex), forward in zip((chain_a, chain_b), across, (False, True), strict=True):
+        fanned = apex[piece_of] >= 0
+        fan = np.stack([apex[piece_of][fanned], chain[step][fanned], chain[step + 1][fanned]], axis=1)
+        polys.append(fan if forward else fan[:, [0, 2, 1]])
+        kinds.append(mesh.face_kind[face[piece_of][fanned]])
+        drop[face[apex >= 0]] = True
+    members, member_id = _split_members(mesh, np.r_[start[:-1], start[-1] + start[:-1]],
+                                        np.r_[chain_a, chain_b])
     kept = mesh.select_faces(~drop)
     sizes = np.concatenate([kept.valences] + [np.full(len(p), p.shape[1]) for p in polys])
     indices = np.concatenate([kept.face_indices] + [p.reshape(-1) for p in polys])
@@ -181,27 +184,47 @@ def _cut(mesh: Mesh, faces: np.ndarray, corners: np.ndarray, pieces: np.ndarray,
                             info=dict(mesh.info))
 
 
-def _split_members(mesh: Mesh, chains: list[np.ndarray]) -> tuple[np.ndarray, np.ndarray]:
-    """Members along the cut generator edges replaced by their pieces (same member ids)."""
+def _chains(first: np.ndarray, inner: np.ndarray, last: np.ndarray, counts: np.ndarray
+            ) -> tuple[np.ndarray, np.ndarray]:
+    """Chains ``first[j], inner[...], last[j]`` (``counts[j]`` inner points each, in order) as
+    one flat array; returns the offsets of the chains ((k + 1,): the last is the length) and it."""
+    start = np.r_[0, np.cumsum(counts + 2)]
+    flat = np.empty(start[-1], dtype=np.int64)
+    flat[start[:-1]] = first
+    flat[start[1:] - 1] = last
+    flat[np.repeat(start[:-1] + 1, counts) + ranks(counts)] = inner
+    return start, flat
+
+
+def _split_members(mesh: Mesh, starts: np.ndarray, flat: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Members along the cut generator edges replaced by their pieces (same member ids).
+
+    ``flat[starts[j]:starts[j + 1]]`` (the last chain runs to the end) is chain ``j``, from one
+    end of a member to its other end."""
     members, ids = mesh.members, mesh.member_id
     if members.size == 0:
         return members, ids
     n = np.int64(mesh.n_vertices)
     key = np.minimum(members[:, 0], members[:, 1]) * n + np.maximum(members[:, 0], members[:, 1])
     order = np.argsort(key)
-    out_m, out_i = [], []
-    gone = np.zeros(len(members), bool)
-    for c in chains:
-        p, q = int(c[0]), int(c[-1])
-        want = min(p, q) * n + max(p, q)
-        pos = int(np.searchsorted(key[order], want))
-        if pos >= len(order) or key[order][pos] != want:
-            continue
-        row = int(order[pos])
-        gone[row] = True
-        seq = c if members[row, 0] == p else c[::-1]
-        out_m.append(np.stack([seq[:-1], seq[1:]], axis=1))
-        out_i.append(np.full(len(seq) - 1, ids[row]))
-    if not out_m:
+    sorted_key = key[order]
+    ends = np.r_[starts[1:], len(flat)] - 1
+    p, q = flat[starts], flat[ends]
+    want = np.minimum(p, q) * n + np.maximum(p, q)
+    pos = np.minimum(np.searchsorted(sorted_key, want), len(order) - 1)
+    found = sorted_key[pos] == want
+    if not found.any():
         return members, ids
-    return (np.concatenate([members[~gone]] + out_m), np.concatenate([ids[~gone]] + out_i))
+    row = order[pos[found]]
+    gone = np.zeros(len(members), bool)
+    gone[row] = True
+    # Each found chain's points in the member's own sense, then its consecutive pairs.
+    forward = members[row, 0] == p[found]
+    lengths = ends[found] - starts[found] + 1
+    rank = ranks(lengths)
+    at = np.repeat(starts[found], lengths) + np.where(np.repeat(forward, lengths), rank,
+                                                      np.repeat(lengths - 1, lengths) - rank)
+    seq = flat[at]
+    pair = np.delete(np.arange(len(seq)), np.cumsum(lengths) - 1)
+    return (np.concatenate([members[~gone], np.stack([seq[pair], seq[pair + 1]], axis=1)]),
+            np.concatenate([ids[~gone], np.repeat(ids[row], lengths - 1)]))
