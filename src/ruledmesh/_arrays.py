@@ -20,8 +20,8 @@ import math
 
 import numpy as np
 
-__all__ = ["corner_angle", "cross", "diagonal", "median", "member", "norm", "percentile", "ranks",
-           "unique"]
+__all__ = ["corner_angle", "cross", "diagonal", "lookup", "median", "member", "norm", "percentile",
+           "ranks", "unique"]
 
 
 def unique(values: np.ndarray) -> np.ndarray:
@@ -76,6 +76,24 @@ def member(values: np.ndarray, among: np.ndarray) -> np.ndarray:
         return np.zeros(v.shape, dtype=bool)
     i = np.minimum(np.searchsorted(s, v), s.size - 1)
     return s[i] == v
+
+
+def lookup(keys: np.ndarray, table: np.ndarray) -> np.ndarray:
+    """Position of each of ``keys`` in the sorted ``table``, -1 where it is absent.
+
+    Parameters
+    ----------
+    keys : (k,) array_like
+    table : (n,) sorted array
+
+    Returns
+    -------
+    (k,) int
+    """
+    if table.size == 0:
+        return np.full(np.shape(keys), -1)
+    pos = np.minimum(np.searchsorted(table, keys), table.size - 1)
+    return np.where(table[pos] == keys, pos, -1)
 
 
 def percentile(values: np.ndarray, q: float) -> float:

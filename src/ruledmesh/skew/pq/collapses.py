@@ -25,7 +25,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..._arrays import cross, diagonal, member, unique
+from ..._arrays import cross, diagonal, lookup, member, unique
 from ...analysis.faces import min_corner_angles
 from ...mesh import FaceKind, Mesh
 from ...tolerances import COLLAPSE_MAX_SAG, FLIP_MAX_BEND_DEG, FLIP_MIN_GAIN_DEG, RESTART_ANGLE_DEG, TINY
@@ -67,14 +67,6 @@ def _triangle_distance(p: np.ndarray, P: np.ndarray) -> np.ndarray:
     edge = np.minimum(np.minimum(_segment_distance(p, A, B), _segment_distance(p, B, C)),
                       _segment_distance(p, C, A))
     return np.where(inside, np.abs(h), edge)
-
-
-def _lookup(keys: np.ndarray, table: np.ndarray) -> np.ndarray:
-    """(k,) int: position of each key in the sorted ``table``, -1 where absent."""
-    if table.size == 0:
-        return np.full(keys.shape, -1)
-    pos = np.clip(np.searchsorted(table, keys), 0, table.size - 1)
-    return np.where(table[pos] == keys, pos, -1)
 
 
 def _expand(counts: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -263,7 +255,7 @@ def _rejoined(members: np.ndarray, member_id: np.ndarray, removed: np.ndarray, n
     # The member that continues each one along its generator: (id, start) = (id, this end).
     key0 = member_id * n + m0
     order = np.argsort(key0, kind="stable")
-    nxt = _lookup(member_id * n + m1, key0[order])
+    nxt = lookup(member_id * n + m1, key0[order])
     nxt = np.where(nxt >= 0, order[np.maximum(nxt, 0)], -1)
     end = m1.copy()
     row = np.arange(len(m1))

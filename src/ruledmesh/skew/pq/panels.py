@@ -16,7 +16,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..._arrays import median, ranks
+from ..._arrays import lookup, median, ranks
 from ...mesh import FaceKind, Mesh, offsets_from_valences
 from ...tolerances import RESTART_ANGLE_DEG
 
@@ -88,10 +88,8 @@ def _neighbours(mesh: Mesh, a: np.ndarray, b: np.ndarray) -> tuple[np.ndarray, n
     following = mesh.next_corners()
     key = idx * n + idx[following]
     order = np.argsort(key, kind="stable")
-    want = b.astype(np.int64) * n + a
-    pos = np.searchsorted(key[order], want)
-    pos = np.minimum(pos, len(order) - 1)
-    found = key[order][pos] == want
+    pos = lookup(b.astype(np.int64) * n + a, key[order])
+    found = pos >= 0
     corner = np.where(found, order[pos], -1)
     face_of = np.repeat(np.arange(mesh.n_faces), mesh.valences)
     face = np.where(found, face_of[np.maximum(corner, 0)], -1)
@@ -168,12 +166,13 @@ def _cut(mesh: Mesh, faces: np.ndarray, corners: np.ndarray, pieces: np.ndarray,
     polys = [np.stack([chain_a[step], chain_a[step + 1], chain_b[step + 1], chain_b[step]], axis=1)]
     kinds = [np.full(len(step), FaceKind.STRIP)]
     for chain, (face, apex), forward in zip((chain_a, chain_b), across, (False, True), strict=True):
-        fanned = apex[piece_of] >= 0
-        fan = np.stack([apex[piece_of][fanned], chain[step][fanned], chain[step + 1][fanned]], axis=1)
+        fanned = apex[piece_of] >= 0            # the pieces beside a triangle that is fanned
+        at = step[fanned]
+        fan = np.stack([apex[piece_of][fanned], chain[at], chain[at + 1]], axis=1)
         polys.append(fan if forward else fan[:, [0, 2, 1]])
         kinds.append(mesh.face_kind[face[piece_of][fanned]])
         drop[face[apex >= 0]] = True
-    members, member_id = _split_members(mesh, np.r_[start[:-1], start[-1] + start[:-1]],
+    members, member_id = _split_members(mesh, np.r_[start[:-1], start + start[-1]],
                                         np.r_[chain_a, chain_b])
     kept = mesh.select_faces(~drop)
     sizes = np.concatenate([kept.valences] + [np.full(len(p), p.shape[1]) for p in polys])
@@ -196,23 +195,21 @@ def _chains(first: np.ndarray, inner: np.ndarray, last: np.ndarray, counts: np.n
     return start, flat
 
 
-def _split_members(mesh: Mesh, starts: np.ndarray, flat: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+def _split_members(mesh: Mesh, start: np.ndarray, flat: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """Members along the cut generator edges replaced by their pieces (same member ids).
 
-    ``flat[starts[j]:starts[j + 1]]`` (the last chain runs to the end) is chain ``j``, from one
-    end of a member to its other end."""
+    ``flat[start[j]:start[j + 1]]`` is chain ``j`` (as :func:`_chains` lays them out), from
+    one end of a member to its other end."""
     members, ids = mesh.members, mesh.member_id
     if members.size == 0:
         return members, ids
     n = np.int64(mesh.n_vertices)
     key = np.minimum(members[:, 0], members[:, 1]) * n + np.maximum(members[:, 0], members[:, 1])
     order = np.argsort(key)
-    sorted_key = key[order]
-    ends = np.r_[starts[1:], len(flat)] - 1
-    p, q = flat[starts], flat[ends]
-    want = np.minimum(p, q) * n + np.maximum(p, q)
-    pos = np.minimum(np.searchsorted(sorted_key, want), len(order) - 1)
-    found = sorted_key[pos] == want
+    first, last = start[:-1], start[1:] - 1
+    p, q = flat[first], flat[last]
+    pos = lookup(np.minimum(p, q) * n + np.maximum(p, q), key[order])
+    found = pos >= 0
     if not found.any():
         return members, ids
     row = order[pos[found]]
@@ -220,10 +217,10 @@ def _split_members(mesh: Mesh, starts: np.ndarray, flat: np.ndarray) -> tuple[np
     gone[row] = True
     # Each found chain's points in the member's own sense, then its consecutive pairs.
     forward = members[row, 0] == p[found]
-    lengths = ends[found] - starts[found] + 1
+    lengths = last[found] - first[found] + 1
     rank = ranks(lengths)
-    at = np.repeat(starts[found], lengths) + np.where(np.repeat(forward, lengths), rank,
-                                                      np.repeat(lengths - 1, lengths) - rank)
+    at = np.repeat(first[found], lengths) + np.where(np.repeat(forward, lengths), rank,
+                                                     np.repeat(lengths - 1, lengths) - rank)
     seq = flat[at]
     pair = np.delete(np.arange(len(seq)), np.cumsum(lengths) - 1)
     return (np.concatenate([members[~gone], np.stack([seq[pair], seq[pair + 1]], axis=1)]),
