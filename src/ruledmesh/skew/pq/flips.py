@@ -18,7 +18,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..._arrays import cross, diagonal, unique
+from ..._arrays import cross, diagonal, lookup, unique
 from ...analysis.faces import min_corner_angles
 from ...kernels import wanted
 from ...mesh import FaceKind, Mesh
@@ -169,10 +169,7 @@ def _round(V: np.ndarray, tri: np.ndarray, tmin: np.ndarray, fixed: np.ndarray, 
 
 def _member(keys: np.ndarray, sorted_keys: np.ndarray) -> np.ndarray:
     """(k,) bool: which ``keys`` are in ``sorted_keys``."""
-    if sorted_keys.size == 0:
-        return np.zeros(keys.shape, bool)
-    pos = np.clip(np.searchsorted(sorted_keys, keys), 0, sorted_keys.size - 1)
-    return sorted_keys[pos] == keys
+    return lookup(keys, sorted_keys) >= 0
 
 
 def _active(V: np.ndarray, tri: np.ndarray) -> tuple[np.ndarray, np.ndarray, tuple | None]:
