@@ -501,7 +501,7 @@ def _line_distance_all(p: np.ndarray, a: np.ndarray, d: np.ndarray, dd: np.ndarr
     return out
 
 
-def surface_generator_distance(p: np.ndarray, ref: Reference, iters: int = 100
+def surface_generator_distance(p: np.ndarray, ref: Reference, iters: int = 100, starts: int = 8
                                ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Distance of points to the nearest generator of the smooth surface, and its t.
 
@@ -509,6 +509,10 @@ def surface_generator_distance(p: np.ndarray, ref: Reference, iters: int = 100
     generator parameter ``u`` for ``min_u |p - A(u) - t*(u) (B(u) - A(u))|``
     (``t*`` the foot on the line), which converges quadratically for points on
     the surface (more slowly near the ends of the patch, hence up to ``iters`` steps).
+    Near a cusp of a director curve every generator passes close to the cusp point,
+    and that distance has a local minimum on each side of it: a point the first descent
+    leaves off the surface is searched again from the next ``starts`` nearest patch
+    points, and the nearest generator found is kept.
 
     Returns
     -------
@@ -518,11 +522,28 @@ def surface_generator_distance(p: np.ndarray, ref: Reference, iters: int = 100
     length : (n,) float64
         Length of that generator between c1 and c2.
     """
-    surf = ref.surface
     T = ref.grid.shape[1]
-    _, idx = cKDTree(ref.grid.reshape(-1, 3)).query(p)
-    u = ref.grid_u[idx // T].astype(float)
+    tree = cKDTree(ref.grid.reshape(-1, 3))
+    _, idx = tree.query(p)
+    u = _generator_descent(p, ref.grid_u[idx // T].astype(float), ref, iters)
+    dist, t, length = _foot(p, u, ref)
+    off = np.nonzero(dist > 1e-12 * ref.diagonal)[0]
+    if len(off) and starts > 1:
+        _, near = tree.query(p[off], k=starts + 1)
+        for k in range(1, starts + 1):
+            u_k = _generator_descent(p[off], ref.grid_u[near[:, k] // T].astype(float), ref, iters)
+            d_k, t_k, l_k = _foot(p[off], u_k, ref)
+            better = d_k < dist[off]
+            dist[off[better]], t[off[better]], length[off[better]] = (
+                d_k[better], t_k[better], l_k[better])
+    return dist, t, length
+
+
+def _generator_descent(p: np.ndarray, u: np.ndarray, ref: Reference, iters: int) -> np.ndarray:
+    """Gauss-Newton on ``u`` from the starts ``u`` (n,), see :func:`surface_generator_distance`."""
+    surf = ref.surface
     lo, hi = float(ref.grid_u[0]), float(ref.grid_u[-1])
+    u = u.copy()
     # A point whose step left its u unchanged is at a fixed point: every later step would
     # start from the same u and compute the same step again.  So only the others are
     # iterated (most points settle in a few steps, a few take many), with the same stop
@@ -545,7 +566,12 @@ def surface_generator_distance(p: np.ndarray, ref: Reference, iters: int = 100
         moving = moving[u_new != um]
         if done:
             break
-    a, b = surf.a(u), surf.b(u)
+    return u
+
+
+def _foot(p: np.ndarray, u: np.ndarray, ref: Reference) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Distance of ``p`` to the generator at ``u``, the foot's t and the generator's length."""
+    a, b = ref.surface.a(u), ref.surface.b(u)
     d = b - a
     t = np.einsum("ij,ij->i", p - a, d) / np.einsum("ij,ij->i", d, d)
     return _norm(p - a - t[:, None] * d), t, _norm(d)
