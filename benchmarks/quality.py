@@ -501,8 +501,8 @@ def _line_distance_all(p: np.ndarray, a: np.ndarray, d: np.ndarray, dd: np.ndarr
     return out
 
 
-def surface_generator_distance(p: np.ndarray, ref: Reference, iters: int = 100, starts: int = 8
-                               ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+def surface_generator_distance(p: np.ndarray, ref: Reference, iters: int = 100, starts: int = 8,
+                               polish: bool = True) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Distance of points to the nearest generator of the smooth surface, and its t.
 
     Starts from the nearest dense patch point and runs Gauss-Newton on the
@@ -512,7 +512,8 @@ def surface_generator_distance(p: np.ndarray, ref: Reference, iters: int = 100, 
     Near a cusp of a director curve every generator passes close to the cusp point,
     and that distance has a local minimum on each side of it: a point the first descent
     leaves off the surface is searched again from the next ``starts`` nearest patch
-    points, and the nearest generator found is kept.
+    points, and the nearest generator found is kept; with ``polish``, what is still off
+    is searched once more by golden section on ``u`` around it.
 
     Returns
     -------
@@ -534,9 +535,41 @@ def surface_generator_distance(p: np.ndarray, ref: Reference, iters: int = 100, 
             u_k = _generator_descent(p[off], ref.grid_u[near[:, k] // T].astype(float), ref, iters)
             d_k, t_k, l_k = _foot(p[off], u_k, ref)
             better = d_k < dist[off]
+            u[off[better]] = u_k[better]
             dist[off[better]], t[off[better]], length[off[better]] = (
                 d_k[better], t_k[better], l_k[better])
+    off = np.nonzero(dist > 1e-12 * ref.diagonal)[0]
+    if len(off) and polish:
+        # Where the foot moves fast along the generator as u changes (the waist of a
+        # surface close to a cone), Gauss-Newton with t held crawls: a golden-section
+        # search on u around what it found settles those points.
+        h = 2.0 * float(np.max(np.diff(ref.grid_u)))
+        u_g = _golden(p[off], u[off] - h, u[off] + h, ref)
+        d_g, t_g, l_g = _foot(p[off], u_g, ref)
+        better = d_g < dist[off]
+        dist[off[better]], t[off[better]], length[off[better]] = (
+            d_g[better], t_g[better], l_g[better])
     return dist, t, length
+
+
+def _golden(p: np.ndarray, lo: np.ndarray, hi: np.ndarray, ref: Reference, iters: int = 90
+            ) -> np.ndarray:
+    """Golden-section search of the generator nearest to each point ``p`` in ``[lo, hi]`` (clipped)."""
+    lo = np.clip(lo, ref.grid_u[0], ref.grid_u[-1])
+    hi = np.clip(hi, ref.grid_u[0], ref.grid_u[-1])
+    g = (np.sqrt(5.0) - 1.0) / 2.0
+    x1, x2 = hi - g * (hi - lo), lo + g * (hi - lo)
+    f1, f2 = _foot(p, x1, ref)[0], _foot(p, x2, ref)[0]
+    for _ in range(iters):
+        left = f1 < f2
+        hi = np.where(left, x2, hi)
+        lo = np.where(left, lo, x1)
+        x2n = np.where(left, x1, lo + g * (hi - lo))
+        x1n = np.where(left, hi - g * (hi - lo), x2)
+        f_new = _foot(p, np.where(left, x1n, x2n), ref)[0]
+        f1, f2 = np.where(left, f_new, f2), np.where(left, f1, f_new)
+        x1, x2 = x1n, x2n
+    return 0.5 * (lo + hi)
 
 
 def _generator_descent(p: np.ndarray, u: np.ndarray, ref: Reference, iters: int) -> np.ndarray:
