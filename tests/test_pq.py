@@ -272,3 +272,63 @@ def test_kink_of_a_director_polyline_gets_a_generator_and_matched_rows():
         pq_mesh(A, B, creases=[len(A) - 1])
     with pytest.raises(ParameterError, match="crease_generators"):
         pq_mesh(A, B, crease_generators=[0])
+
+
+@pytest.mark.parametrize("h", [np.sqrt(3.0), 3.0])
+def test_strongly_twisted_hyperboloid_carries_rows_to_its_side_generators(h):
+    """Half a hyperboloid whose generators turn by 120 (h = sqrt 3) or 143 degrees: the rows
+    of the primary's part reach its middle third only, the rest lies far out on the primary,
+    where even steps bunched into slivers.  48 % and 72 % of the area were triangles and the
+    side generators carried no rows; with the bunching rows left out 15 % and 20 %."""
+    from ruledmesh.analysis.faces import area_shares, face_min_angles
+
+    A, B = hyperboloid_lines(2.0, 1.0, 0.0, np.pi, 61, h=h)
+    mesh = pq_mesh(A, B, rows=24)
+    check_mesh(mesh)
+    assert 1.0 - area_shares(mesh)["quads"] <= 0.22
+    assert face_min_angles(mesh).min() >= 3.0
+    assert not any("carry no" in w for w in mesh.info["warnings"])
+
+
+def test_rows_that_do_not_bunch_are_all_kept():
+    from ruledmesh.skew.pq.extension import thinned_rows
+
+    tau = np.arange(-10, 41) / 24.0
+    tau = tau[:len(tau) // 2 * 2]
+    M = np.tile(np.eye(2), (5, 1, 1))
+    M[:, 0, 1] = np.linspace(-0.5, 0.5, 5)                  # shifted copies: the same spacing
+    assert np.array_equal(thinned_rows(M, tau, (0.0, 1.0), 24), tau)
+
+
+@given(st.integers(8, 60), st.floats(0.2, 3.0))
+@settings(max_examples=60, deadline=None)
+def test_rows_beyond_the_primary_part_are_spread_where_they_bunch(rows, k):
+    """One generator takes the primary's tau to t = k / tau: far out even steps land ever
+    closer.  Beyond [0, 1] the a-rows kept land there about half of _BUNCHING of a step
+    apart or more (the last, the margin, excepted: a row is kept where the running sum of
+    the steps' shares passes a whole number, so two kept rows are at least max(s, 1 - s)
+    apart for steps of share s, less the change of s from step to step), every a-row of
+    the primary's part stays, and so do the ends."""
+    from ruledmesh.skew.pq import extension
+    from ruledmesh.skew.pq.extension import thinned_rows
+
+    tau = np.arange(-4, 20 * rows + 2) / rows
+    tau = tau[:len(tau) // 2 * 2]
+    M = np.array([np.eye(2), [[0.0, k], [1.0, 0.0]]])
+    out = thinned_rows(M, tau, (0.0, 1.0), rows)
+    assert np.all(np.diff(out) > 0)
+    a, kept = tau[0::2], out[0::2]
+    own = a[(a >= 0.0) & (a <= 1.0)]
+    assert np.isin(own, kept).all() and kept[0] == a[0] and kept[-1] == a[-1]
+    # (Up to 1.05 the primary itself lands on its patch and keeps the rows.)
+    beyond = kept[kept > 1.05 + 2.0 / rows]
+    image = k / beyond
+    lands = image[:-1] < 1.0 + 0.05
+    gaps = -np.diff(image)[lands[:len(image) - 1]][:-1]
+    assert np.all(gaps >= 0.4 * extension._BUNCHING * 2.0 / rows)
+    assert len(kept) < len(a)
+    # Where even steps already land on the patch _BUNCHING of a step apart, none is left out.
+    far = (a[:-1] > 1.0) & (k / a[1:] < 1.0 + 0.05)
+    wide = np.zeros(len(a) - 1, bool)
+    wide[far] = k / a[:-1][far] - k / a[1:][far] >= extension._BUNCHING * 2.0 / rows
+    assert np.isin(a[1:][wide], kept).all()

@@ -55,15 +55,15 @@ QUADRIC = [s for s in ALL if "quadric" in s.flags]
 # surface that starts to pass fails here until it is taken off the list, so the list cannot
 # go stale and the bar is never lowered.
 SHORT_OF_ANGLE = {
-    "twisted-arcs-160deg": "two faces of 1.47 deg between runs of rows",
-    "twisted-arcs-160deg-tol1e-3": "smallest angle 0.79 deg",
+    "twisted-arcs-160deg": "smallest angle 2.46 deg",
+    "twisted-arcs-160deg-tol1e-3": "smallest angle 1.55 deg",
 }
 SHORT_OF_GENERATOR: dict[str, str] = {}
 SHORT_OF_SHARE = {
     "plucker-lines-tol1e-3": "18.7% of the area in triangles",
     "skew-bspline-301x300": "17.9% of the area in triangles",
-    "twisted-arcs-160deg": "86.8% of the area in triangles (rows bunch: 94 of 109 generators carry none)",
-    "twisted-arcs-120deg": "46% of the area in triangles (rows leave through the border arcs)",
+    "twisted-arcs-160deg": "41.1% of the area in triangles, 28% at the border",
+    "twisted-arcs-160deg-tol1e-3": "30.6% of the area in triangles (8.6% before rows were thinned)",
     "moebius-r5-w0.8-97x20": "27.5% of the area in triangles (border teeth)",
     "plucker-lines-a1-41": "26.0% of the area in triangles",
 }
@@ -309,7 +309,7 @@ def test_generator_distance_iterates_the_moving_points_only():
     u = rng.uniform(ref.grid_u[0], ref.grid_u[-1], 400)
     off = rng.normal(size=(400, 3)) * 1e-3 * ref.diagonal
     p = surf.point(u, rng.uniform(-0.1, 1.1, 400)) + off
-    dist, t, length = quality.surface_generator_distance(p, ref, starts=1)
+    dist, t, length = quality.surface_generator_distance(p, ref, starts=1, polish=False)
     T = ref.grid.shape[1]
     from scipy.spatial import cKDTree
 
@@ -349,7 +349,7 @@ def test_generator_distance_finds_generators_next_to_a_cusp():
     u = np.linspace(0.5 - 0.01, 0.5 + 0.01, 41)
     t = np.tile([0.002, 0.006, 0.02], len(u))
     p = ref.surface.point(np.repeat(u, 3), t)
-    one = quality.surface_generator_distance(p, ref, starts=1)[0] / ref.diagonal
+    one = quality.surface_generator_distance(p, ref, starts=1, polish=False)[0] / ref.diagonal
     assert one.max() > 1e-5                  # the case this guards: one start misses
     assert quality.surface_generator_distance(p, ref)[0].max() / ref.diagonal <= 1e-12
 

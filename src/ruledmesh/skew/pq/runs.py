@@ -24,6 +24,7 @@ from ...budget import MAX_GRID_POINTS, PQ_BYTES_PER_GRID_POINT
 from ...errors import GeometryError
 from ...kernels import wanted
 from ...tolerances import INTERIOR, RESTART_ANGLE_DEG, ROUNDING, TINY, Tolerances
+from .extension import thinned_rows
 from .maps import (
     ChainMaps,
     HopMaps,
@@ -93,7 +94,11 @@ class Run:
 
 def _uniform_rows(M: np.ndarray, div: Division, primary_global: int, tol: Tolerances,
                   warnings: list[str]) -> np.ndarray:
-    """Root parameters of all rows, uniform in ``1 / rows``; even entries on the primary."""
+    """Root parameters of all rows, uniform in ``1 / rows``; even entries on the primary.
+
+    Beyond the primary's part the rows that would bunch on every generator are
+    left out (:func:`~ruledmesh.skew.pq.extension.thinned_rows`).
+    """
     rows = div.rows
     if div.extend == "auto":
         lo, hi, bounded = patch_preimage(M, tol.degenerate)
@@ -117,11 +122,15 @@ def _uniform_rows(M: np.ndarray, div: Division, primary_global: int, tol: Tolera
         j0 -= 1
     count = j1 - j0 + 1
     count += count % 2
-    return (j0 + np.arange(count)) / rows
+    tau = (j0 + np.arange(count)) / rows
+    return thinned_rows(M, tau, (0.0, 1.0), rows) if div.extend == "auto" else tau
 
 
 def _matched_rows(M: np.ndarray, div: Division, tol: Tolerances) -> np.ndarray:
-    """Root parameters from a matched division, extended by the end spacings."""
+    """Root parameters from a matched division, extended by the end spacings.
+
+    Beyond the given rows those that would bunch on every generator are left out.
+    """
     given = np.asarray(div.matched, dtype=np.float64)
     lo, hi, bounded = patch_preimage(M, tol.degenerate)
     lo_v = max(lo[bounded].min() if bounded.any() else 0.0, -div.max_extend)
@@ -143,7 +152,7 @@ def _matched_rows(M: np.ndarray, div: Division, tol: Tolerances) -> np.ndarray:
     out[0::2] = a_rows
     out[1:-1:2] = mid
     out[-1] = a_rows[-1] + 0.5 * s1
-    return out
+    return thinned_rows(M, out, (float(given[0]), float(given[-1])), div.rows)
 
 
 def _root_b_rows(M: np.ndarray, N: np.ndarray, tau: np.ndarray, primary: int,
