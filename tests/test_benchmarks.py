@@ -131,3 +131,23 @@ def test_designer_benchmark_times_every_stage(capsys):
         median = float(line.split("median")[1].split("ms")[0])
         assert 0 < median < 60_000, line
     assert "load average" in out
+
+
+def test_twisted_arcs_sweep_writes_designs_that_build(tmp_path):
+    import importlib.util
+
+    from ruledmesh import build
+    from ruledmesh.analysis.faces import area_shares, planarity
+
+    spec = importlib.util.spec_from_file_location(
+        "twisted_arcs", Path(__file__).resolve().parents[1] / "benchmarks" / "twisted_arcs.py")
+    mod = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(mod)
+    assert mod.main([str(tmp_path)]) == 0
+    files = sorted(tmp_path.glob("*.toml"))
+    assert len(files) == 32
+    # The most twisted of them, turned by 140 degrees: 78.5 % triangles before the bunched rows
+    # far out on the primary were left out, 14.9 % after.
+    mesh = build(tmp_path / "arcs-t140-s120-r3-h3.toml")
+    assert 1.0 - area_shares(mesh)["quads"] <= 0.25
+    assert planarity(mesh).max() <= 1e-12
