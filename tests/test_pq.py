@@ -328,7 +328,8 @@ def test_rows_beyond_the_primary_part_are_spread_where_they_bunch(rows, k):
     assert np.all(gaps >= 0.4 * extension._BUNCHING * 2.0 / rows)
     assert len(kept) < len(a)
     # Where even steps already land on the patch _BUNCHING of a step apart, none is left out.
-    far = (a[:-1] > 1.0) & (k / a[1:] < 1.0 + 0.05)
+    far = a[:-1] > 1.0
+    far[far] = k / a[1:][far] < 1.0 + 0.05
     wide = np.zeros(len(a) - 1, bool)
     wide[far] = k / a[:-1][far] - k / a[1:][far] >= extension._BUNCHING * 2.0 / rows
     assert np.isin(a[1:][wide], kept).all()
