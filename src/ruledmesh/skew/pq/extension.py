@@ -24,6 +24,8 @@ __all__ = ["thinned_rows"]
 
 # Rows are spread where on every generator they would land closer than this share of a step.
 _BUNCHING = 0.25
+# a-rows measured at a time (the generators x rows temporaries stay small).
+_CHUNK = 2048
 # Landing this far outside [0, 1] (in units of the generator) still counts: a face spans two rows.
 _LANDING_SLACK = 0.05
 
@@ -60,17 +62,8 @@ def thinned_rows(M: np.ndarray, tau: np.ndarray, own: tuple[float, float], rows:
     n = len(a)
     if n < 3:
         return tau
-    with np.errstate(divide="ignore", invalid="ignore", over="ignore"):
-        num = M[:, 0, 0, None] * a + M[:, 0, 1, None]
-        den = M[:, 1, 0, None] * a + M[:, 1, 1, None]
-        t = num / den
-        lands = np.isfinite(t) & (t > -_LANDING_SLACK) & (t < 1.0 + _LANDING_SLACK)
-        # A pole between two rows (the denominator's sign changes) makes them far apart.
-        through = np.signbit(den[:, 1:]) != np.signbit(den[:, :-1])
-        gap = np.where(through, np.inf, np.abs(np.diff(t, axis=1)))
-        gap = np.where(lands[:, 1:] | lands[:, :-1], gap, 0.0)
-        share = np.minimum(np.nan_to_num(gap, nan=np.inf).max(axis=0) / (_BUNCHING * 2.0 / rows),
-                           1.0)
+    share = np.concatenate([_shares(M, a[k:k + _CHUNK + 1], rows)
+                            for k in range(0, n - 1, _CHUNK)])
     keep = (a >= own[0]) & (a <= own[1])
     keep[[0, -1]] = True
     inside = np.flatnonzero(keep[1:-1]) + 1
@@ -91,3 +84,18 @@ def thinned_rows(M: np.ndarray, tau: np.ndarray, own: tuple[float, float], rows:
     out[1:-1:2] = np.where(neighbours, tau[2 * k[:-1] + 1], 0.5 * (a[k[:-1]] + a[k[1:]]))
     out[-1] = tau[2 * k[-1] + 1]
     return out
+
+
+def _shares(M: np.ndarray, a: np.ndarray, rows: int) -> np.ndarray:
+    """(len(a) - 1,) each step's count in :func:`thinned_rows`, for a-rows ``a``."""
+    with np.errstate(divide="ignore", invalid="ignore", over="ignore"):
+        num = M[:, 0, 0, None] * a + M[:, 0, 1, None]
+        den = M[:, 1, 0, None] * a + M[:, 1, 1, None]
+        t = num / den
+        lands = np.isfinite(t) & (t > -_LANDING_SLACK) & (t < 1.0 + _LANDING_SLACK)
+        # A pole between two rows (the denominator's sign changes) makes them far apart.
+        through = np.signbit(den[:, 1:]) != np.signbit(den[:, :-1])
+        gap = np.where(through, np.inf, np.abs(np.diff(t, axis=1)))
+        gap = np.where(lands[:, 1:] | lands[:, :-1], gap, 0.0)
+        return np.minimum(np.nan_to_num(gap, nan=np.inf).max(axis=0) / (_BUNCHING * 2.0 / rows),
+                          1.0)
