@@ -47,6 +47,22 @@ def test_analyze_mesh_file_and_design(tmp_path, capsys):
     assert report["coverage"]["ratio"] == pytest.approx(1, abs=0.02)
 
 
+def test_quiet_build_writes_the_same_mesh_without_measuring_it(tmp_path, capsys, monkeypatch):
+    import ruledmesh.analysis.report as report
+
+    loud, quiet = tmp_path / "loud.obj", tmp_path / "quiet.obj"
+    assert main(["build", str(EXAMPLES / "skew.toml"), "-o", str(loud)]) == 0
+
+    def unasked(*args, **kwargs):
+        raise AssertionError("a quiet build analysed its mesh")
+
+    monkeypatch.setattr(report, "analyze", unasked)
+    capsys.readouterr()
+    assert main(["build", str(EXAMPLES / "skew.toml"), "-o", str(quiet), "-q"]) == 0
+    assert capsys.readouterr().out == ""
+    assert quiet.read_bytes() == loud.read_bytes()
+
+
 BAD = {
     "count-word": ('[curves.c1]\ntype="line"\npoints=[[0,0,0],[1,0,0]]\n[curves.c2]\ntype="line"\n'
                    'points=[[0,1,1],[1,1,2]]\n[rulings]\nbetween=["c1","c2"]\ncount="forty"\n',

@@ -38,7 +38,7 @@ from . import faces as F
 from .live import face_measures, figure_warnings, min_max_mean, scaled_back, unit_copy, unit_figures
 
 __all__ = ["KIND_NOUNS", "METRIC_HOOKS", "MISMATCH", "analyze", "format_summary", "format_table",
-           "kind_counts", "strict_json"]
+           "kind_counts", "require_faces", "strict_json"]
 
 # The words every report, the command line and the docs use for face counts.
 KIND_NOUNS = {
@@ -145,9 +145,7 @@ def analyze(mesh: Mesh, reference=None, extras: Mapping[str, Any] | None = None,
     GeometryError
         If the mesh has no faces.
     """
-    if mesh.n_faces == 0:
-        raise GeometryError(f"the mesh has no faces ({mesh.n_vertices} vertices); "
-                            "nothing to analyse")
+    require_faces(mesh)
     _load_hooks()
     # The figures are taken on a copy in a unit frame (a power-of-two scale: exact),
     # so they do not depend on the scale of the mesh, and products of lengths never
@@ -173,6 +171,13 @@ def analyze(mesh: Mesh, reference=None, extras: Mapping[str, Any] | None = None,
         report.update(dict(extras))
     report["warnings"] = _warnings(work, report, tol)
     return strict_json(report)
+
+
+def require_faces(mesh: Mesh) -> None:
+    """Raise GeometryError if ``mesh`` has no faces (nothing to analyse or to write)."""
+    if mesh.n_faces == 0:
+        raise GeometryError(f"the mesh has no faces ({mesh.n_vertices} vertices); "
+                            "nothing to analyse")
 
 
 def strict_json(report: dict[str, Any]) -> dict[str, Any]:

@@ -27,12 +27,13 @@ def add_parser(sub) -> None:
                    help="STL: subtract this point before float32 rounding (auto: the lower "
                         "corner in whole units); recorded in the header")
     p.add_argument("-q", "--quiet", action="store_true",
-                   help="print nothing on success (no progress, no summary)")
+                   help="print nothing on success (no progress, no summary; the mesh is "
+                        "not analysed)")
     p.set_defaults(run=run)
 
 
 def run(args) -> int:
-    from ..analysis.report import analyze, format_summary
+    from ..analysis.report import analyze, format_summary, require_faces
     from ..errors import ParameterError, RuledMeshWarning
     from ..io import WRITERS, save
     from ._common import check_output_file, progress_for, read_design
@@ -45,12 +46,18 @@ def run(args) -> int:
                              "--origin")
     progress = progress_for(args)
     _, built = read_design(args.design, progress)
-    report = analyze(built.mesh, reference=built.reference, extras=built.extras, progress=progress)
+    # Quiet without --json prints nothing the analysis would say: no need to measure
+    # (an empty mesh is still refused, as the analysis would).
+    require_faces(built.mesh)
+    report = None if args.quiet and not args.json else \
+        analyze(built.mesh, reference=built.reference, extras=built.extras, progress=progress)
     with progress.task(f"write {args.output}"), warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always", RuledMeshWarning)
         save(output, built.mesh, **({} if origin is None else {"origin": origin}))
     for w in caught:
         print(f"warning: {w.message}", file=sys.stderr)
+    if report is None:
+        return 0
     if args.json:
         json.dump(report, sys.stdout, indent=2)
         sys.stdout.write("\n")
