@@ -499,3 +499,34 @@ def test_helicoid_with_a_vanishing_pitch_is_refused():
     # The design layer refuses such a number before the construction sees it.
     with pytest.raises(RuledMeshError, match=r"surface\.pitch: expected 0 or a number of magnitude"):
         build_design(parse_design(text, "helicoid.toml"))
+
+
+def test_pq_border_snap_that_would_leave_no_face_is_not_taken():
+    # Found by the fuzz at 10x its examples: five micrometre generators, 2 rows, no extension.
+    # The snap of a corner onto the border removed every face around the end point, and its
+    # measure indexed a vertex the merged mesh no longer had (IndexError).
+    from ruledmesh.analysis.faces import convexity
+    from ruledmesh.pq import pq_mesh
+
+    a = np.array([[1e-6, 0, 0], [1e-6, 0, 2.5e-7], [1e-6, 0, 5e-7], [1e-6, 0, 7.5e-7], [1e-6, 0, 1e-6]])
+    b = np.array([[1e-6, 1e-6, 1e-6], [1e-6, 1e-6, 1.25e-6], [1.075e-6, 1.5e-6, -5e-7],
+                  [1.16875e-6, 1.75e-6, -1.25e-6], [1.3e-6, 2e-6, -2e-6]])
+    mesh = pq_mesh(a, b, rows=2, option=0, trim=False, primary="middle", extend=0.0)
+    assert mesh.n_faces > 0 and np.all(np.isfinite(mesh.vertices))
+    assert planarity(mesh).max() <= 1e-12 and convexity(mesh).all()
+
+
+def test_linear_directrix_with_a_flat_stretch_of_its_twist_builds():
+    # Found by the fuzz at 10x its examples: the root search of a torsal band's partner met two
+    # equal values of the twist and divided by zero in its inverse quadratic step (scipy's C
+    # code gets inf there and bisects, as ours does now).
+    import ruledmesh
+
+    design = {"curves": {"c1": {"type": "line", "points": [[1.585402155435423, 1.7762939584031822e-236,
+                                                              -3.3216671699380305], [7.0, 0.0, 0.0]]},
+                         "c2": {"type": "line", "points": [[0.0, 0.0, 1.0], [0.0, 1.0, 0.0]]}},
+              "rulings": {"between": ["c1", "c2"], "count": 7, "distribution": "linear-directrix",
+                          "directrix": [[0.0, 0.0, 0.0], [1.0, 0.0, 1.0]]},
+              "mesh": {"method": "pq", "rows": 1, "option": 0, "trim": True}}
+    mesh = ruledmesh.build(design)
+    assert mesh.n_faces > 0 and planarity(mesh).max() <= 1e-12

@@ -74,7 +74,10 @@ def brentq(f: Callable[[float], float], a: float, b: float, xtol: float = BRENTQ
             else:  # extrapolate
                 dpre = (fpre - fcur) / (xpre - xcur)
                 dblk = (fblk - fcur) / (xblk - xcur)
-                stry = -fcur * (fblk * dblk - fpre * dpre) / (dblk * dpre * (fblk - fpre))
+                den = dblk * dpre * (fblk - fpre)
+                # Two equal values (a flat stretch of f): no parabola through the three
+                # points; C's division gives inf there and the step is refused, so bisect.
+                stry = -fcur * (fblk * dblk - fpre * dpre) / den if den != 0.0 else math.inf
             if 2 * abs(stry) < min(abs(spre), 3 * abs(sbis) - delta):
                 spre, scur = scur, stry  # a good short step
             else:

@@ -226,9 +226,12 @@ def _snapped(mesh: Mesh, v: np.ndarray, b: np.ndarray, measure: bool = True) -> 
     if not measure:
         return out, np.zeros(v.size)
     before, thin_before = _around_min(mesh, [v, b])
-    after, thin_after = _around_min(out, [new_index[b]])
+    # An end point whose faces the merge removed all of is left with none: no gain, a hole.
+    kept = new_index[b]
+    gone = kept < 0
+    after, thin_after = _around_min(out, [np.where(gone, -1, kept)])
     # A move that fattens the thinnest face but leaves more splinters around is no gain.
-    return out, np.where(thin_after > thin_before, -1.0, after - before)
+    return out, np.where(gone | (thin_after > thin_before), -1.0, after - before)
 
 
 def _around_min(mesh: Mesh, groups: list[np.ndarray]) -> tuple[np.ndarray, np.ndarray]:
@@ -236,7 +239,8 @@ def _around_min(mesh: Mesh, groups: list[np.ndarray]) -> tuple[np.ndarray, np.nd
     (k,) how many of those faces are splinters (each counted once)."""
     slot = np.full(mesh.n_vertices, -1)
     for g in groups:
-        slot[g] = np.arange(g.size)
+        there = g >= 0                          # (-1: a vertex the mesh no longer has)
+        slot[g[there]] = np.arange(g.size)[there]
     face_of = np.repeat(np.arange(mesh.n_faces), mesh.valences)
     s = slot[mesh.face_indices]
     out = np.full(groups[0].size, 180.0)
