@@ -533,23 +533,26 @@ def surface_generator_distance(p: np.ndarray, ref: Reference, iters: int = 100, 
         _, near = tree.query(p[off], k=starts + 1)
         for k in range(1, starts + 1):
             u_k = _generator_descent(p[off], ref.grid_u[near[:, k] // T].astype(float), ref, iters)
-            d_k, t_k, l_k = _foot(p[off], u_k, ref)
-            better = d_k < dist[off]
-            u[off[better]] = u_k[better]
-            dist[off[better]], t[off[better]], length[off[better]] = (
-                d_k[better], t_k[better], l_k[better])
+            _keep_nearer(p, off, u_k, ref, (u, dist, t, length))
     off = np.nonzero(dist > 1e-12 * ref.diagonal)[0]
     if len(off) and polish:
         # Where the foot moves fast along the generator as u changes (the waist of a
         # surface close to a cone), Gauss-Newton with t held crawls: a golden-section
         # search on u around what it found settles those points.
         h = 2.0 * float(np.max(np.diff(ref.grid_u)))
-        u_g = _golden(p[off], u[off] - h, u[off] + h, ref)
-        d_g, t_g, l_g = _foot(p[off], u_g, ref)
-        better = d_g < dist[off]
-        dist[off[better]], t[off[better]], length[off[better]] = (
-            d_g[better], t_g[better], l_g[better])
+        _keep_nearer(p, off, _golden(p[off], u[off] - h, u[off] + h, ref), ref, (u, dist, t, length))
     return dist, t, length
+
+
+def _keep_nearer(p: np.ndarray, off: np.ndarray, u_new: np.ndarray, ref: Reference,
+                 found: tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]) -> None:
+    """Where the generator at ``u_new`` is nearer to ``p[off]``, take it into ``found``
+    (``u``, distance, foot t, generator length; updated in place)."""
+    u, dist, t, length = found
+    d_new, t_new, l_new = _foot(p[off], u_new, ref)
+    better = d_new < dist[off]
+    sel = off[better]
+    u[sel], dist[sel], t[sel], length[sel] = u_new[better], d_new[better], t_new[better], l_new[better]
 
 
 def _golden(p: np.ndarray, lo: np.ndarray, hi: np.ndarray, ref: Reference, iters: int = 90

@@ -61,7 +61,7 @@ def run(args) -> int:
     if args.json:
         json.dump(report, sys.stdout, indent=2)
         sys.stdout.write("\n")
-    elif not args.quiet:
+    else:
         print(f"wrote {args.output}: {format_summary(report)}")
         for warning in report.get("warnings", []):
             print(f"warning: {warning}", file=sys.stderr)

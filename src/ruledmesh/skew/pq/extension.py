@@ -20,14 +20,15 @@ import numpy as np
 
 from ...tolerances import ROUNDING
 
-__all__ = ["thinned_rows"]
+__all__ = ["LANDING_SLACK", "thinned_rows"]
 
 # Rows are spread where on every generator they would land closer than this share of a step.
 _BUNCHING = 0.25
 # a-rows measured at a time (the generators x rows temporaries stay small).
 _CHUNK = 2048
-# Landing this far outside [0, 1] (in units of the generator) still counts: a face spans two rows.
-_LANDING_SLACK = 0.05
+# A row this far outside [0, 1] of a generator (in units of its length) still lands on the
+# patch: a face spans two rows.  The b-rows' rooting counts faces on the patch the same way.
+LANDING_SLACK = 0.05
 
 
 def thinned_rows(M: np.ndarray, tau: np.ndarray, own: tuple[float, float], rows: int) -> np.ndarray:
@@ -92,7 +93,7 @@ def _shares(M: np.ndarray, a: np.ndarray, rows: int) -> np.ndarray:
         num = M[:, 0, 0, None] * a + M[:, 0, 1, None]
         den = M[:, 1, 0, None] * a + M[:, 1, 1, None]
         t = num / den
-        lands = np.isfinite(t) & (t > -_LANDING_SLACK) & (t < 1.0 + _LANDING_SLACK)
+        lands = np.isfinite(t) & (t > -LANDING_SLACK) & (t < 1.0 + LANDING_SLACK)
         # A pole between two rows (the denominator's sign changes) makes them far apart.
         through = np.signbit(den[:, 1:]) != np.signbit(den[:, :-1])
         gap = np.where(through, np.inf, np.abs(np.diff(t, axis=1)))

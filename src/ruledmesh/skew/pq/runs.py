@@ -24,7 +24,7 @@ from ...budget import MAX_GRID_POINTS, PQ_BYTES_PER_GRID_POINT
 from ...errors import GeometryError
 from ...kernels import wanted
 from ...tolerances import INTERIOR, RESTART_ANGLE_DEG, ROUNDING, TINY, Tolerances
-from .extension import thinned_rows
+from .extension import LANDING_SLACK, thinned_rows
 from .maps import (
     ChainMaps,
     HopMaps,
@@ -178,7 +178,8 @@ def _root_b_rows(M: np.ndarray, N: np.ndarray, tau: np.ndarray, primary: int,
     lo, hi = np.minimum(lo, hi), np.maximum(lo, hi)
     # Only faces on the patch constrain a row.
     t_mid = apply(M[inner], np.broadcast_to(sigma0, (len(inner), H)).copy())
-    relevant = np.isfinite(lo) & np.isfinite(hi) & (t_mid > -0.05) & (t_mid < 1.05)
+    relevant = (np.isfinite(lo) & np.isfinite(hi) & (t_mid > -LANDING_SLACK)
+                & (t_mid < 1.0 + LANDING_SLACK))
     lo = np.where(relevant, lo, -np.inf)
     hi = np.where(relevant, hi, np.inf)
     order = np.argsort(np.abs(inner - primary - 0.5), kind="stable")

@@ -229,7 +229,7 @@ def _snapped(mesh: Mesh, v: np.ndarray, b: np.ndarray, measure: bool = True) -> 
     # An end point whose faces the merge removed all of is left with none: no gain, a hole.
     kept = new_index[b]
     gone = kept < 0
-    after, thin_after = _around_min(out, [np.where(gone, -1, kept)])
+    after, thin_after = _around_min(out, [kept])
     # A move that fattens the thinnest face but leaves more splinters around is no gain.
     return out, np.where(gone | (thin_after > thin_before), -1.0, after - before)
 
