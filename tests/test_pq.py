@@ -290,6 +290,23 @@ def test_strongly_twisted_hyperboloid_carries_rows_to_its_side_generators(h):
     assert not any("carry no" in w for w in mesh.info["warnings"])
 
 
+def test_full_extension_keeps_the_rows_that_auto_leaves_out():
+    """extend = "full" covers what "auto" covers, with every row of the even division: on
+    the twisted hyperboloid the bunched rows cut the runs short again, so the side
+    generators carry no rows (what thinning avoids); the mesh is as exact, and a misspelt
+    word is refused naming the parameter."""
+    A, B = hyperboloid_lines(2.0, 1.0, 0.0, np.pi, 61, h=3.0)
+    auto = pq_mesh(A, B, rows=24)
+    full = pq_mesh(A, B, rows=24, extend="full")
+    check_mesh(full)
+    assert (auto.info["extend"], full.info["extend"]) == ("auto", "full")
+
+    assert any("carry no" in w for w in full.info["warnings"])
+    assert not any("carry no" in w for w in auto.info["warnings"])
+    with pytest.raises(ParameterError, match="extend"):
+        pq_mesh(A, B, rows=24, extend="fill")
+
+
 def test_rows_that_do_not_bunch_are_all_kept():
     from ruledmesh.skew.pq.extension import thinned_rows
 

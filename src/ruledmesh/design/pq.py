@@ -35,9 +35,10 @@ def build_pq(rulings, table: Mapping[str, Any], ctx: BuildContext) -> Built:
         primary = check_int(primary, "mesh.primary", lo=-m, hi=m - 1, err=DesignError)
     option = check_int(table.get("option", 0), "mesh.option", lo=0, hi=1, err=DesignError)
     extend = table.get("extend", "auto")
-    if extend != "auto":
+    if extend != "auto" and extend != "full":
         if isinstance(extend, str):
-            raise DesignError(f'expected "auto" or a number >= 0, got {describe(extend)}', "mesh.extend")
+            raise DesignError(f'expected "auto", "full" or a number >= 0, got {describe(extend)}',
+                              "mesh.extend")
         extend = check_float(extend, "mesh.extend", lo=0.0, hi=1e3, err=DesignError)
     trim = check_bool(table.get("trim", True), "mesh.trim", err=DesignError)
     max_extend = check_float(table.get("max_extend", 20.0), "mesh.max_extend", lo=0.0, hi=1e3,
@@ -146,7 +147,8 @@ def _refined(rulings, mesh, options: dict):
     generators with each torsal band spanned by one coplanar pair
     (:mod:`.torsal`: strip quads instead of the band's triangles; the user's
     generators inside the band are left out), and with a planarity tolerance,
-    where the meshes so far miss a goal, from the exact rows too.  Of all the
+    where the meshes so far miss a goal, from the exact rows too, and then from
+    an extension that keeps every row (``extend = "full"``).  Of all the
     meshes made, the one kept is first by :func:`_fabricable`.
     """
     from ..rulings import dense_grid
@@ -165,6 +167,13 @@ def _refined(rulings, mesh, options: dict):
         # An exact mesh is within any tolerance: where the tolerance's cuts (nearly flat
         # strips) leave stretches without rows, the exact rows can do better.
         rounds += _candidates(rulings, _mesh(rulings, exact), exact, grid, user, goal)
+    if options["planarity_tolerance"] > DEFAULT.planarity and options["extend"] == "auto" and \
+            max(_fabricable(r, goal) for r in rounds)[0] < 2:
+        # Where the rows far out on the primary bunch, the automatic extension leaves them
+        # out; with a tolerance the stretches they then leave without rows can do better
+        # (generators with an even division, whose triangles pair into quads within it).
+        full = {**options, "extend": "full"}
+        rounds += _candidates(rulings, _mesh(rulings, full), full, grid, user, goal)
     best = _worth_its_panels(max(rounds, key=lambda r: _fabricable(r, goal)), rounds, goal)
     added = int(best[3].info.get("inserted", 0)) - int(rulings.info.get("inserted", 0))
     rulings, mesh = best[3], best[4]
@@ -172,6 +181,9 @@ def _refined(rulings, mesh, options: dict):
     if options["planarity_tolerance"] > mesh.info.get("planarity_tolerance", DEFAULT.planarity):
         notes.append("every face is planar to rounding: the exact mesh had more of its area in "
                      "quads than one using the planarity tolerance")
+    if mesh.info.get("extend") == "full" and options["extend"] == "auto":
+        notes.append('every row of the extension kept (as [mesh] extend = "full"): that mesh had '
+                     "more of its area in quads")
     if added > 0:
         notes.append(f"{added} generators of the smooth surface added where the rows needed them "
                      f"({len(rulings.u)} in all, {user} given)")

@@ -25,6 +25,7 @@ from .runs import (
     Division,
     Run,
     carrier,
+    matched,
     mesh_run,
 )
 from .splinters import open_walled_splinters, snap_to_border, trim_border_needles
@@ -175,11 +176,11 @@ def _build_segment(plan: _Plan, lo: int, hi: int, primary: int, div: Division,
                    plan.tol, plan.scale, plan.warnings, plan.hops)
     runs = [run]
     if right is not None:
-        matched = Division(div.rows, div.option, "auto", div.max_extend, run.inside_t(new_hi))
-        runs += _build_segment(plan, new_hi, hi, 0, matched, budget, shared=new_hi)
+        runs += _build_segment(plan, new_hi, hi, 0, matched(div, run.inside_t(new_hi)), budget,
+                               shared=new_hi)
     if left is not None:
-        matched = Division(div.rows, div.option, "auto", div.max_extend, run.inside_t(new_lo))
-        runs += _build_segment(plan, lo, new_lo, new_lo - lo, matched, budget, shared=new_lo)
+        runs += _build_segment(plan, lo, new_lo, new_lo - lo, matched(div, run.inside_t(new_lo)),
+                               budget, shared=new_lo)
     return runs
 
 
@@ -279,10 +280,13 @@ def pq_mesh(a, b, rows: int = 20, primary: int | str = "middle", option: int = 0
         Index of the primary generator (negative indices count from the end).
     option : {0, 1}
         Which colour of the checkerboard carries the vertices (the paper's two options).
-    extend : "auto" or float
+    extend : "auto", "full" or float
         How far the division of the primary generator continues beyond
         ``[0, 1]`` (in primary-generator lengths); ``"auto"`` takes just what
-        covers the patch on every generator, found from the row maps.
+        covers the patch on every generator, found from the row maps, and leaves
+        out the rows that would bunch there
+        (:func:`~ruledmesh.skew.pq.extension.thinned_rows`); ``"full"`` covers the
+        same range with every row of the even division.
     trim : bool
         Trim the faces to the patch ``0 <= t <= 1``, keeping every vertex on a
         generator.
@@ -361,7 +365,8 @@ def pq_mesh(a, b, rows: int = 20, primary: int | str = "middle", option: int = 0
     _warn_splinters(mesh, warnings, torsal, measured)
     if kept.size < m_given:
         mesh = _renumbered(mesh, kept)
-    return mesh.with_info(runs=len(parts), restarts=restarts, planarity_tolerance=ptol, **fattening)
+    return mesh.with_info(runs=len(parts), restarts=restarts, planarity_tolerance=ptol,
+                          extend=args.extend, **fattening)
 
 
 def _cut(a, d, rows, ptol, scale, tol, creases, crease_generators, warnings):
@@ -471,9 +476,10 @@ def _checked(a, b, rows, primary, option, extend, trim, max_extend, planarity_to
         p = m // 2
     else:
         p = check_int(primary, "primary", lo=-m, hi=m - 1) % m
-    if not (isinstance(extend, str) and extend == "auto"):
+    if not (isinstance(extend, str) and extend in ("auto", "full")):
         if isinstance(extend, str):
-            raise ParameterError(f'expected "auto" or a number >= 0, got {describe(extend)}', "extend")
+            raise ParameterError(f'expected "auto", "full" or a number >= 0, got {describe(extend)}',
+                                 "extend")
         extend = check_float(extend, "extend", lo=0.0, hi=1e3)
     max_extend = check_float(max_extend, "max_extend", lo=0.0, hi=1e3)
     ptol = tol.planarity if planarity_tolerance is None else check_float(
@@ -721,7 +727,7 @@ def _build_all(plan: _Plan, segs: list[_Segment], p: int, middle: bool, div: Div
                                           budget)
             else:
                 t = _boundary_t(built[k - step], src)
-                sub = Division(div.rows, div.option, "auto", div.max_extend, t if t.size else None)
+                sub = matched(div, t if t.size else None)
                 built[k] = _build_segment(plan, s.lo, s.hi, primary, sub, budget,
                                           shared=src if crease else None)
             k += step

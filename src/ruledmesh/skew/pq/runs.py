@@ -38,7 +38,7 @@ from .maps import (
     propagate,
 )
 
-__all__ = ["MAX_GRID_POINTS", "Division", "Run", "carrier", "mesh_run"]
+__all__ = ["MAX_GRID_POINTS", "Division", "Run", "carrier", "matched", "mesh_run"]
 
 # The grid-point limit and the memory per point: ruledmesh.budget.
 BYTES_PER_GRID_POINT = PQ_BYTES_PER_GRID_POINT
@@ -100,7 +100,7 @@ def _uniform_rows(M: np.ndarray, div: Division, primary_global: int, tol: Tolera
     left out (:func:`~ruledmesh.skew.pq.extension.thinned_rows`).
     """
     rows = div.rows
-    if div.extend == "auto":
+    if isinstance(div.extend, str):         # "auto" or "full": what covers the patch
         lo, hi, bounded = patch_preimage(M, tol.degenerate)
         if not np.all(bounded):
             warnings.append(f"{int((~bounded).sum())} generators cannot be covered by a finite "
@@ -126,10 +126,21 @@ def _uniform_rows(M: np.ndarray, div: Division, primary_global: int, tol: Tolera
     return thinned_rows(M, tau, (0.0, 1.0), rows) if div.extend == "auto" else tau
 
 
+def matched(div: Division, t: np.ndarray | None) -> Division:
+    """The division of a run continuing ``div``'s on a generator whose vertices are ``t``.
+
+    Its extension is automatic; bunched rows beyond ``t`` are left out unless ``div``
+    keeps every row (``extend = "full"``).
+    """
+    return Division(div.rows, div.option, "full" if div.extend == "full" else "auto",
+                    div.max_extend, t)
+
+
 def _matched_rows(M: np.ndarray, div: Division, tol: Tolerances) -> np.ndarray:
     """Root parameters from a matched division, extended by the end spacings.
 
-    Beyond the given rows those that would bunch on every generator are left out.
+    Beyond the given rows those that would bunch on every generator are left out
+    (unless ``div.extend`` is ``"full"``).
     """
     given = np.asarray(div.matched, dtype=np.float64)
     lo, hi, bounded = patch_preimage(M, tol.degenerate)
@@ -152,6 +163,8 @@ def _matched_rows(M: np.ndarray, div: Division, tol: Tolerances) -> np.ndarray:
     out[0::2] = a_rows
     out[1:-1:2] = mid
     out[-1] = a_rows[-1] + 0.5 * s1
+    if div.extend == "full":
+        return out
     return thinned_rows(M, out, (float(given[0]), float(given[-1])), div.rows)
 
 
