@@ -45,3 +45,48 @@ def test_pipe_and_revolution_distances():
                                       2 * np.pi, np.array([1.0, 0, 0]))
     np.testing.assert_allclose(cylinder.distance(np.array([[3.0, 0, 1], [0, 0.5, 2], [2, 0, 7]])),
                                [1.0, 1.5, 2.0], atol=1e-15)
+
+
+def _design(name: str) -> str:
+    from pathlib import Path
+
+    root = Path(__file__).resolve().parents[1]
+    path = root / "examples" / f"{name}.toml"
+    return str(path if path.exists() else root / "benchmarks" / "quality" / f"{name}.toml")
+
+
+def test_closeness_starts_at_each_vertex_own_place():
+    """A §4.3 build tells the reference each generator's u: every vertex is point(u_g, t).
+    On the linear-directrix example the search from samples had left vertices 1.3e-2 of
+    the diagonal off the surface they lie on (to rounding); from their own place they read
+    rounding, and the analysis reports that."""
+    from ruledmesh.analysis.report import analyze
+    from ruledmesh.api import build_full
+
+    built = build_full(_design("linear-directrix"))
+    assert built.reference.vertex_parameters(built.mesh) is not None
+    assert analyze(built.mesh, built.reference)["closeness"]["vertices_max"] <= 1e-14
+    searched = built.reference.distance(built.mesh.vertices) / built.mesh.diagonal()
+    assert searched.max() > 1e-3            # what the search alone finds there
+
+
+def test_closeness_searches_where_a_face_start_is_on_another_part():
+    """On the Pluecker conoid two faces' mean parameters descend to a foot 2.3e-2 of the
+    diagonal away, where the nearest point is 4.6e-4 away: those (everything farther than
+    CLOSENESS_SEARCH) are searched from samples as well, so the figure is the search's."""
+    from ruledmesh.analysis.faces import face_centroids
+    from ruledmesh.api import build_full
+    from ruledmesh.tolerances import CLOSENESS_SEARCH
+
+    built = build_full(_design("plucker-conoid"))
+    mesh, ref = built.mesh, built.reference
+    u, t = ref.vertex_parameters(mesh)
+    near = tuple(np.add.reduceat(x[mesh.face_indices], mesh.face_offsets[:-1]) / mesh.valences
+                 for x in (u, t))
+    c, diag = face_centroids(mesh), mesh.diagonal()
+    seeded_only = ref.distance(c, near=near, beyond=np.inf) / diag
+    checked = ref.distance(c, near=near, beyond=CLOSENESS_SEARCH * diag) / diag
+    searched = ref.distance(c) / diag
+    assert seeded_only.max() > 10 * searched.max()
+    assert np.all(checked <= seeded_only)
+    assert checked.max() == pytest.approx(searched.max(), rel=1e-6)

@@ -23,7 +23,8 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
-__all__ = ["BORDER_TRIM_MAX_GAP", "BRENTQ_XTOL", "COLLINEAR", "COLLINEAR_SQ", "CONGRUENCE_ANGLE_DEG", "CONVERGED",
+__all__ = ["BORDER_TRIM_MAX_GAP", "BRENTQ_XTOL", "CLOSENESS_SEARCH", "COLLINEAR", "COLLINEAR_SQ",
+           "CONGRUENCE_ANGLE_DEG", "CONVERGED",
            "COLLAPSE_MAX_SAG", "DEFAULT", "DEPTH_BIAS", "FLAT_PAIR_MAX_SAG", "FLIP_ACTIVE_DEG", "FLIP_MAX_BEND_DEG",
            "FLIP_MAX_SAG", "FLIP_MIN_GAIN_DEG", "FLOAT32_WARNING", "INTERIOR", "KKT_REGULARISATION",
            "MIN_EXTENT", "MIN_HALF_ANGLE", "MIN_RELATIVE_EXTENT", "MITRE_FLOOR", "NEARLY_DEVELOPABLE", "OCCT_FACE",
@@ -106,6 +107,11 @@ PARAMETER_SLACK = 1e-9
 #: A Gauss-Newton step smaller than this (in parameter space) no longer moves the point:
 #: the nearest-point search of the closeness analysis stops there.
 SETTLED = 1e-13
+#: The closeness analysis starts each vertex's descent at its own place on the patch (where
+#: the mesher says it) and searches from samples too only where that ends farther than this
+#: share of the diagonal (a face across a fold of the surface).  Most faces of a mesh of the
+#: regression designs lie closer; the search costs 8-35 times the seeded descent.
+CLOSENESS_SEARCH = 1e-4
 #: Two roots of the same equation closer than this (in parameter space) are one root.
 SAME_ROOT = 1e-8
 

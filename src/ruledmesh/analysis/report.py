@@ -33,7 +33,7 @@ from .._arrays import median, percentile, unique
 from ..errors import GeometryError
 from ..mesh import FaceKind, Mesh
 from ..progress import Progress, stages
-from ..tolerances import DEFAULT, Tolerances
+from ..tolerances import CLOSENESS_SEARCH, DEFAULT, Tolerances
 from . import faces as F
 from .live import face_measures, figure_warnings, min_max_mean, scaled_back, unit_copy, unit_figures
 
@@ -240,8 +240,21 @@ def _t_junctions(mesh: Mesh) -> dict[str, Any]:
 def _closeness(mesh: Mesh, reference, mesh_area: float) -> dict[str, Any]:
     """Closeness to the smooth patch and coverage of it (relative to the diagonal)."""
     diag = mesh.diagonal() or 1.0
-    dc = reference.distance(F.face_centroids(mesh)) / diag
-    dv = reference.distance(mesh.vertices[unique(mesh.face_indices)]) / diag
+    used = unique(mesh.face_indices)
+    known = getattr(reference, "vertex_parameters", lambda _: None)(mesh)
+    if known is None:
+        dc = reference.distance(F.face_centroids(mesh)) / diag
+        dv = reference.distance(mesh.vertices[used]) / diag
+    else:
+        # Where the mesher says on which generator and where each vertex lies, the
+        # descent starts there (a face's at the mean of its corners'); only what ends
+        # farther than CLOSENESS_SEARCH is searched for from samples too.
+        u, t = known
+        corner = mesh.face_indices
+        mean = [np.add.reduceat(x[corner], mesh.face_offsets[:-1]) / mesh.valences for x in (u, t)]
+        beyond = CLOSENESS_SEARCH * diag
+        dc = reference.distance(F.face_centroids(mesh), near=(mean[0], mean[1]), beyond=beyond) / diag
+        dv = reference.distance(mesh.vertices[used], near=(u[used], t[used]), beyond=beyond) / diag
     out: dict[str, Any] = {"closeness": {
         "vertices_max": float(dv.max()) if dv.size else 0.0,
         "centroids_max": float(dc.max()) if dc.size else 0.0,

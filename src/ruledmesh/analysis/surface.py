@@ -34,10 +34,30 @@ class RuledReference:
         Has ``point(u, t)``, ``partials(u, t)`` and ``area()``.
     samples : int
         Grid resolution of the seeding samples per direction.
+    generator_u : (m,) float64, optional
+        The surface parameter ``u`` of each generator that a mesh's
+        ``vertex_data["generator"]`` indexes (its vertex ``a_g + t (b_g - a_g)`` is
+        ``point(u_g, t)``): :meth:`vertex_parameters` then knows where on the patch
+        each vertex lies, and the search needs no samples.
     """
 
     surface: RuledPatch
     samples: int = 64
+    generator_u: np.ndarray | None = None
+
+    def vertex_parameters(self, mesh) -> tuple[np.ndarray, np.ndarray] | None:
+        """(V,) ``u`` and ``t`` of each vertex of ``mesh``, where :attr:`generator_u` says.
+
+        None without them, or when the mesh's vertex data do not index them
+        (another mesh than the one built with these generators).
+        """
+        data = mesh.vertex_data
+        if self.generator_u is None or "generator" not in data or "t" not in data:
+            return None
+        g = np.asarray(data["generator"], dtype=np.int64)
+        if g.size != mesh.n_vertices or (g.size and (g.min() < 0 or g.max() >= len(self.generator_u))):
+            return None
+        return np.asarray(self.generator_u, dtype=np.float64)[g], np.asarray(data["t"], dtype=np.float64)
     _cache: dict = field(default_factory=dict, repr=False)
 
     def _seeds(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
@@ -140,13 +160,33 @@ class RuledReference:
             live = live[moving]
         return u, t
 
-    def distance(self, points: np.ndarray) -> np.ndarray:
-        """(n,) float64: distance of each point from the patch."""
+    def distance(self, points: np.ndarray, near: tuple[np.ndarray, np.ndarray] | None = None,
+                 beyond: float = 0.0) -> np.ndarray:
+        """(n,) float64: distance of each point from the patch.
+
+        ``near``: (n,) ``u`` and ``t`` of a point of the patch near each point (a
+        vertex's own, a face's mean of its corners'): the descent starts there
+        instead of at the nearest samples, and only the points it leaves farther
+        than ``beyond`` from the patch are searched from the samples as well (the
+        nearer result kept).  A mesh's vertices and most of its faces then need
+        no search.
+        """
         points = np.asarray(points, dtype=np.float64).reshape(-1, 3)
         if len(points) == 0:
             return np.zeros(0)
-        u, t = self.closest(points)
-        return np.linalg.norm(self.surface.point(u, t) - points, axis=1)
+        if near is None:
+            u, t = self.closest(points)
+            return np.linalg.norm(self.surface.point(u, t) - points, axis=1)
+        u0 = np.clip(np.asarray(near[0], dtype=np.float64), 0.0, 1.0)
+        t0 = np.clip(np.asarray(near[1], dtype=np.float64), 0.0, 1.0)
+        u, t = self._descend(points, u0, t0, 12)
+        d = np.linalg.norm(self.surface.point(u, t) - points, axis=1)
+        far = np.flatnonzero(d > beyond)
+        if far.size:
+            # The start's own part of the surface may not hold the nearest point (a face
+            # across a fold, a strip quad spanning a torsal band).
+            d[far] = np.minimum(d[far], self.distance(points[far]))
+        return d
 
     def area(self) -> float:
         """Area of the smooth patch."""

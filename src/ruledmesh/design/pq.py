@@ -56,7 +56,8 @@ def build_pq(rulings, table: Mapping[str, Any], ctx: BuildContext) -> Built:
     if getattr(rulings, "surface", None) is not None:
         from ..surfaces import RuledReference
 
-        reference = RuledReference(rulings.surface)
+        # Every vertex is a_g + t (b_g - a_g) = point(u_g, t): the closeness needs no search.
+        reference = RuledReference(rulings.surface, generator_u=np.asarray(rulings.u, dtype=np.float64))
     return Built(mesh.with_info(source=ctx.source), reference, rulings)
 
 
