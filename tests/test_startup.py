@@ -84,6 +84,12 @@ def test_small_build_loads_no_scipy(tmp_path, example):
     names = imported(code, tmp_path)
     assert (tmp_path / "m.obj").is_file()
     assert _offenders(names) == []
+    # The command line names its subcommand: the other subcommands' modules stay unloaded.
+    from ruledmesh.cli import COMMANDS
+
+    # (build writes its file through export's options)
+    others = {f"ruledmesh.cli.{c}" for c in COMMANDS if c not in ("build", "export")}
+    assert not others & names, sorted(others & names)
 
 
 @pytest.mark.parametrize("example", ["fig7b-hyperboloid-circular", "fig8-helicoid", "fig6a-prism", "skew"])

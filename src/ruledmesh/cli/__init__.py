@@ -29,8 +29,12 @@ EPILOG = """examples:
 """
 
 
-def build_parser() -> argparse.ArgumentParser:
-    """The top-level parser with every available subcommand."""
+def build_parser(only: str | None = None) -> argparse.ArgumentParser:
+    """The top-level parser with every available subcommand, or with ``only`` that one.
+
+    A command line naming its subcommand needs no other: their modules (and what
+    they import) stay unloaded, which a small build's start-up notices.
+    """
     from .. import __version__
 
     parser = argparse.ArgumentParser(
@@ -42,7 +46,7 @@ def build_parser() -> argparse.ArgumentParser:
     parser.add_argument("--version", action="version", version=f"ruledmesh {__version__}")
     parser.add_argument("--debug", action="store_true", help="show tracebacks of errors")
     sub = parser.add_subparsers(dest="command", metavar="COMMAND")
-    for name in COMMANDS:
+    for name in COMMANDS if only is None else [only]:
         try:
             module = importlib.import_module(f"{__name__}.{name}")
         except ModuleNotFoundError as exc:
@@ -89,8 +93,11 @@ def main(argv: Sequence[str] | None = None) -> int:
     3 an internal error (a bug: please report it with ``--debug`` output),
     130 interrupted, 141 the reader of stdout went away (``| head``).
     """
-    parser = build_parser()
-    args = parser.parse_args(argv)
+    words = list(sys.argv[1:] if argv is None else argv)
+    # The top-level options take no value: the first word that is not one is the subcommand.
+    first = next((w for w in words if not w.startswith("-")), None)
+    parser = build_parser(first if first in COMMANDS else None)
+    args = parser.parse_args(words)
     if not getattr(args, "run", None):
         parser.print_help()
         return 2
