@@ -281,12 +281,9 @@ def pq_mesh(a, b, rows: int = 20, primary: int | str = "middle", option: int = 0
     option : {0, 1}
         Which colour of the checkerboard carries the vertices (the paper's two options).
     extend : "auto", "full" or float
-        How far the division of the primary generator continues beyond
-        ``[0, 1]`` (in primary-generator lengths); ``"auto"`` takes just what
-        covers the patch on every generator, found from the row maps, and leaves
-        out the rows that would bunch there
-        (:func:`~ruledmesh.skew.pq.extension.thinned_rows`); ``"full"`` covers the
-        same range with every row of the even division.
+        How far the division of the primary continues beyond ``[0, 1]`` (in its
+        lengths); ``"auto"`` covers the patch on every generator, leaving out rows
+        that would bunch (:mod:`.extension`); ``"full"`` keeps every row.
     trim : bool
         Trim the faces to the patch ``0 <= t <= 1``, keeping every vertex on a
         generator.
@@ -365,8 +362,7 @@ def pq_mesh(a, b, rows: int = 20, primary: int | str = "middle", option: int = 0
     _warn_splinters(mesh, warnings, torsal, measured)
     if kept.size < m_given:
         mesh = _renumbered(mesh, kept)
-    return mesh.with_info(runs=len(parts), restarts=restarts, planarity_tolerance=ptol,
-                          extend=args.extend, **fattening)
+    return mesh.with_info(runs=len(parts), restarts=restarts, planarity_tolerance=ptol, extend=args.extend, **fattening)
 
 
 def _cut(a, d, rows, ptol, scale, tol, creases, crease_generators, warnings):
