@@ -9,6 +9,7 @@ from __future__ import annotations
 import io
 import os
 import pty
+import re
 import select
 import subprocess
 import sys
@@ -52,9 +53,16 @@ def test_build_reports_its_stages_in_order_and_closes():
     assert [note for _, _, note in rec.steps if note] == ["mesh", "transforms"]
     assert sum(n for _, n, _ in rec.steps) == 2 and rec.closed == ["build"]
     rec = Recorder()
-    build_file(EXAMPLES / "skew.toml", progress=rec)
+    built = build_file(EXAMPLES / "skew.toml", progress=rec)
     assert rec.tasks == [("build", 2)]                       # ruled: generators, mesh
-    assert [note for _, _, note in rec.steps if note] == ["generators", "mesh"]
+    notes = [note for _, _, note in rec.steps if note]
+    assert notes[:2] == ["generators", "mesh"]
+    # The refinement's meshes, counted, each with its generators (no unit of the bar).
+    made = [re.fullmatch(r"mesh (\d+), (\d+) generators", note) for note in notes[2:]]
+    assert len(made) >= 2 and all(made)
+    assert [int(m.group(1)) for m in made] == list(range(1, len(made) + 1))
+    assert len(built.rulings.u) in {int(m.group(2)) for m in made}
+    assert all(n == 0 for _, n, note in rec.steps if note and note.startswith("mesh "))
 
 
 def test_analysis_reports_every_figure(capsys):

@@ -57,11 +57,15 @@ class BuildContext:
         Folder relative paths in the design resolve against.
     design : mapping
         The whole design (read-only), for builders that look at other tables.
+    task : Task, optional
+        The build's progress task (:mod:`ruledmesh.progress`): a builder that makes
+        several meshes may say which one it is at (``task.advance(0, note)``).
     """
 
     source: str = "<design>"
     base_dir: Path = Path(".")
     design: Mapping[str, Any] = field(default_factory=dict)
+    task: Any = None
 
 
 @dataclass(frozen=True)

@@ -14,7 +14,7 @@ import os
 import sys
 import tomllib
 from collections.abc import Mapping
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from pathlib import Path
 from typing import Any
 
@@ -199,15 +199,13 @@ def _build(design: Design, progress: Progress) -> Built:
         if transforms:
             _in_range(built.mesh, "the transformed mesh")
             task.advance()
-    from dataclasses import replace
-
     return replace(built, mesh=built.mesh.with_info(units=units.value))
 
 
 def _build_surface(design: Design, mesh_table: Mapping, task: Task) -> Built:
     """The mesh of the [surface] or [rulings] tables, before any transform."""
     data = design.data
-    ctx = design.context
+    ctx = replace(design.context, task=task)
     if "surface" in data:
         if "rulings" in data:
             raise DesignError("give either [surface] or [rulings], not both", "rulings")
@@ -370,8 +368,6 @@ def _with_creases(rulings, table: Mapping, curves: Mapping) -> Any:
     inverted (no smooth surface), the strips holding a kink are recorded in
     ``info["creases"]`` and the mesher closes them with triangles.
     """
-    from dataclasses import replace
-
     names = table.get("between")
     if "conoid" in table and isinstance(table["conoid"], Mapping):
         names = [table["conoid"].get("curve")]

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import contextvars
 from collections.abc import Mapping
 from typing import Any
 
@@ -49,9 +50,14 @@ def build_pq(rulings, table: Mapping[str, Any], ctx: BuildContext) -> Built:
     refine = check_bool(table.get("refine", True), "mesh.refine", err=DesignError)
     options = {"rows": rows, "primary": primary, "option": option, "extend": extend,
                "trim": trim, "max_extend": max_extend, "planarity_tolerance": ptol}
-    mesh = _mesh(rulings, options)
-    if refine:
-        rulings, mesh = _refined(rulings, mesh, options)
+    token = _PROGRESS.set([ctx.task, 0]) if ctx.task is not None else None
+    try:
+        mesh = _mesh(rulings, options)
+        if refine:
+            rulings, mesh = _refined(rulings, mesh, options)
+    finally:
+        if token is not None:
+            _PROGRESS.reset(token)
     reference = None
     if getattr(rulings, "surface", None) is not None:
         from ..surfaces import RuledReference
@@ -61,7 +67,16 @@ def build_pq(rulings, table: Mapping[str, Any], ctx: BuildContext) -> Built:
     return Built(mesh.with_info(source=ctx.source), reference, rulings)
 
 
+# The build's progress task and how many meshes it has made, while build_pq runs: the
+# refinement makes up to about twenty, and a long build says which one it is at.
+_PROGRESS: contextvars.ContextVar[list | None] = contextvars.ContextVar("pq_progress", default=None)
+
+
 def _mesh(rulings, options: dict):
+    said = _PROGRESS.get()
+    if said is not None:
+        said[1] += 1
+        said[0].advance(0, note=f"mesh {said[1]}, {len(rulings.a)} generators")
     return pq_mesh(rulings.a, rulings.b, creases=rulings.info.get("creases"),
                    crease_generators=rulings.info.get("crease_generators"), **options)
 
