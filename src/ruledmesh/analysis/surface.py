@@ -44,6 +44,7 @@ class RuledReference:
     surface: RuledPatch
     samples: int = 64
     generator_u: np.ndarray | None = None
+    _cache: dict = field(default_factory=dict, repr=False)
 
     def vertex_parameters(self, mesh) -> tuple[np.ndarray, np.ndarray] | None:
         """(V,) ``u`` and ``t`` of each vertex of ``mesh``, where :attr:`generator_u` says.
@@ -58,7 +59,6 @@ class RuledReference:
         if g.size != mesh.n_vertices or (g.size and (g.min() < 0 or g.max() >= len(self.generator_u))):
             return None
         return np.asarray(self.generator_u, dtype=np.float64)[g], np.asarray(data["t"], dtype=np.float64)
-    _cache: dict = field(default_factory=dict, repr=False)
 
     def _seeds(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """Sample points of the patch and their parameters ``u``, ``t``."""
