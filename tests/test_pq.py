@@ -350,3 +350,71 @@ def test_rows_beyond_the_primary_part_are_spread_where_they_bunch(rows, k):
     wide = np.zeros(len(a) - 1, bool)
     wide[far] = k / a[:-1][far] - k / a[1:][far] >= extension._BUNCHING * 2.0 / rows
     assert np.isin(a[1:][wide], kept).all()
+
+
+def test_respaced_restarts_keep_the_rows_spread_on_a_strongly_twisted_surface():
+    """Between two half circles turned by 160 degrees (a hyperboloid near its waist cone) the
+    rows of an even division bunch on the generators a quarter turn away and gape elsewhere;
+    restarting where they gape, with the division evened there, puts more of the area in
+    quads, the faces as exact, and the widest gap between the rows on the patch shrinks."""
+    from ruledmesh.skew.pq.respacing import SPREAD
+
+    h = np.tan(np.radians(80.0))
+    A, B = hyperboloid_lines(4.0 / np.hypot(1.0, h), 1.5 / h, 0.0, np.pi, 61, h=h)
+    plain = pq_mesh(A, B, rows=24)
+    spaced = pq_mesh(A, B, rows=24, respace=True)
+    check_mesh(spaced)
+    assert (plain.info["respace"], spaced.info["respace"]) == (False, True)
+    assert spaced.info["restarts"] > plain.info["restarts"]
+
+    def quads(mesh):
+        area = face_areas(mesh)
+        return area[mesh.valences == 4].sum() / area.sum()
+
+    def widest_gap(mesh):
+        g, t = mesh.vertex_data["generator"], mesh.vertex_data["t"]
+        order = np.lexsort((t, g))
+        g, t = g[order], t[order]
+        return np.max(np.where(g[1:] == g[:-1], np.diff(t), 0.0))
+
+    assert quads(spaced) > quads(plain) + 0.03, (quads(plain), quads(spaced))
+    assert widest_gap(spaced) < widest_gap(plain)
+    assert widest_gap(plain) > SPREAD * 2 / 24
+    with pytest.raises(ParameterError, match="respace"):
+        pq_mesh(A, B, rows=24, respace="yes")
+
+
+@given(st.lists(st.floats(0.0, 1.0), min_size=2, max_size=60, unique=True), st.integers(2, 80))
+@settings(max_examples=200, deadline=None)
+def test_evened_division_steps_stay_within_half_and_one_and_a_half_steps(values, rows):
+    """The evened division keeps its ends and only entries of the division it evens, and
+    every entry of that division lies within half a step of one it keeps; its steps stay
+    within half a step and a step and a half (unless the whole division is shorter)."""
+    from ruledmesh.skew.pq.respacing import evened
+
+    t = np.sort(np.asarray(values))
+    out = evened(t, rows)
+    step = 2.0 / rows
+    assert np.all(np.diff(out) > 0)
+    assert (out[0], out[-1]) == (t[0], t[-1])
+    kept = out[np.isin(out, t)]
+    nearest = np.abs(t[:, None] - kept[None, :]).min(axis=1)
+    assert np.all(nearest < 0.5 * step + 1e-12)
+    if t[-1] - t[0] >= 0.5 * step:
+        assert np.diff(out).min() >= 0.5 * step * (1 - 1e-9)
+    assert np.diff(out).max() <= 1.5 * step * (1 + 1e-9)
+
+
+def test_spread_generators_are_those_whose_rows_gape():
+    from ruledmesh.skew.pq.respacing import spread_generators
+
+    even = np.linspace(0.0, 1.0, 13)                 # the division's own step, 2 / 24
+    gaping = np.r_[np.linspace(0.0, 0.3, 8), 0.9]    # a gap of 0.6: 7.2 steps
+    short = np.array([0.45])                         # one vertex: left to the torsal cases
+    t = np.r_[even, gaping, short, even - 0.5]       # the last: half beyond the border
+    gen = np.repeat([5, 6, 7, 8], [13, 9, 1, 13])
+    far = np.zeros(t.size, bool)
+    got = spread_generators(t, gen, far, 5, 4, rows=24)
+    assert got.tolist() == [False, True, False, True]
+    far[gen == 6] = True
+    assert not spread_generators(t, gen, far, 5, 4, rows=24)[1]

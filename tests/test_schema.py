@@ -81,6 +81,7 @@ BAD = [
     ("fig5a-transformed-rotational", [(("transform", 0, "xw"), 1.0)], "transform"),
     ("skew", [(("mesh", "rows"), 0)], "mesh.rows"),
     ("skew", [(("mesh", "extend"), "far")], "mesh.extend"),
+    ("skew", [(("mesh", "respace"), "sometimes")], "mesh.respace"),
     ("skew", [(("mesh", "method"), "quads")], "mesh.method"),
     ("skew", [(("mesh", "divisions"), 4)], "mesh"),
     ("skew", [(("surface",), {"kind": "torus", "R": 3.0, "r": 1.0})], "rulings"),

@@ -179,10 +179,11 @@ def check_float(value: Any, name: str, *, lo: float | None = None, hi: float | N
     return fvalue
 
 
-def check_bool(value: Any, name: str, *, err: type = ParameterError) -> bool:
-    """Return ``value`` if it is a boolean."""
+def check_bool(value: Any, name: str, *, err: type = ParameterError, word: str | None = None) -> bool:
+    """Return ``value`` if it is a boolean (the error names ``word`` too where it is also accepted)."""
     if not isinstance(value, (bool, np.bool_)):
-        raise err(f"expected true or false, got {describe(value)}", name)
+        expected = f'"{word}", true or false' if word else "true or false"
+        raise err(f"expected {expected}, got {describe(value)}", name)
     return bool(value)
 
 

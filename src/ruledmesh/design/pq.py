@@ -19,7 +19,7 @@ from ..tolerances import DEFAULT, TINY
 __all__ = ["MESH_KEYS", "build_pq"]
 
 MESH_KEYS = ("method", "rows", "primary", "option", "extend", "trim", "max_extend",
-             "planarity_tolerance", "refine")
+             "planarity_tolerance", "refine", "respace")
 
 
 @mesh_method("pq")
@@ -48,13 +48,17 @@ def build_pq(rulings, table: Mapping[str, Any], ctx: BuildContext) -> Built:
     ptol = check_float(table.get("planarity_tolerance", DEFAULT.planarity), "mesh.planarity_tolerance",
                        lo=0.0, hi=0.1, err=DesignError)
     refine = check_bool(table.get("refine", True), "mesh.refine", err=DesignError)
+    respace = table.get("respace", "auto")
+    if respace != "auto":
+        respace = check_bool(respace, "mesh.respace", err=DesignError, word="auto")
     options = {"rows": rows, "primary": primary, "option": option, "extend": extend,
-               "trim": trim, "max_extend": max_extend, "planarity_tolerance": ptol}
+               "trim": trim, "max_extend": max_extend, "planarity_tolerance": ptol,
+               "respace": respace is True}
     token = _PROGRESS.set([ctx.task, 0]) if ctx.task is not None else None
     try:
         mesh = _mesh(rulings, options)
         if refine:
-            rulings, mesh = _refined(rulings, mesh, options)
+            rulings, mesh = _refined(rulings, mesh, options, respace == "auto")
     finally:
         if token is not None:
             _PROGRESS.reset(token)
@@ -146,7 +150,7 @@ _ROOM = 0.25
 _SPLINTER_COST = 0.01
 
 
-def _refined(rulings, mesh, options: dict):
+def _refined(rulings, mesh, options: dict, respace_auto: bool = False):
     """Add generators of the smooth surface in the strips the rows could not fill with quads.
 
     The §4.3 chains drift apart in proportion to the generator spacing, most
@@ -190,6 +194,11 @@ def _refined(rulings, mesh, options: dict):
         # (generators with an even division, whose triangles pair into quads within it).
         full = {**options, "extend": "full"}
         rounds += _candidates(rulings, _mesh(rulings, full), full, grid, user, goal)
+    if respace_auto and max(_fabricable(r, goal) for r in rounds)[0] < 2:
+        # Where the rows spread unevenly over the generators (strongly twisted surfaces: the
+        # maps between generators are projective), restarts with an evened division.
+        spaced = {**options, "respace": True}
+        rounds += _candidates(rulings, _mesh(rulings, spaced), spaced, grid, user, goal)
     best = _worth_its_panels(max(rounds, key=lambda r: _fabricable(r, goal)), rounds, goal)
     added = int(best[3].info.get("inserted", 0)) - int(rulings.info.get("inserted", 0))
     rulings, mesh = best[3], best[4]
@@ -200,6 +209,9 @@ def _refined(rulings, mesh, options: dict):
     if mesh.info.get("extend") == "full" and options["extend"] == "auto":
         notes.append('every row of the extension kept (as [mesh] extend = "full"): that mesh had '
                      "more of its area in quads")
+    if mesh.info.get("respace") and not options["respace"]:
+        notes.append("rows restarted with an even division where they had spread (as [mesh] "
+                     "respace = true): that mesh had more of its area in quads")
     if added > 0:
         notes.append(f"{added} generators of the smooth surface added where the rows needed them "
                      f"({len(rulings.u)} in all, {user} given)")

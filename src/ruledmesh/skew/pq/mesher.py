@@ -19,6 +19,7 @@ from .flips import flip_splinters, flip_triangles
 from .maps import HopMaps, hop_maps
 from .pairing import pair_triangles
 from .panels import split_strip_quads
+from .respacing import evened, spread_generators
 from .runs import (
     BYTES_PER_GRID_POINT,
     MAX_GRID_POINTS,
@@ -91,11 +92,15 @@ class _Plan:
     warnings: list
     crease_generators: frozenset = frozenset()
     hops: HopMaps | None = None     # of all the generators: each run takes its part
+    respace: bool = False           # restart where the rows spread (.respacing)
 
 
-def _cut_at(run: Run, primary: int, m: int) -> tuple[int | None, int | None]:
+def _cut_at(run: Run, primary: int, m: int, plan: _Plan, rows: int) -> tuple[int | None, int | None]:
     """Run-local generators where the run must restart (right of, left of the primary)."""
     bad = (run.failing >= 2) & (run.failing >= _RESTART_SHARE * np.maximum(run.on_patch, 1))
+    if plan.respace:
+        first = int(run.gen.min()) if run.gen.size else 0
+        bad |= spread_generators(run.t, run.gen, run.far, first, m, rows)
     right = [k for k in np.flatnonzero(bad) if k >= primary + 3 and m - k >= 2]
     left = [k for k in np.flatnonzero(bad) if k <= primary - 3 and k >= 1]
     return (int(right[0]) if right else None), (int(left[-1]) if left else None)
@@ -166,7 +171,8 @@ def _build_segment(plan: _Plan, lo: int, hi: int, primary: int, div: Division,
                        plan.warnings, plan.hops)
         rest = _even(plan, r1 + 1, hi, div.rows) if shared == lo else _even(plan, lo, r0 - 1, div.rows)
         return [run] + rest
-    right, left = _cut_at(run, primary, m) if budget[0] > 0 and m >= 2 * _MIN_RUN else (None, None)
+    cut = budget[0] > 0 and m >= 2 * _MIN_RUN
+    right, left = _cut_at(run, primary, m, plan, div.rows) if cut else (None, None)
     if right is None and left is None:
         return [run]
     budget[0] -= (right is not None) + (left is not None)
@@ -176,12 +182,19 @@ def _build_segment(plan: _Plan, lo: int, hi: int, primary: int, div: Division,
                    plan.tol, plan.scale, plan.warnings, plan.hops)
     runs = [run]
     if right is not None:
-        runs += _build_segment(plan, new_hi, hi, 0, matched(div, run.inside_t(new_hi)), budget,
-                               shared=new_hi)
+        runs += _build_segment(plan, new_hi, hi, 0, matched(div, _handed_on(plan, run, new_hi, div)),
+                               budget, shared=new_hi)
     if left is not None:
-        runs += _build_segment(plan, lo, new_lo, new_lo - lo, matched(div, run.inside_t(new_lo)),
-                               budget, shared=new_lo)
+        runs += _build_segment(plan, lo, new_lo, new_lo - lo,
+                               matched(div, _handed_on(plan, run, new_lo, div)), budget, shared=new_lo)
     return runs
+
+
+def _handed_on(plan: _Plan, run: Run, g: int, div: Division) -> np.ndarray:
+    """The division a restart on global generator ``g`` takes from ``run``: its vertices
+    there, evened where the rows are respaced."""
+    t = run.inside_t(g)
+    return evened(t, div.rows) if plan.respace else t
 
 
 def _torsal_cuts(a, d, scale, tol, creases, m):
@@ -266,7 +279,7 @@ def _listed(ks: np.ndarray) -> str:
 def pq_mesh(a, b, rows: int = 20, primary: int | str = "middle", option: int = 0,
             extend: float | str = "auto", trim: bool = True, *, max_extend: float = 20.0,
             creases=None, crease_generators=None, planarity_tolerance: float | None = None,
-            tol: Tolerances = DEFAULT) -> Mesh:
+            respace: bool = False, tol: Tolerances = DEFAULT) -> Mesh:
     """The §4.3 PQ mesh of the ruled surface through generators ``a_i b_i``.
 
     Parameters
@@ -290,10 +303,9 @@ def pq_mesh(a, b, rows: int = 20, primary: int | str = "middle", option: int = 0
     max_extend : float
         Cap of the automatic extension.
     creases : (k,) int, optional
-        Strips ``i`` (between generators ``i`` and ``i + 1``) across which the
-        surface has a crease (a kink of a director curve inside the strip); the
-        rows restart there and the strip is closed by triangles.  (Design files
-        put a generator through every kink instead, see :mod:`ruledmesh.design`.)
+        Strips ``i`` (generators ``i`` to ``i + 1``) holding a crease (a kink of a
+        director curve): the rows restart there and the strip is closed by
+        triangles.  (Design files put a generator through every kink instead.)
     crease_generators : (k,) int, optional
         Generators along which the surface has a crease (through a kink of a
         director curve): the rows restart there with a matched division.
@@ -301,22 +313,20 @@ def pq_mesh(a, b, rows: int = 20, primary: int | str = "middle", option: int = 0
         Relative planarity (the paper's measure, as :func:`ruledmesh.analysis.planarity`)
         that strip quads between nearly coplanar generators may have; default
         ``tol.planarity`` (exact to rounding).
+    respace : bool
+        Also restart the rows where they spread, evened there (:mod:`.respacing`).
     tol : Tolerances
 
     Returns
     -------
     Mesh
-        Faces of kind QUAD (interior), BORDER (reaching a director curve),
-        STRIP (quads between coplanar generators), FILL (notch, torsal and
-        border triangles) and SPLIT (quads that were not convex, split along
-        their generator diagonal); members are the generator segments between
-        consecutive vertices; ``vertex_data`` holds ``t`` and ``generator``;
-        ``info["warnings"]`` says what was replaced or could not be covered,
-        ``info["runs"]`` how many runs the generators were meshed in, and
-        ``flips``, ``collapsed``, ``paired``, ``snapped``, ``trimmed``, ``opened``, ``cut`` how
-        many edge flips, collapses, paired quads, corners snapped onto the border, end
-        points trimmed with their needles, quads opened around splinters the fattening
-        made and strip quads cut to the size of the other panels.
+        Faces of kind QUAD, BORDER (reaching a director curve), STRIP (between
+        coplanar generators), FILL (notch, torsal, border triangles) and SPLIT
+        (halves of quads that were not convex); members are the generator
+        segments between vertices; ``vertex_data`` holds ``t`` and ``generator``;
+        ``info`` the ``warnings``, the ``runs`` and ``restarts``, and how many
+        ``flips``, ``collapsed``, ``paired``, ``snapped``, ``trimmed``, ``opened``
+        and ``cut`` faces the passes after the grid made.
 
     Raises
     ------
@@ -349,7 +359,8 @@ def pq_mesh(a, b, rows: int = 20, primary: int | str = "middle", option: int = 0
     a, d, creases, crease_generators = _keep(kept, a, d, creases, crease_generators)
     m = len(a)
     flat, torsal, cg, segs = _cut(a, d, rows, ptol, scale, tol, creases, crease_generators, warnings)
-    plan = _Plan(a, d, tol, scale, warnings, frozenset(cg.tolist()), hop_maps(a, d))
+    plan = _Plan(a, d, tol, scale, warnings, frozenset(cg.tolist()), hop_maps(a, d),
+                 check_bool(respace, "respace"))
     primary = int(np.searchsorted(kept, args.primary, side="right") - 1)
     parts = _build_all(plan, segs, primary, args.middle,
                        Division(rows, args.option, args.extend, args.max_extend), m)
@@ -362,7 +373,8 @@ def pq_mesh(a, b, rows: int = 20, primary: int | str = "middle", option: int = 0
     _warn_splinters(mesh, warnings, torsal, measured)
     if kept.size < m_given:
         mesh = _renumbered(mesh, kept)
-    return mesh.with_info(runs=len(parts), restarts=restarts, planarity_tolerance=ptol, extend=args.extend, **fattening)
+    return mesh.with_info(runs=len(parts), restarts=restarts, planarity_tolerance=ptol, extend=args.extend,
+                          respace=plan.respace, **fattening)
 
 
 def _cut(a, d, rows, ptol, scale, tol, creases, crease_generators, warnings):

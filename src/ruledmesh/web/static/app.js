@@ -1242,7 +1242,14 @@ function control(parent, path, name, value) {
   row.append(label);
   const send = (v, coalesce) => queueEdit([[path, v]], coalesce);
 
-  if (typeof value === 'boolean') {
+  if (name === 'respace' && path[0] === 'mesh') {
+    // "auto" or a boolean: one list of the three, the booleans sent as booleans.
+    const sel = document.createElement('select');
+    for (const c of ['auto', 'true', 'false']) sel.add(new Option(c, c, false, c === String(value)));
+    sel.dataset.path = path.join('.');
+    sel.addEventListener('change', () => send(sel.value === 'auto' ? 'auto' : sel.value === 'true'));
+    row.append(sel);
+  } else if (typeof value === 'boolean') {
     const box = document.createElement('input');
     box.type = 'checkbox';
     box.checked = value;
@@ -1370,7 +1377,7 @@ function buildControls() {
 // one has a control even while the design leaves it out.
 const METHOD_FIELDS = {
   pq: { rows: 20, primary: 'middle', option: 0, extend: 'auto', trim: true, max_extend: 20.0,
-        planarity_tolerance: 1e-12, refine: true },
+        planarity_tolerance: 1e-12, refine: true, respace: 'auto' },
   hybrid: { midpoints: 1, divisions: 8, flip: false, orient: true },
 };
 
