@@ -49,14 +49,29 @@ def _unit_normals(p, q, r) -> np.ndarray:
     return n / np.maximum(np.linalg.norm(n, axis=1, keepdims=True), TINY)
 
 
-def _edge_keys(mesh_faces: list[np.ndarray], n: int) -> np.ndarray:
-    """Sorted undirected edge keys ``lo * n + hi`` of fixed-valence face arrays."""
+def _edge_keys(mesh_faces: list[np.ndarray], n: int, among: np.ndarray) -> np.ndarray:
+    """Sorted undirected edge keys ``lo * n + hi`` of fixed-valence face arrays, of the edges
+    whose two ends are both marked in ``among`` (n,) bool.
+
+    A flip re-cuts triangles among their own corners, so only an edge between two corners
+    of the triangles taking part can be made again: the others (most of a large mesh's
+    quad edges) need not be sorted.
+    """
     keys = []
     for F in mesh_faces:
         if len(F):
             a, b = F.reshape(-1), np.roll(F, -1, axis=1).reshape(-1)
+            both = among[a] & among[b]
+            a, b = a[both], b[both]
             keys.append(np.minimum(a, b) * n + np.maximum(a, b))
     return unique(np.concatenate(keys)) if keys else np.zeros(0, np.int64)
+
+
+def _corners(tri: np.ndarray, n: int) -> np.ndarray:
+    """(n,) bool: the vertices that are corners of the triangles ``tri`` (T, 3)."""
+    out = np.zeros(n, bool)
+    out[tri.reshape(-1)] = True
+    return out
 
 
 def _ring(t1: np.ndarray, t2: np.ndarray, mark: np.ndarray) -> np.ndarray:
@@ -276,8 +291,8 @@ def flip_triangles(mesh: Mesh, changeable: np.ndarray | None = None,
     for k in unique(val[~is_tri]).tolist():
         f = np.flatnonzero(val == k)
         others.append(mesh.face_indices[mesh.face_offsets[f][:, None] + np.arange(k)])
-    fixed = _edge_keys(others, n)
     tri = tri_all[live]
+    fixed = _edge_keys(others, n, _corners(tri, n))
     tmin = ang[live]
     before = tri.copy()
     flips = 0
@@ -359,7 +374,7 @@ def flip_splinters(mesh: Mesh, scale: float | None = None) -> tuple[Mesh, int]:
     ids, tri, tmin = ids[live], tri_all[live], ang[live]
     others = [tri_all[~live]] + [mesh.face_indices[mesh.face_offsets[f][:, None] + np.arange(k)]
                                  for k in unique(val[val != 3]).tolist() for f in [np.flatnonzero(val == k)]]
-    fixed = _edge_keys(others, len(V))
+    fixed = _edge_keys(others, len(V), _corners(tri, len(V)))
     on_generator = np.asarray(mesh.vertex_data["generator"])
     before = tri.copy()
     flips = 0
