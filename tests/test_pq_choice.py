@@ -16,15 +16,13 @@ from ruledmesh.design.pq import (
 QUALITY = Path(__file__).resolve().parents[1] / "benchmarks" / "quality"
 
 
-def _variant(name, count, rows, tolerance=None, respace=None):
+def _variant(name, count, rows, tolerance=None):
     text = (QUALITY / name).read_text()
     lines = [f"count = {count}" if ln.startswith("count =") else f"rows = {rows}" if ln.startswith("rows =")
              else ln for ln in text.splitlines()]
     text = "\n".join(lines) + "\n"
     if tolerance is not None:
         text = text.replace("[mesh]", f"[mesh]\nplanarity_tolerance = {tolerance:g}")
-    if respace is not None:
-        text = text.replace("[mesh]", f"[mesh]\nrespace = {str(respace).lower()}")
     return build_design(parse_design(text))
 
 
@@ -75,11 +73,8 @@ def test_of_two_meshes_meeting_one_goal_each_the_nearer_wins():
 def test_tolerance_mode_keeps_the_exact_mesh_where_it_has_more_quads():
     """Pluecker conoid at 40 x 30 with planarity_tolerance = 1e-3: 46 % of the area was in
     triangles (the strips planar within the tolerance cut the rows off from generators 0-10);
-    the exact mesh has 14.7 % and no splinter, and the build says it kept it.  (With the
-    respaced restarts, tried since that mesh misses the 10 % goal, a tolerance mesh with 8.1 %
-    and no splinter is kept instead: the choice between exact and tolerance rows is measured
-    here without them.)"""
-    built = _variant("plucker-conoid.toml", 40, 30, tolerance=1e-3, respace=False)
+    the exact mesh has 14.7 % and no splinter, and the build says it kept it."""
+    built = _variant("plucker-conoid.toml", 40, 30, tolerance=1e-3)
     mesh = built.mesh
     # (Not check_exact: the end points of the first and last generators meet on the axis,
     # one vertex where the conoid touches itself, so the mesh is not a disc.)

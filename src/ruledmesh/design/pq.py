@@ -196,9 +196,15 @@ def _refined(rulings, mesh, options: dict, respace_auto: bool = False):
         rounds += _candidates(rulings, _mesh(rulings, full), full, grid, user, goal)
     if respace_auto and max(_fabricable(r, goal) for r in rounds)[0] < 2:
         # Where the rows spread unevenly over the generators (strongly twisted surfaces: the
-        # maps between generators are projective), restarts with an evened division.
+        # maps between generators are projective), restarts with an evened division; only
+        # where they spread on the generators as given.  Elsewhere the rounds made the same
+        # meshes or ones that differ where added generators happened to spread them, for
+        # twice the build time: linear-directrix 29.0 -> 28.4 % in 14 s instead of 7, and
+        # one of 24 random surfaces 30.6 -> 35.6 % (a cheaper mesh kept).
         spaced = {**options, "respace": True}
-        rounds += _candidates(rulings, _mesh(rulings, spaced), spaced, grid, user, goal)
+        first = _mesh(rulings, spaced)
+        if first.info["restarts"] > mesh.info["restarts"]:
+            rounds += _candidates(rulings, first, spaced, grid, user, goal)
     best = _worth_its_panels(max(rounds, key=lambda r: _fabricable(r, goal)), rounds, goal)
     added = int(best[3].info.get("inserted", 0)) - int(rulings.info.get("inserted", 0))
     rulings, mesh = best[3], best[4]
