@@ -128,3 +128,29 @@ def test_respaced_rows_only_where_the_goals_are_missed():
     assert auto.info["respace"] is False
     assert auto.vertices.tobytes() == never.vertices.tobytes()
     assert auto.face_indices.tobytes() == never.face_indices.tobytes()
+
+
+def test_the_refinement_builds_each_mesh_once(monkeypatch):
+    """The refinement's tiers and starts come back to generators they meshed already (6 of
+    24 meshes of twisted-arcs-160deg): each mesh is built once per build, and the build is
+    the same as with every mesh built anew."""
+    import hashlib
+
+    import numpy as np
+
+    import ruledmesh.design.pq as pq
+
+    first = _variant("twisted-arcs-160deg.toml", 61, 24).mesh
+    calls = []
+    real = pq.pq_mesh
+
+    def counted(a, b, **options):
+        calls.append(hashlib.sha1(np.ascontiguousarray(a).tobytes() + repr(sorted(options.items()))
+                                  .encode()).hexdigest())
+        return real(a, b, **options)
+
+    monkeypatch.setattr(pq, "pq_mesh", counted)
+    again = _variant("twisted-arcs-160deg.toml", 61, 24).mesh
+    assert len(calls) == len(set(calls)) >= 10
+    assert again.vertices.tobytes() == first.vertices.tobytes()
+    assert again.face_indices.tobytes() == first.face_indices.tobytes()
