@@ -154,3 +154,22 @@ def test_the_refinement_builds_each_mesh_once(monkeypatch):
     assert len(calls) == len(set(calls)) >= 10
     assert again.vertices.tobytes() == first.vertices.tobytes()
     assert again.face_indices.tobytes() == first.face_indices.tobytes()
+
+
+def test_explicit_lines_take_the_more_fabricable_checkerboard_and_primary():
+    """The Plücker conoid from 41 lines had 26.0 % of its area in triangles with option 0 from
+    the middle generator; the lines cannot be refined, so where the design leaves option and
+    primary free the build tries both checkerboards and three primaries and keeps the mesh
+    with 23.2 % (option 1 from the third generator), saying so.  A design that sets them
+    gets what it set."""
+    text = (QUALITY / "plucker-lines-a1-41.toml").read_text()
+    mesh = build_design(parse_design(text)).mesh
+    assert (mesh.info["option"], mesh.info["primary"]) == (1, 13)
+    assert 1.0 - area_shares(mesh)["quads"] <= _GOAL_TRIANGLES
+    assert face_min_angles(mesh).min() >= 3.0 and planarity(mesh).max() <= 1e-12
+    assert any("option = 1, primary = 13" in w for w in mesh.info["warnings"])
+
+    given = build_design(parse_design(text.replace("[mesh]", '[mesh]\noption = 0\nprimary = "middle"'))).mesh
+    assert (given.info["option"], given.info["primary"]) == (0, "middle")
+    assert 1.0 - area_shares(given)["quads"] > _GOAL_TRIANGLES
+    assert not any("option =" in w for w in given.info["warnings"])

@@ -303,9 +303,8 @@ def pq_mesh(a, b, rows: int = 20, primary: int | str = "middle", option: int = 0
     max_extend : float
         Cap of the automatic extension.
     creases : (k,) int, optional
-        Strips ``i`` (generators ``i`` to ``i + 1``) holding a crease (a kink of a
-        director curve): the rows restart there and the strip is closed by
-        triangles.  (Design files put a generator through every kink instead.)
+        Strips ``i`` (generators ``i`` to ``i + 1``) holding a crease (a kink of a director
+        curve): the rows restart there, the strip is closed by triangles.
     crease_generators : (k,) int, optional
         Generators along which the surface has a crease (through a kink of a
         director curve): the rows restart there with a matched division.
@@ -324,9 +323,9 @@ def pq_mesh(a, b, rows: int = 20, primary: int | str = "middle", option: int = 0
         coplanar generators), FILL (notch, torsal, border triangles) and SPLIT
         (halves of quads that were not convex); members are the generator
         segments between vertices; ``vertex_data`` holds ``t`` and ``generator``;
-        ``info`` the ``warnings``, the ``runs`` and ``restarts``, and how many
-        ``flips``, ``collapsed``, ``paired``, ``snapped``, ``trimmed``, ``opened``
-        and ``cut`` faces the passes after the grid made.
+        ``info`` the ``warnings``, the ``runs``, ``restarts``, ``option``, ``primary`` and how
+        many ``flips``, ``collapsed``, ``paired``, ``snapped``, ``trimmed``, ``opened`` and
+        ``cut`` faces the passes after the grid made.
 
     Raises
     ------
@@ -374,7 +373,8 @@ def pq_mesh(a, b, rows: int = 20, primary: int | str = "middle", option: int = 0
     if kept.size < m_given:
         mesh = _renumbered(mesh, kept)
     return mesh.with_info(runs=len(parts), restarts=restarts, planarity_tolerance=ptol, extend=args.extend,
-                          respace=plan.respace, **fattening)
+                          respace=plan.respace, option=args.option,
+                          primary="middle" if args.middle else args.primary, **fattening)
 
 
 def _cut(a, d, rows, ptol, scale, tol, creases, crease_generators, warnings):
