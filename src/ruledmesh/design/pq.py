@@ -60,10 +60,12 @@ def build_pq(rulings, table: Mapping[str, Any], ctx: BuildContext) -> Built:
     try:
         mesh = _mesh(rulings, options)
         if refine:
-            rulings, mesh = _refined(rulings, mesh, options, respace == "auto")
-            if _fixed_generators(rulings):
-                mesh = _other_checkerboards(rulings, mesh, options, free=(
-                    "option" not in table, "primary" not in table))
+            rulings, mesh, notes = _refined(rulings, mesh, options, respace == "auto")
+            mesh, chosen = _other_checkerboards(rulings, mesh, options, free=(
+                "option" not in table, "primary" not in table))
+            notes += chosen
+            if notes:
+                mesh = mesh.with_info(warnings=list(mesh.info.get("warnings", [])) + notes)
     finally:
         _MADE.reset(made)
         if token is not None:
@@ -200,7 +202,7 @@ def _refined(rulings, mesh, options: dict, respace_auto: bool = False):
     from ..rulings import dense_grid
 
     if _fixed_generators(rulings):
-        return rulings, mesh
+        return rulings, mesh, []
     grid, _ = dense_grid(len(rulings.u))
     user = len(rulings.u) - int(rulings.info.get("inserted", 0))
     goal = _GOAL_TRIANGLES_TOLERANCE if options["planarity_tolerance"] > DEFAULT.planarity \
@@ -246,9 +248,7 @@ def _refined(rulings, mesh, options: dict, respace_auto: bool = False):
     if added > 0:
         notes.append(f"{added} generators of the smooth surface added where the rows needed them "
                      f"({len(rulings.u)} in all, {user} given)")
-    if not notes:
-        return rulings, mesh
-    return rulings, mesh.with_info(warnings=list(mesh.info.get("warnings", [])) + notes)
+    return rulings, mesh, notes
 
 
 def _fixed_generators(rulings) -> bool:
@@ -261,22 +261,25 @@ def _fixed_generators(rulings) -> bool:
 _OTHER_PRIMARIES = (1 / 3, 2 / 3)
 
 
-def _other_checkerboards(rulings, mesh, options: dict, free: tuple[bool, bool]):
-    """For generators that cannot be refined, where ``mesh`` misses a goal: the more
-    fabricable (:func:`_fabricable`) of the meshes from the paper's two checkerboards
+def _other_checkerboards(rulings, mesh, options: dict, free: tuple[bool, bool]) -> tuple:
+    """Where the mesh kept misses a goal: ``(mesh, notes)``, the more fabricable
+    (:func:`_fabricable`) of the meshes of its generators from the paper's two checkerboards
     (``option``) and three primaries (the middle, a third and two thirds in), where the
-    design leaves them free (``free``: option, primary).
+    design leaves them free (``free``: option, primary), and a note if it is another.
 
-    The rows of §4.3 depend on both; with the lines fixed they are the only freedom left.
-    On the Plücker conoid from 41 lines (``plucker-lines-a1-41``) 26.0 % of the area in
-    triangles with option 0 from the middle, 23.2 % with option 1 from the third
-    generator; on the other line sets of ``benchmarks/quality`` the best is within a point.
+    The rows of §4.3 depend on both; for explicit lines they are the only freedom left.  On
+    the Plücker conoid from 41 lines (``plucker-lines-a1-41``) 26.0 % of the area in
+    triangles with option 0 from the middle, 23.2 % with option 1 from the third generator;
+    ``twisted-arcs-160deg`` (118 generators after the refinement) 24.4 % with a face of 2.85
+    degrees from the middle, 23.7 % and none below 3 from two thirds in.  The meshes are of
+    the generators kept, with the options of the mesh kept (tolerance, extension, respacing).
     """
     goal = _GOAL_TRIANGLES_TOLERANCE if options["planarity_tolerance"] > DEFAULT.planarity \
         else _GOAL_TRIANGLES
     best = (_measured(mesh)[0], *_splinters(mesh), rulings, mesh, ())
     if sum(_goals_met(best, goal)) == 2 or not any(free):
-        return mesh
+        return mesh, []
+    options = {**options, **{k: mesh.info[k] for k in ("planarity_tolerance", "extend", "respace")}}
     m = len(rulings.a)
     choices = [(o, p) for o in ((0, 1) if free[0] else (options["option"],))
                for p in (("middle", *(int(f * m) for f in _OTHER_PRIMARIES)) if free[1]
@@ -294,13 +297,12 @@ def _other_checkerboards(rulings, mesh, options: dict, free: tuple[bool, bool]):
             best = round_
     kept = best[4]
     if kept is mesh:
-        return mesh
-    said = [f"option = {kept.info['option']}"] if free[0] else []
-    said += [f"primary = {kept.info['primary']}"] if free[1] else []
-    return kept.with_info(warnings=list(kept.info.get("warnings", [])) + [
-        f"rows from [mesh] {', '.join(said)} (of the two checkerboards and three primary "
-        f"generators tried for these lines): that mesh had more of its area in quads or fewer "
-        f"splinters; set them to choose"])
+        return mesh, []
+    said = [f"option {kept.info['option']}"] if free[0] else []
+    said += [f"the primary generator {kept.info['primary']} of {len(rulings.a)}"] if free[1] else []
+    return kept, [f"rows from {' and '.join(said)} (of the two checkerboards and three primary "
+                  f"generators tried): that mesh had more of its area in quads or fewer splinters; "
+                  f"[mesh] option and primary choose them"]
 
 
 def _candidates(rulings, mesh, options: dict, grid: np.ndarray, user: int, goal: float) -> list[tuple]:
