@@ -138,8 +138,13 @@ _TOLERANCE = Param("Tolerance", "Number", "planarity tolerance of the report (re
 
 
 def _pq_mesh_table(inputs: Mapping[str, Any]) -> dict[str, Any]:
-    return {"method": "pq", "rows": inputs["Rows"], "primary": _primary(inputs["Primary"]),
-            "option": inputs["Option"]}
+    table = {"method": "pq", "rows": inputs["Rows"], "primary": _primary(inputs["Primary"]),
+             "option": inputs["Option"]}
+    if table["primary"] == "middle" and table["option"] == 0:
+        # Both at their defaults: as a design file that leaves them out, the build may take
+        # the other checkerboard or primary where its mesh misses a goal (and says so).
+        del table["primary"], table["option"]
+    return table
 
 
 def _ruled_pq(inputs: dict[str, Any]):
