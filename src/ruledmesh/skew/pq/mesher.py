@@ -95,12 +95,12 @@ class _Plan:
     respace: bool = False           # restart where the rows spread (.respacing)
 
 
-def _cut_at(run: Run, primary: int, m: int, plan: _Plan, rows: int) -> tuple[int | None, int | None]:
-    """Run-local generators where the run must restart (right of, left of the primary)."""
+def _cut_at(run: Run, lo: int, primary: int, m: int, plan: _Plan, rows: int) -> tuple[int | None, int | None]:
+    """Run-local generators where the run (from global generator ``lo``) must restart (right
+    of, left of the primary)."""
     bad = (run.failing >= 2) & (run.failing >= _RESTART_SHARE * np.maximum(run.on_patch, 1))
     if plan.respace:
-        first = int(run.gen.min()) if run.gen.size else 0
-        bad |= spread_generators(run.t, run.gen, run.far, first, m, rows)
+        bad |= spread_generators(run.t, run.gen, run.far, lo, m, rows)
     right = [k for k in np.flatnonzero(bad) if k >= primary + 3 and m - k >= 2]
     left = [k for k in np.flatnonzero(bad) if k <= primary - 3 and k >= 1]
     return (int(right[0]) if right else None), (int(left[-1]) if left else None)
@@ -172,7 +172,7 @@ def _build_segment(plan: _Plan, lo: int, hi: int, primary: int, div: Division,
         rest = _even(plan, r1 + 1, hi, div.rows) if shared == lo else _even(plan, lo, r0 - 1, div.rows)
         return [run] + rest
     cut = budget[0] > 0 and m >= 2 * _MIN_RUN
-    right, left = _cut_at(run, primary, m, plan, div.rows) if cut else (None, None)
+    right, left = _cut_at(run, lo, primary, m, plan, div.rows) if cut else (None, None)
     if right is None and left is None:
         return [run]
     budget[0] -= (right is not None) + (left is not None)
@@ -348,7 +348,7 @@ def pq_mesh(a, b, rows: int = 20, primary: int | str = "middle", option: int = 0
     True
     """
     a, b, args = _checked(a, b, rows, primary, option, extend, trim, max_extend,
-                          planarity_tolerance, tol)
+                          planarity_tolerance, respace, tol)
     rows, ptol = args.rows, args.ptol
     d = b - a
     scale = _patch_scale(a, b, d, tol)
@@ -358,8 +358,7 @@ def pq_mesh(a, b, rows: int = 20, primary: int | str = "middle", option: int = 0
     a, d, creases, crease_generators = _keep(kept, a, d, creases, crease_generators)
     m = len(a)
     flat, torsal, cg, segs = _cut(a, d, rows, ptol, scale, tol, creases, crease_generators, warnings)
-    plan = _Plan(a, d, tol, scale, warnings, frozenset(cg.tolist()), hop_maps(a, d),
-                 check_bool(respace, "respace"))
+    plan = _Plan(a, d, tol, scale, warnings, frozenset(cg.tolist()), hop_maps(a, d), args.respace)
     primary = int(np.searchsorted(kept, args.primary, side="right") - 1)
     parts = _build_all(plan, segs, primary, args.middle,
                        Division(rows, args.option, args.extend, args.max_extend), m)
@@ -464,9 +463,10 @@ class _Args:
     trim: bool
     max_extend: float
     ptol: float
+    respace: bool
 
 
-def _checked(a, b, rows, primary, option, extend, trim, max_extend, planarity_tolerance,
+def _checked(a, b, rows, primary, option, extend, trim, max_extend, planarity_tolerance, respace,
              tol: Tolerances) -> tuple[np.ndarray, np.ndarray, _Args]:
     """Validate the arguments of :func:`pq_mesh` (ParameterError naming the parameter)."""
     a = check_points(a, "a", min_count=3)
@@ -493,7 +493,8 @@ def _checked(a, b, rows, primary, option, extend, trim, max_extend, planarity_to
     ptol = tol.planarity if planarity_tolerance is None else check_float(
         planarity_tolerance, "planarity_tolerance", lo=0.0, hi=0.1)
     _check_grid_budget(m, rows, extend)
-    return a, b, _Args(rows, p, middle, option, extend, trim, max_extend, max(ptol, tol.planarity))
+    return a, b, _Args(rows, p, middle, option, extend, trim, max_extend, max(ptol, tol.planarity),
+                       check_bool(respace, "respace"))
 
 
 def _check_grid_budget(m: int, rows: int, extend: float | str) -> None:
