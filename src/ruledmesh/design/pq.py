@@ -60,8 +60,8 @@ def build_pq(rulings, table: Mapping[str, Any], ctx: BuildContext) -> Built:
     try:
         mesh = _mesh(rulings, options)
         if refine:
-            rulings, mesh, notes = _refined(rulings, mesh, options, respace == "auto")
-            mesh, chosen = _other_checkerboards(rulings, mesh, options, free=(
+            rulings, kept, notes = _refined(rulings, mesh, options, respace == "auto")
+            mesh, chosen = _other_checkerboards(kept, options, free=(
                 "option" not in table, "primary" not in table))
             notes += chosen
             if notes:
@@ -202,11 +202,10 @@ def _refined(rulings, mesh, options: dict, respace_auto: bool = False):
     from ..rulings import dense_grid
 
     if _fixed_generators(rulings):
-        return rulings, mesh, []
+        return rulings, _round(rulings, mesh), []
     grid, _ = dense_grid(len(rulings.u))
     user = len(rulings.u) - int(rulings.info.get("inserted", 0))
-    goal = _GOAL_TRIANGLES_TOLERANCE if options["planarity_tolerance"] > DEFAULT.planarity \
-        else _GOAL_TRIANGLES
+    goal = _goal(options)
     rounds = _candidates(rulings, mesh, options, grid, user, goal)
     exact = {**options, "planarity_tolerance": DEFAULT.planarity}
     if options["planarity_tolerance"] > DEFAULT.planarity and \
@@ -248,7 +247,20 @@ def _refined(rulings, mesh, options: dict, respace_auto: bool = False):
     if added > 0:
         notes.append(f"{added} generators of the smooth surface added where the rows needed them "
                      f"({len(rulings.u)} in all, {user} given)")
-    return rulings, mesh, notes
+    return rulings, best, notes
+
+
+def _goal(options: dict) -> float:
+    """The share of the area in triangles a build may have: in exact mode, with a planarity
+    tolerance."""
+    return _GOAL_TRIANGLES_TOLERANCE if options["planarity_tolerance"] > DEFAULT.planarity \
+        else _GOAL_TRIANGLES
+
+
+def _round(rulings, mesh, pairs: tuple = ()) -> tuple:
+    """``mesh`` of ``rulings`` as a round of the refinement: ``(quad share, splinters, their
+    cost, rulings, mesh, pairs)``."""
+    return (_measured(mesh)[0], *_splinters(mesh), rulings, mesh, pairs)
 
 
 def _fixed_generators(rulings) -> bool:
@@ -257,15 +269,16 @@ def _fixed_generators(rulings) -> bool:
     return getattr(rulings, "surface", None) is None or rulings.info.get("distribution") == "lines"
 
 
-# Other primaries tried for explicit lines: at these shares of the generators (and the middle).
+# The other primaries tried where a mesh misses a goal: at these shares of the generators (and the middle).
 _OTHER_PRIMARIES = (1 / 3, 2 / 3)
 
 
-def _other_checkerboards(rulings, mesh, options: dict, free: tuple[bool, bool]) -> tuple:
-    """Where the mesh kept misses a goal: ``(mesh, notes)``, the more fabricable
-    (:func:`_fabricable`) of the meshes of its generators from the paper's two checkerboards
-    (``option``) and three primaries (the middle, a third and two thirds in), where the
-    design leaves them free (``free``: option, primary), and a note if it is another.
+def _other_checkerboards(kept: tuple, options: dict, free: tuple[bool, bool]) -> tuple:
+    """Where the mesh of the round ``kept`` (as :func:`_round`) misses a goal: ``(mesh, notes)``,
+    the more fabricable (:func:`_fabricable`) of the meshes of its generators from the paper's
+    two checkerboards (``option``) and three primaries (the middle, a third and two thirds
+    in), where the design leaves them free (``free``: option, primary), and a note if it is
+    another.
 
     The rows of §4.3 depend on both; for explicit lines they are the only freedom left.  On
     the Plücker conoid from 41 lines (``plucker-lines-a1-41``) 26.0 % of the area in
@@ -274,9 +287,8 @@ def _other_checkerboards(rulings, mesh, options: dict, free: tuple[bool, bool]) 
     degrees from the middle, 23.7 % and none below 3 from two thirds in.  The meshes are of
     the generators kept, with the options of the mesh kept (tolerance, extension, respacing).
     """
-    goal = _GOAL_TRIANGLES_TOLERANCE if options["planarity_tolerance"] > DEFAULT.planarity \
-        else _GOAL_TRIANGLES
-    best = (_measured(mesh)[0], *_splinters(mesh), rulings, mesh, ())
+    goal = _goal(options)
+    best, rulings, mesh = kept, kept[3], kept[4]
     if sum(_goals_met(best, goal)) == 2 or not any(free):
         return mesh, []
     options = {**options, **{k: mesh.info[k] for k in ("planarity_tolerance", "extend", "respace")}}
@@ -292,15 +304,15 @@ def _other_checkerboards(rulings, mesh, options: dict, free: tuple[bool, bool]) 
             other = _mesh(rulings, {**options, "option": option, "primary": primary})
         except GeometryError:
             continue
-        round_ = (_measured(other)[0], *_splinters(other), rulings, other, ())
+        round_ = _round(rulings, other)
         if _fabricable(round_, goal) > _fabricable(best, goal):
             best = round_
-    kept = best[4]
-    if kept is mesh:
+    if best is kept:
         return mesh, []
-    said = [f"option {kept.info['option']}"] if free[0] else []
-    said += [f"the primary generator {kept.info['primary']} of {len(rulings.a)}"] if free[1] else []
-    return kept, [f"rows from {' and '.join(said)} (of the two checkerboards and three primary "
+    other = best[4]
+    said = [f"option {other.info['option']}"] if free[0] else []
+    said += [f"the primary generator {other.info['primary']} of {len(rulings.a)}"] if free[1] else []
+    return other, [f"rows from {' and '.join(said)} (of the two checkerboards and three primary "
                   f"generators tried): that mesh had more of its area in quads or fewer splinters; "
                   f"[mesh] option and primary choose them"]
 

@@ -89,8 +89,7 @@ def _around(tri: np.ndarray, n: int, mark: np.ndarray, times: int) -> np.ndarray
     holds every triangle ``times`` edge-sharing steps away (and some more).
     """
     for _ in range(times):
-        hit = np.zeros(n, bool)
-        hit[tri[mark]] = True
+        hit = _corners(tri[mark], n)
         mark = hit[tri[:, 0]] | hit[tri[:, 1]] | hit[tri[:, 2]]
     return mark
 
