@@ -418,3 +418,69 @@ def test_spread_generators_are_those_whose_rows_gape():
     assert got.tolist() == [False, True, False, True]
     far[gen == 6] = True
     assert not spread_generators(t, gen, far, 5, 4, rows=24)[1]
+
+
+def moebius_band_lines(n=60, turn=5.2, r=5.0, w=0.8):
+    """Generators of a Moebius band (centre circle of radius ``r``, half-width ``w``, the
+    generator turning by half the angle about the circle), over ``turn`` radians."""
+    phi = np.linspace(0.0, turn, n)
+    c = np.stack([r * np.cos(phi), r * np.sin(phi), 0 * phi], 1)
+    e = np.stack([np.cos(phi) * np.cos(phi / 2), np.sin(phi) * np.cos(phi / 2), np.sin(phi / 2)], 1)
+    return c - w * e, c + w * e
+
+
+def _quad_share_of_border_edges(mesh, side):
+    """Of the mesh's edges between the end points ``t = side`` of consecutive generators,
+    the share that are edges of quads."""
+    t, g = mesh.vertex_data["t"], mesh.vertex_data["generator"]
+    idx = mesh.face_indices
+    nxt = idx[mesh.next_corners()]
+    face = np.repeat(np.arange(mesh.n_faces), mesh.valences)
+    on = np.abs(t - side) <= 1e-12
+    edge = on[idx] & on[nxt] & (np.abs(g[idx] - g[nxt]) == 1)
+    return float(np.mean(mesh.valences[face[edge]] == 4)), int(edge.sum())
+
+
+def test_rows_through_the_end_points_leave_no_teeth_on_that_curve():
+    """Rows through the generators' end points on c1 (c2) make the border there edges of
+    quads: on a Moebius band, where the rows run steeply across the generators, none of the
+    border edges is a quad edge with the rows from the primary, most are from either curve,
+    and the band of teeth along it (half the triangles) goes."""
+    A, B = moebius_band_lines()
+    plain = pq_mesh(A, B, rows=16)
+    assert plain.info["rows_from"] == "primary"
+    shares = {}
+    for side, rows_from in ((0.0, "c1"), (1.0, "c2")):
+        mesh = pq_mesh(A, B, rows=16, rows_from=rows_from)
+        check_mesh(mesh)
+        assert mesh.info["rows_from"] == rows_from
+        on_generators = A[mesh.vertex_data["generator"]] + mesh.vertex_data["t"][:, None] * (
+            B - A)[mesh.vertex_data["generator"]]
+        assert np.abs(mesh.vertices - on_generators).max() <= 1e-12 * np.abs(A).max()
+        share, edges = _quad_share_of_border_edges(mesh, side)
+        assert edges >= 50 and share >= 0.8, (share, edges)
+        assert _quad_share_of_border_edges(plain, side)[0] == 0.0
+        area = face_areas(mesh)
+        shares[rows_from] = area[mesh.valences == 3].sum() / area.sum()
+    plain_area = face_areas(plain)
+    plain_share = plain_area[plain.valences == 3].sum() / plain_area.sum()
+    assert plain_share > 0.45 and max(shares.values()) < 0.35, (plain_share, shares)
+    with pytest.raises(ParameterError, match="rows_from"):
+        pq_mesh(A, B, rows_from="c3")
+
+
+@pytest.mark.parametrize("seed", range(6))
+@pytest.mark.parametrize("rows_from", ["c1", "c2"])
+def test_rows_through_the_end_points_keep_the_invariants(seed, rows_from):
+    """Random skew surfaces between two smooth curves: every face planar, convex and with
+    area, every vertex on its generator, with the rows through either curve's end points."""
+    rng = np.random.default_rng(seed)
+    s = np.linspace(0.0, 1.0, 41)[:, None]
+    k1, k2 = rng.normal(size=(2, 3)), rng.normal(size=(2, 3))
+    c1 = np.c_[10 * s, np.zeros_like(s), np.zeros_like(s)] + np.sin(3 * s) * k1[0] + s ** 2 * k1[1]
+    c2 = np.c_[10 * s, 2 + 0 * s, 4 + 0 * s] + np.cos(2 * s) * k2[0] + s ** 3 * k2[1]
+    mesh = pq_mesh(c1, c2, rows=20, rows_from=rows_from)
+    check_mesh(mesh)
+    g, t = mesh.vertex_data["generator"], mesh.vertex_data["t"]
+    assert np.abs(mesh.vertices - (c1[g] + t[:, None] * (c2 - c1)[g])).max() <= 1e-12 * 12
+    assert ((t >= -1e-12) & (t <= 1 + 1e-12)).all()

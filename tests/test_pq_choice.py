@@ -173,3 +173,23 @@ def test_explicit_lines_take_the_more_fabricable_checkerboard_and_primary():
     assert (given.info["option"], given.info["primary"]) == (0, "middle")
     assert 1.0 - area_shares(given)["quads"] > _GOAL_TRIANGLES
     assert not any("checkerboards" in w for w in given.info["warnings"])
+
+
+def test_rows_through_the_end_points_where_the_mesh_keeps_teeth():
+    """The Moebius band from 24 lines keeps a band of teeth along both edges with the rows
+    from the primary (24.8 % of its area in triangles): with rows_from left free the build
+    also meshes it with the rows through the end points of either curve, keeps the better
+    one and says so; a design that sets rows_from gets what it set."""
+    text = (QUALITY / "moebius-lines.toml").read_text()
+    auto = build_design(parse_design(text)).mesh
+    assert auto.info["rows_from"] in ("c1", "c2")
+    assert any("[mesh] rows_from" in w for w in auto.info["warnings"])
+    shares = area_shares(auto)
+    assert 1.0 - shares["quads"] < 0.18, shares
+    assert face_min_angles(auto).min() >= 3.0
+    assert planarity(auto).max() <= 1e-12 and convexity(auto).all()
+    assert not degenerate_faces(auto).any()
+    fixed = build_design(parse_design(text.replace("[mesh]", '[mesh]\nrows_from = "primary"'))).mesh
+    assert fixed.info["rows_from"] == "primary"
+    assert not any("rows_from" in w for w in fixed.info["warnings"])
+    assert 1.0 - area_shares(fixed)["quads"] > 0.24

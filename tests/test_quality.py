@@ -61,7 +61,6 @@ SHORT_OF_SHARE = {
     "skew-bspline-301x300": "17.9% of the area in triangles",
     "twisted-arcs-160deg-tol1e-3": "11.9% of the area in triangles (no splinter; the mesh with "
                                    "8.6% had three faces of 0.79-1.46 deg)",
-    "moebius-r5-w0.8-97x20": "27.5% of the area in triangles (border teeth)",
 }
 
 

@@ -82,6 +82,7 @@ BAD = [
     ("skew", [(("mesh", "rows"), 0)], "mesh.rows"),
     ("skew", [(("mesh", "extend"), "far")], "mesh.extend"),
     ("skew", [(("mesh", "respace"), "sometimes")], "mesh.respace"),
+    ("skew", [(("mesh", "rows_from"), "c3")], "mesh.rows_from"),
     ("skew", [(("mesh", "method"), "quads")], "mesh.method"),
     ("skew", [(("mesh", "divisions"), 4)], "mesh"),
     ("skew", [(("surface",), {"kind": "torus", "R": 3.0, "r": 1.0})], "rulings"),

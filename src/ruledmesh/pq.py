@@ -8,6 +8,6 @@ one benchmarks and scripts call), so it keeps working; the mesher's modules
 
 from __future__ import annotations
 
-from .skew.pq import MAX_GRID_POINTS, pq_mesh, row_maps
+from .skew.pq import MAX_GRID_POINTS, RowsFrom, pq_mesh, row_maps
 
-__all__ = ["MAX_GRID_POINTS", "pq_mesh", "row_maps"]
+__all__ = ["MAX_GRID_POINTS", "RowsFrom", "pq_mesh", "row_maps"]

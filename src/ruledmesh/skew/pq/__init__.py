@@ -16,7 +16,8 @@ construction, up to rounding that does not accumulate.
 - :mod:`~ruledmesh.skew.pq.maps`: the rows as Moebius maps of the line parameter,
   propagated hop by hop; the drift between the two chains.
 - :mod:`~ruledmesh.skew.pq.runs`: one run's grid; chain *b* rooted where its faces
-  stay convex; matched divisions for runs that meet on a generator.
+  stay convex; matched divisions for runs that meet on a generator; rows through the
+  generators' end points on a director curve (``rows_from``).
 - :mod:`~ruledmesh.skew.pq.mesher`: torsal generators, restarts, the whole mesh.
 - :mod:`~ruledmesh.skew.pq.strips` and :mod:`~ruledmesh.skew.pq.assemble`: trimming to
   the patch with every vertex on a generator, closing the strips.
@@ -25,7 +26,7 @@ construction, up to rounding that does not accumulate.
 from __future__ import annotations
 
 from .maps import row_maps
-from .mesher import pq_mesh
+from .mesher import RowsFrom, pq_mesh
 from .runs import MAX_GRID_POINTS
 
-__all__ = ["MAX_GRID_POINTS", "pq_mesh", "row_maps"]
+__all__ = ["MAX_GRID_POINTS", "RowsFrom", "pq_mesh", "row_maps"]

@@ -3,11 +3,12 @@
 from __future__ import annotations
 
 from dataclasses import dataclass
+from enum import Enum
 
 import numpy as np
 
 from ..._arrays import unique
-from ..._validation import check_bool, check_float, check_int, check_points, describe
+from ..._validation import check_bool, check_choice, check_float, check_int, check_points, describe
 from ...errors import GeometryError, ParameterError
 from ...hop import coplanarity, sense_changes
 from ...mesh import Mesh
@@ -31,7 +32,7 @@ from .runs import (
 )
 from .splinters import open_walled_splinters, snap_to_border, trim_border_needles
 
-__all__ = ["pq_mesh"]
+__all__ = ["RowsFrom", "pq_mesh"]
 
 # A run restarts on a generator where this share of its faces on the patch (and
 # at least two) would not be convex; the shared generator costs one strip of
@@ -279,7 +280,7 @@ def _listed(ks: np.ndarray) -> str:
 def pq_mesh(a, b, rows: int = 20, primary: int | str = "middle", option: int = 0,
             extend: float | str = "auto", trim: bool = True, *, max_extend: float = 20.0,
             creases=None, crease_generators=None, planarity_tolerance: float | None = None,
-            respace: bool = False, tol: Tolerances = DEFAULT) -> Mesh:
+            respace: bool = False, rows_from: str = "primary", tol: Tolerances = DEFAULT) -> Mesh:
     """The §4.3 PQ mesh of the ruled surface through generators ``a_i b_i``.
 
     Parameters
@@ -314,6 +315,12 @@ def pq_mesh(a, b, rows: int = 20, primary: int | str = "middle", option: int = 0
         ``tol.planarity`` (exact to rounding).
     respace : bool
         Also restart the rows where they spread, evened there (:mod:`.respacing`).
+    rows_from : {"primary", "c1", "c2"}
+        ``"primary"``: the rows start at the division of the primary generator (§4.3).
+        ``"c1"`` (``"c2"``): each row the director curve at ``t = 0`` (``t = 1``) cuts
+        passes through a generator's end point there, so that the border along that
+        curve is edges of quads instead of a band of teeth (the rows' spacing is then
+        that of the end points; restarted runs keep their matched divisions).
     tol : Tolerances
 
     Returns
@@ -348,7 +355,7 @@ def pq_mesh(a, b, rows: int = 20, primary: int | str = "middle", option: int = 0
     True
     """
     a, b, args = _checked(a, b, rows, primary, option, extend, trim, max_extend,
-                          planarity_tolerance, respace, tol)
+                          planarity_tolerance, respace, tol, rows_from)
     rows, ptol = args.rows, args.ptol
     d = b - a
     scale = _patch_scale(a, b, d, tol)
@@ -361,7 +368,8 @@ def pq_mesh(a, b, rows: int = 20, primary: int | str = "middle", option: int = 0
     plan = _Plan(a, d, tol, scale, warnings, frozenset(cg.tolist()), hop_maps(a, d), args.respace)
     primary = int(np.searchsorted(kept, args.primary, side="right") - 1)
     parts = _build_all(plan, segs, primary, args.middle,
-                       Division(rows, args.option, args.extend, args.max_extend), m)
+                       Division(rows, args.option, args.extend, args.max_extend,
+                                ends=args.rows_from.ends), m)
     restarts = max(len([r for r in parts if len(r.left)]) - len([s for s in segs if s.hi - s.lo >= 2]), 0)
     even = _even_ranges(parts, segs, warnings, exact=ptol <= tol.planarity)
     meet = np.r_[flat, False] | np.r_[False, flat]      # generators of a coplanar pair
@@ -372,7 +380,7 @@ def pq_mesh(a, b, rows: int = 20, primary: int | str = "middle", option: int = 0
     if kept.size < m_given:
         mesh = _renumbered(mesh, kept)
     return mesh.with_info(runs=len(parts), restarts=restarts, planarity_tolerance=ptol, extend=args.extend,
-                          respace=plan.respace, option=args.option,
+                          respace=plan.respace, rows_from=args.rows_from.value, option=args.option,
                           primary="middle" if args.middle else args.primary, **fattening)
 
 
@@ -451,6 +459,20 @@ def _reflipped(mesh: Mesh, frozen: np.ndarray, scale: float) -> Mesh:
     return mesh
 
 
+class RowsFrom(str, Enum):
+    """Where the rows of :func:`pq_mesh` start: the division of the primary generator, or the
+    generators' end points on director curve c1 (``t = 0``) or c2 (``t = 1``)."""
+
+    PRIMARY = "primary"
+    C1 = "c1"
+    C2 = "c2"
+
+    @property
+    def ends(self) -> int | None:
+        """The end parameter the rows pass through (None: the primary's division)."""
+        return {"primary": None, "c1": 0, "c2": 1}[self.value]
+
+
 @dataclass(frozen=True)
 class _Args:
     """The mesher's arguments, checked."""
@@ -464,10 +486,11 @@ class _Args:
     max_extend: float
     ptol: float
     respace: bool
+    rows_from: RowsFrom = RowsFrom.PRIMARY
 
 
 def _checked(a, b, rows, primary, option, extend, trim, max_extend, planarity_tolerance, respace,
-             tol: Tolerances) -> tuple[np.ndarray, np.ndarray, _Args]:
+             tol: Tolerances, rows_from: str = "primary") -> tuple[np.ndarray, np.ndarray, _Args]:
     """Validate the arguments of :func:`pq_mesh` (ParameterError naming the parameter)."""
     a = check_points(a, "a", min_count=3)
     b = check_points(b, "b", min_count=3)
@@ -494,7 +517,7 @@ def _checked(a, b, rows, primary, option, extend, trim, max_extend, planarity_to
         planarity_tolerance, "planarity_tolerance", lo=0.0, hi=0.1)
     _check_grid_budget(m, rows, extend)
     return a, b, _Args(rows, p, middle, option, extend, trim, max_extend, max(ptol, tol.planarity),
-                       check_bool(respace, "respace"))
+                       check_bool(respace, "respace"), check_choice(rows_from, RowsFrom, "rows_from"))
 
 
 def _check_grid_budget(m: int, rows: int, extend: float | str) -> None:

@@ -52,6 +52,8 @@ class Division:
     ``extend``, checkerboard colour ``option``), or *matched*: the given
     parameters ``matched`` (increasing, the vertices another run left on this
     generator), extended by their end spacings as far as the run needs.
+    ``ends`` (0 or 1; a uniform division only) also puts a row through the end
+    point ``t = ends`` of every generator the rows cross there (:func:`_through_ends`).
     """
 
     rows: int
@@ -59,6 +61,7 @@ class Division:
     extend: float | str = "auto"
     max_extend: float = 20.0
     matched: np.ndarray | None = None
+    ends: int | None = None
 
 
 @dataclass
@@ -168,6 +171,74 @@ def _matched_rows(M: np.ndarray, div: Division, tol: Tolerances) -> np.ndarray:
     return thinned_rows(M, out, (float(given[0]), float(given[-1])), div.rows)
 
 
+# Rows through the end points: of two roots closer than this share of an a-row step
+# (2 / rows), the second is left out (a row that meets the curve twice, on either side of
+# a turn, would otherwise be there twice) ...
+_ENDS_MIN_GAP = 0.2
+# ... and a b-row goes through an end point only where that root lies this far inside its
+# a-rows' bracket (else it keeps its convex root).
+_ENDS_B_MARGIN = 0.1
+
+
+def _end_roots(M: np.ndarray, side: float, lo: float, hi: float) -> np.ndarray:
+    """(m,) root parameters of the rows through each generator's point ``t = side`` (NaN
+    where that is at a pole or outside ``(lo, hi)``)."""
+    r = apply(inverse(M), np.full(len(M), side))
+    return np.where(np.isfinite(r) & (r > lo) & (r < hi), r, np.nan)
+
+
+def _through_ends(M: np.ndarray, tau: np.ndarray, parity: np.ndarray, side: float,
+                  rows: int) -> np.ndarray:
+    """Chain *a*'s roots moved so that a row passes through the end point ``t = side`` of
+    every a-generator (b-rows at the middles, rooted afterwards).
+
+    Where every row the border cuts passes through a generator's end point, the
+    border edges are edges of quads (the hop from one end point lands on the
+    next-but-one generator inside the patch, the other chain ends on the border
+    between): no teeth of triangles along that director curve.  Beyond the
+    range of these roots the uniform rows stay (rows that never reach the curve).
+    """
+    step = 2.0 / rows
+    ends = _end_roots(M, side, tau[0], tau[-1])
+    ends = np.sort(ends[(parity == 0) & np.isfinite(ends)])
+    if ends.size < 2:
+        return tau
+    # A row close to one kept before is left out (a run of close roots keeps its first).
+    kept = [ends[0]]
+    for r in ends[1:]:
+        if r - kept[-1] > _ENDS_MIN_GAP * step:
+            kept.append(r)
+    a_rows = tau[0::2]
+    outside = a_rows[(a_rows < kept[0] - 0.5 * step) | (a_rows > kept[-1] + 0.5 * step)]
+    a_rows = np.sort(np.concatenate([outside, kept]))
+    out = np.empty(2 * len(a_rows))
+    out[0::2] = a_rows
+    out[1:-1:2] = 0.5 * (a_rows[1:] + a_rows[:-1])
+    out[-1] = a_rows[-1] + 0.5 * (a_rows[-1] - a_rows[-2])
+    return out
+
+
+def _b_through_ends(M: np.ndarray, tau: np.ndarray, parity: np.ndarray, side: float) -> np.ndarray:
+    """Chain *b*'s roots moved onto the end points ``t = side`` of the b-generators: in each
+    bracket of a-rows the end point's root nearest its middle, where one lies inside."""
+    ends = _end_roots(M, side, tau[0], tau[-1])
+    ends = np.sort(ends[(parity == 1) & np.isfinite(ends)])
+    if ends.size == 0:
+        return tau
+    lo, hi = tau[0:-2:2], tau[2::2]
+    mid = 0.5 * (lo + hi)
+    k = np.clip(np.searchsorted(ends, mid), 1, ends.size - 1) if ends.size > 1 else np.zeros(len(mid), int)
+    near = ends[k]
+    if ends.size > 1:
+        other = ends[k - 1]
+        near = np.where(np.abs(other - mid) < np.abs(near - mid), other, near)
+    margin = _ENDS_B_MARGIN * (hi - lo)
+    inside = (near > lo + margin) & (near < hi - margin)
+    out = tau.copy()
+    out[1:-1:2] = np.where(inside, near, tau[1:-1:2])
+    return out
+
+
 def _root_b_rows(M: np.ndarray, N: np.ndarray, tau: np.ndarray, primary: int,
                  parity: np.ndarray) -> np.ndarray:
     """Chain *b*'s roots, each in the middle of the interval that keeps its faces convex.
@@ -249,14 +320,19 @@ def mesh_run(a: np.ndarray, d: np.ndarray, first: int, primary: int, div: Divisi
         tau = _matched_rows(M, div, tol)
     else:
         tau = _uniform_rows(M, div, first + primary, tol, warnings)
+    parity = (np.arange(m) - primary) % 2                     # 0: chain a, 1: chain b
+    side = None if div.ends is None or div.matched is not None else float(div.ends)
+    if side is not None:
+        tau = _through_ends(M, tau, parity, side, div.rows)
     H = len(tau) // 2
     if m * 2 * H > MAX_GRID_POINTS:
         need = m * 2 * H * BYTES_PER_GRID_POINT / 2**30
         raise GeometryError(f"the grid would have {m} x {2 * H} points (about {need:.1f} GiB); "
                             f"reduce the generator count, the rows or the extension")
-    parity = (np.arange(m) - primary) % 2                     # 0: chain a, 1: chain b
     N = drift_maps(a, d, M, hops.crossing)
     tau = _root_b_rows(M, N, tau, primary, parity)
+    if side is not None:
+        tau = _b_through_ends(M, tau, parity, side)
     return _grid(a, d, first, maps, tau, parity, tol, scale, hops.crossing)
 
 
