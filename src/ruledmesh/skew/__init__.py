@@ -25,8 +25,8 @@ from .compound import (
     compound_net,
 )
 from .hybrid import checkerboard_faces, hybrid_grid, hybrid_mesh, orient_generators
-from .pq import MAX_GRID_POINTS, pq_mesh, row_maps
+from .pq import MAX_GRID_POINTS, RowsFrom, pq_mesh, row_maps
 
-__all__ = ["MAX_GRID_POINTS", "CompoundReference", "CompoundSurface", "c1_residual", "c1_step",
+__all__ = ["MAX_GRID_POINTS", "CompoundReference", "RowsFrom", "CompoundSurface", "c1_residual", "c1_step",
            "checkerboard_faces", "compound_mesh", "compound_net", "hybrid_grid", "hybrid_mesh",
            "orient_generators", "pq_mesh", "row_maps"]

@@ -299,8 +299,7 @@ def pq_mesh(a, b, rows: int = 20, primary: int | str = "middle", option: int = 0
         lengths); ``"auto"`` covers the patch on every generator, leaving out rows
         that would bunch (:mod:`.extension`); ``"full"`` keeps every row.
     trim : bool
-        Trim the faces to the patch ``0 <= t <= 1``, keeping every vertex on a
-        generator.
+        Trim the faces to the patch ``0 <= t <= 1``, every vertex staying on a generator.
     max_extend : float
         Cap of the automatic extension.
     creases : (k,) int, optional
@@ -316,11 +315,7 @@ def pq_mesh(a, b, rows: int = 20, primary: int | str = "middle", option: int = 0
     respace : bool
         Also restart the rows where they spread, evened there (:mod:`.respacing`).
     rows_from : {"primary", "c1", "c2"}
-        ``"primary"``: the rows start at the division of the primary generator (§4.3).
-        ``"c1"`` (``"c2"``): each row the director curve at ``t = 0`` (``t = 1``) cuts
-        passes through a generator's end point there, so that the border along that
-        curve is edges of quads instead of a band of teeth (the rows' spacing is then
-        that of the end points; restarted runs keep their matched divisions).
+        Where the rows start (:class:`RowsFrom`).
     tol : Tolerances
 
     Returns
@@ -330,7 +325,7 @@ def pq_mesh(a, b, rows: int = 20, primary: int | str = "middle", option: int = 0
         coplanar generators), FILL (notch, torsal, border triangles) and SPLIT
         (halves of quads that were not convex); members are the generator
         segments between vertices; ``vertex_data`` holds ``t`` and ``generator``;
-        ``info`` the ``warnings``, the ``runs``, ``restarts``, ``option``, ``primary`` and how
+        ``info`` the ``warnings``, ``runs``, ``restarts``, ``option``, ``primary``, ``rows_from``, how
         many ``flips``, ``collapsed``, ``paired``, ``snapped``, ``trimmed``, ``opened`` and
         ``cut`` faces the passes after the grid made.
 
@@ -460,8 +455,14 @@ def _reflipped(mesh: Mesh, frozen: np.ndarray, scale: float) -> Mesh:
 
 
 class RowsFrom(str, Enum):
-    """Where the rows of :func:`pq_mesh` start: the division of the primary generator, or the
-    generators' end points on director curve c1 (``t = 0``) or c2 (``t = 1``)."""
+    """Where the rows of :func:`pq_mesh` start.
+
+    ``PRIMARY``: the division of the primary generator (§4.3).  ``C1`` (``C2``): each row
+    the director curve at ``t = 0`` (``t = 1``) cuts passes through a generator's end point
+    there, so the border along that curve is edges of quads instead of a band of teeth; the
+    rows are then as far apart as the end points' rows, and restarted runs keep their
+    matched divisions (:func:`.runs._through_ends`).
+    """
 
     PRIMARY = "primary"
     C1 = "c1"
