@@ -66,7 +66,7 @@ def build_pq(rulings, table: Mapping[str, Any], ctx: BuildContext) -> Built:
         if refine:
             rulings, kept, notes = _refined(rulings, mesh, options, respace == "auto",
                                             rows_from == "auto")
-            mesh, chosen = _other_checkerboards(kept, options, free=(
+            mesh, chosen = _other_rows(kept, options, free=(
                 "option" not in table, "primary" not in table, rows_from == "auto"))
             notes += chosen
             if notes:
@@ -242,7 +242,7 @@ def _refined(rulings, mesh, options: dict, respace_auto: bool = False, rows_from
         # it), and the rounds from there.  On 24 random two-B-spline designs (40-60
         # generators, 20-40 rows) the mean share in triangles 11.9 -> 11.3 %, 7 -> 4 above
         # 12 %, 5 % fewer faces, twice the build time of the 24 (13 -> 27 s); the meshes
-        # kept from these rounds alone (and the choice at the end, _through_ends) gave
+        # kept from these rounds alone (and the choice at the end, _from_either_curve) gave
         # 11.4 % with 1 % more faces.  millimetre-scale 18.4 -> 13.9 %,
         # examples/right-conoid-arc 17.9 -> 13.1 %, skew-bspline-301x300 17.9 -> 17.3 % with
         # 99k faces instead of 186k (7 -> 23 s).
@@ -296,13 +296,13 @@ def _fixed_generators(rulings) -> bool:
 _OTHER_PRIMARIES = (1 / 3, 2 / 3)
 
 
-def _other_checkerboards(kept: tuple, options: dict, free: tuple[bool, bool, bool]) -> tuple:
+def _other_rows(kept: tuple, options: dict, free: tuple[bool, bool, bool]) -> tuple:
     """Where the mesh of the round ``kept`` (as :func:`_round`) misses a goal: ``(mesh, notes)``,
     the more fabricable (:func:`_fabricable`) of the meshes of its generators from the paper's
     two checkerboards (``option``) and three primaries (the middle, a third and two thirds
     in), where the design leaves them free (``free``: option, primary, rows_from), then of
     that mesh with its rows through the end points on either director curve
-    (:func:`_through_ends`), and a note if it is another.
+    (:func:`_from_either_curve`), and a note if it is another.
 
     The rows of §4.3 depend on both; for explicit lines they are the only freedom left.  On
     the Plücker conoid from 41 lines (``plucker-lines-a1-41``) 26.0 % of the area in
@@ -316,7 +316,7 @@ def _other_checkerboards(kept: tuple, options: dict, free: tuple[bool, bool, boo
     options = {**options, **{k: mesh.info[k] for k in ("planarity_tolerance", "extend", "respace")}}
     said: list[str] = []
     if sum(_goals_met(best, goal)) < 2 and any(free[:2]):
-        best = _more_fabricable(best, rulings, options, goal, _checkerboards(rulings, options, free))
+        best = _more_fabricable(best, rulings, goal, _checkerboards(rulings, options, free))
         if best is not kept:
             other = best[4]
             said = [f"option {other.info['option']}"] if free[0] else []
@@ -324,7 +324,7 @@ def _other_checkerboards(kept: tuple, options: dict, free: tuple[bool, bool, boo
             said = [f"rows from {' and '.join(said)} (of the two checkerboards and three primary "
                     f"generators tried): that mesh had more of its area in quads or fewer splinters; "
                     f"[mesh] option and primary choose them"]
-    through = _through_ends(best, rulings, options, goal) if free[2] else best
+    through = _from_either_curve(best, rulings, options, goal) if free[2] else best
     if through is not best:
         if through[4].info["rows_from"] != best[4].info["rows_from"]:
             said.append(_rows_from_note(through[4].info["rows_from"]))
@@ -343,8 +343,7 @@ def _checkerboards(rulings, options: dict, free: tuple[bool, ...]) -> list[dict]
             if (o, p) != first]
 
 
-def _more_fabricable(best: tuple, rulings, options: dict, goal: float, tries: list[dict],
-                     priced: bool = False) -> tuple:
+def _more_fabricable(best: tuple, rulings, goal: float, tries: list[dict], priced: bool = False) -> tuple:
     """The most fabricable of ``best`` and the meshes of ``rulings`` with each of ``tries``;
     with ``priced`` none with more splinters than ``best``, and one with more faces only
     where it meets more goals or pays for its panels (:func:`_price`, as for generators)."""
@@ -378,7 +377,7 @@ def _short(round_: tuple, goal: float) -> bool:
     return sum(_goals_met(round_, goal)) < 2 or 1.0 - round_[0] > _typical(goal)
 
 
-def _through_ends(kept: tuple, rulings, options: dict, goal: float) -> tuple:
+def _from_either_curve(kept: tuple, rulings, options: dict, goal: float) -> tuple:
     """Where the mesh of ``kept`` misses a goal or has more than the typical share of its area
     in triangles: the more fabricable of it and its rows through the end points of the
     generators on director curve c1 or c2 (``rows_from``), with its option and primary.
@@ -396,7 +395,7 @@ def _through_ends(kept: tuple, rulings, options: dict, goal: float) -> tuple:
     mesh = kept[4]
     base = {**options, "option": mesh.info["option"], "primary": mesh.info["primary"]}
     tries = [{**base, "rows_from": side.value} for side in (RowsFrom.C1, RowsFrom.C2)]
-    return _more_fabricable(kept, rulings, base, goal, tries, priced=True)
+    return _more_fabricable(kept, rulings, goal, tries, priced=True)
 
 
 def _candidates(rulings, mesh, options: dict, grid: np.ndarray, user: int, goal: float) -> list[tuple]:
