@@ -469,17 +469,19 @@ def test_rows_through_the_end_points_leave_no_teeth_on_that_curve():
         pq_mesh(A, B, rows_from="c3")
 
 
-@pytest.mark.parametrize("seed", range(6))
-@pytest.mark.parametrize("rows_from", ["c1", "c2"])
-def test_rows_through_the_end_points_keep_the_invariants(seed, rows_from):
+@settings(max_examples=30, deadline=None, suppress_health_check=[HealthCheck.too_slow])
+@given(seed=st.integers(0, 2**32 - 1), rows_from=st.sampled_from(["c1", "c2"]), m=st.integers(12, 61),
+       rows=st.integers(4, 40), option=st.integers(0, 1))
+def test_rows_through_the_end_points_keep_the_invariants(seed, rows_from, m, rows, option):
     """Random skew surfaces between two smooth curves: every face planar, convex and with
-    area, every vertex on its generator, with the rows through either curve's end points."""
+    area, every vertex on its generator inside the patch, with the rows through either
+    curve's end points."""
     rng = np.random.default_rng(seed)
-    s = np.linspace(0.0, 1.0, 41)[:, None]
+    s = np.linspace(0.0, 1.0, m)[:, None]
     k1, k2 = rng.normal(size=(2, 3)), rng.normal(size=(2, 3))
     c1 = np.c_[10 * s, np.zeros_like(s), np.zeros_like(s)] + np.sin(3 * s) * k1[0] + s ** 2 * k1[1]
     c2 = np.c_[10 * s, 2 + 0 * s, 4 + 0 * s] + np.cos(2 * s) * k2[0] + s ** 3 * k2[1]
-    mesh = pq_mesh(c1, c2, rows=20, rows_from=rows_from)
+    mesh = pq_mesh(c1, c2, rows=rows, rows_from=rows_from, option=option)
     check_mesh(mesh)
     g, t = mesh.vertex_data["generator"], mesh.vertex_data["t"]
     assert np.abs(mesh.vertices - (c1[g] + t[:, None] * (c2 - c1)[g])).max() <= 1e-12 * 12
