@@ -237,21 +237,22 @@ def _refined(rulings, mesh, options: dict, respace_auto: bool = False, rows_from
         if first.info["restarts"] > mesh.info["restarts"]:
             rounds += _candidates(rulings, first, spaced, grid, user, goal)
     so_far = max(rounds, key=lambda r: _fabricable(r, goal))
-    if rows_from_auto and _short(so_far, goal):
+    if rows_from_auto and options["trim"] and _short(so_far, goal):
         # Rows through the end points on either director curve (no teeth of triangles along
-        # it), and the rounds from there.  On 24 random two-B-spline designs (40-60
-        # generators, 20-40 rows) the mean share in triangles 11.9 -> 11.3 %, 7 -> 4 above
-        # 12 %, 5 % fewer faces, twice the build time of the 24 (13 -> 27 s); the meshes
-        # kept from these rounds alone (and the choice at the end, _from_either_curve) gave
-        # 11.4 % with 1 % more faces.  millimetre-scale 18.4 -> 13.9 %,
-        # examples/right-conoid-arc 17.9 -> 13.1 %, skew-bspline-301x300 17.9 -> 17.3 % with
-        # 99k faces instead of 186k (7 -> 23 s).
+        # it), and the rounds from the better of the two where its first mesh has more of its
+        # area in quads than the first from the primary.  On 24 random two-B-spline designs
+        # (40-60 generators, 20-40 rows) the mean share in triangles 11.9 -> 11.3 %, 7 -> 4
+        # above 12 %, as many faces, twice the build time of the 24 (13 -> 26 s);
+        # millimetre-scale 18.4 -> 13.9 %, examples/right-conoid-arc 17.9 -> 13.1 %,
+        # skew-bspline-301x300 17.9 -> 17.3 % with 99k faces instead of 186k (9 -> 17 s).
+        # The rounds from both curves, always, took twisted-arcs-120deg to 9.9 % too, for half
+        # as much build time again on the quality surfaces (80 -> 117 s).
         # They never bring in a splinter (linear-directrix: 29.0 -> 25.0 % with a face at
         # 2.86 degrees, a smaller miss by _fabricable, but a new kind of panel to cut).
-        for side in (RowsFrom.C1, RowsFrom.C2):
-            rooted = {**options, "rows_from": side.value}
-            rounds += [r for r in _candidates(rulings, _mesh(rulings, rooted), rooted, grid, user, goal)
-                       if r[1] <= so_far[1]]
+        tries = [{**options, "rows_from": side.value} for side in (RowsFrom.C1, RowsFrom.C2)]
+        rooted, first = max(((o, _mesh(rulings, o)) for o in tries), key=lambda f: _measured(f[1])[0])
+        if _measured(first)[0] > _measured(mesh)[0]:
+            rounds += [r for r in _candidates(rulings, first, rooted, grid, user, goal) if r[1] <= so_far[1]]
     best = _worth_its_panels(max(rounds, key=lambda r: _fabricable(r, goal)), rounds, goal)
     added = int(best[3].info.get("inserted", 0)) - int(rulings.info.get("inserted", 0))
     rulings, mesh = best[3], best[4]
@@ -324,7 +325,8 @@ def _other_rows(kept: tuple, options: dict, free: tuple[bool, bool, bool]) -> tu
             said = [f"rows from {' and '.join(said)} (of the two checkerboards and three primary "
                     f"generators tried): that mesh had more of its area in quads or fewer splinters; "
                     f"[mesh] option and primary choose them"]
-    through = _from_either_curve(best, rulings, options, goal) if free[2] else best
+    # Untrimmed, a mesh has no border to cut teeth along.
+    through = _from_either_curve(best, rulings, options, goal) if free[2] and options["trim"] else best
     if through is not best:
         if through[4].info["rows_from"] != best[4].info["rows_from"]:
             said.append(_rows_from_note(through[4].info["rows_from"]))
