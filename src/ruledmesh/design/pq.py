@@ -250,8 +250,10 @@ def _refined(rulings, mesh, options: dict, respace_auto: bool = False, rows_from
         # They never bring in a splinter (linear-directrix: 29.0 -> 25.0 % with a face at
         # 2.86 degrees, a smaller miss by _fabricable, but a new kind of panel to cut).
         tries = [{**options, "rows_from": side.value} for side in (RowsFrom.C1, RowsFrom.C2)]
-        rooted, first = max(((o, _mesh(rulings, o)) for o in tries), key=lambda f: _measured(f[1])[0])
-        if _measured(first)[0] > _measured(mesh)[0]:
+        firsts = [(o, _mesh(rulings, o)) for o in tries]
+        shares = [_measured(m)[0] for _, m in firsts]
+        rooted, first = firsts[int(np.argmax(shares))]
+        if max(shares) > rounds[0][0]:       # the first round: the mesh from the primary
             rounds += [r for r in _candidates(rulings, first, rooted, grid, user, goal) if r[1] <= so_far[1]]
     best = _worth_its_panels(max(rounds, key=lambda r: _fabricable(r, goal)), rounds, goal)
     added = int(best[3].info.get("inserted", 0)) - int(rulings.info.get("inserted", 0))
@@ -320,9 +322,9 @@ def _other_rows(kept: tuple, options: dict, free: tuple[bool, bool, bool]) -> tu
         best = _more_fabricable(best, rulings, goal, _checkerboards(rulings, options, free))
         if best is not kept:
             other = best[4]
-            said = [f"option {other.info['option']}"] if free[0] else []
-            said += [f"the primary generator {other.info['primary']} of {len(rulings.a)}"] if free[1] else []
-            said = [f"rows from {' and '.join(said)} (of the two checkerboards and three primary "
+            named = [f"option {other.info['option']}"] if free[0] else []
+            named += [f"the primary generator {other.info['primary']} of {len(rulings.a)}"] if free[1] else []
+            said = [f"rows from {' and '.join(named)} (of the two checkerboards and three primary "
                     f"generators tried): that mesh had more of its area in quads or fewer splinters; "
                     f"[mesh] option and primary choose them"]
     # Untrimmed, a mesh has no border to cut teeth along.

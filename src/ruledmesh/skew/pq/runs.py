@@ -139,6 +139,16 @@ def matched(div: Division, t: np.ndarray | None) -> Division:
                     div.max_extend, t)
 
 
+def _with_middles(a_rows: np.ndarray, last_step: float) -> np.ndarray:
+    """Root parameters of a-rows ``a_rows`` with the b-rows at their middles, and one more
+    b-row half ``last_step`` beyond the last a-row."""
+    out = np.empty(2 * len(a_rows))
+    out[0::2] = a_rows
+    out[1:-1:2] = 0.5 * (a_rows[1:] + a_rows[:-1])
+    out[-1] = a_rows[-1] + 0.5 * last_step
+    return out
+
+
 def _matched_rows(M: np.ndarray, div: Division, tol: Tolerances) -> np.ndarray:
     """Root parameters from a matched division, extended by the end spacings.
 
@@ -161,11 +171,7 @@ def _matched_rows(M: np.ndarray, div: Division, tol: Tolerances) -> np.ndarray:
     n0, n1 = min(n0, 100_000), min(n1, 100_000)
     a_rows = np.concatenate([given[0] - s0 * np.arange(n0, 0, -1), given,
                              given[-1] + s1 * np.arange(1, n1 + 1)])
-    mid = 0.5 * (a_rows[1:] + a_rows[:-1])
-    out = np.empty(2 * len(a_rows))
-    out[0::2] = a_rows
-    out[1:-1:2] = mid
-    out[-1] = a_rows[-1] + 0.5 * s1
+    out = _with_middles(a_rows, s1)
     if div.extend == "full":
         return out
     return thinned_rows(M, out, (float(given[0]), float(given[-1])), div.rows)
@@ -211,11 +217,7 @@ def _through_ends(M: np.ndarray, tau: np.ndarray, parity: np.ndarray, side: floa
     a_rows = tau[0::2]
     outside = a_rows[(a_rows < kept[0] - 0.5 * step) | (a_rows > kept[-1] + 0.5 * step)]
     a_rows = np.sort(np.concatenate([outside, kept]))
-    out = np.empty(2 * len(a_rows))
-    out[0::2] = a_rows
-    out[1:-1:2] = 0.5 * (a_rows[1:] + a_rows[:-1])
-    out[-1] = a_rows[-1] + 0.5 * (a_rows[-1] - a_rows[-2])
-    return out
+    return _with_middles(a_rows, a_rows[-1] - a_rows[-2])
 
 
 def _b_through_ends(M: np.ndarray, tau: np.ndarray, parity: np.ndarray, side: float) -> np.ndarray:
