@@ -469,18 +469,59 @@ def test_rows_through_the_end_points_leave_no_teeth_on_that_curve():
         pq_mesh(A, B, rows_from="c3")
 
 
+def _same_mesh(m1, m2) -> bool:
+    return all(np.array_equal(getattr(m1, k), getattr(m2, k)) for k in (
+        "vertices", "face_offsets", "face_indices", "face_kind", "members", "member_id"))
+
+
+def test_rows_from_per_generator_give_each_segment_its_own():
+    """``rows_from`` per generator: each segment between torsal generators (here where the
+    twist changes sign) takes the value of the generator its rows start from; one value for
+    every generator is the mesh of that value, bit for bit."""
+    s = np.linspace(0.0, 1.0, 41)[:, None]
+    A = np.c_[10 * s, 0 * s, 0 * s]
+    B = np.c_[10 * s, 3 * np.sin(2 * np.pi * s), 4 + 0 * s]
+    c1 = pq_mesh(A, B, rows=12, rows_from="c1")
+    assert _same_mesh(c1, pq_mesh(A, B, rows=12, rows_from=["c1"] * 41))
+    segments = c1.info["row_segments"]
+    assert sorted(sg[:2] for sg in segments) == [[0, 10], [11, 30], [31, 40]]
+    per = ["c1"] * 41
+    per[11:31] = ["c2"] * 20
+    mixed = pq_mesh(A, B, rows=12, rows_from=per)
+    check_mesh(mixed)
+    assert mixed.info["rows_from"] == "mixed"
+    assert sorted(mixed.info["row_segments"]) == [[0, 10, "c1"], [11, 30, "c2"], [31, 40, "c1"]]
+    g, t = mixed.vertex_data["generator"], mixed.vertex_data["t"]
+    assert np.abs(mixed.vertices - (A[g] + t[:, None] * (B - A)[g])).max() <= 1e-12 * 10
+    # The middle segment's faces are those of the mesh with every row from c2.
+    c2 = pq_mesh(A, B, rows=12, rows_from="c2")
+
+    def inner(m):
+        gf = m.vertex_data["generator"][m.face_indices].reshape(-1)
+        first = np.add.reduceat(gf, m.face_offsets[:-1]) / m.valences
+        sel = (first > 12) & (first < 29)
+        return np.sort(np.round(face_areas(m)[sel], 12))
+    assert np.array_equal(inner(mixed), inner(c2)) and not np.array_equal(inner(mixed), inner(c1))
+    with pytest.raises(ParameterError, match=r"rows_from.*one per generator"):
+        pq_mesh(A, B, rows_from=["c1"] * 40)
+    with pytest.raises(ParameterError, match=r"rows_from\[40\]"):
+        pq_mesh(A, B, rows_from=["c1"] * 40 + ["c3"])
+
+
 @settings(max_examples=30, deadline=None, suppress_health_check=[HealthCheck.too_slow])
-@given(seed=st.integers(0, 2**32 - 1), rows_from=st.sampled_from(["c1", "c2"]), m=st.integers(12, 61),
+@given(seed=st.integers(0, 2**32 - 1), rows_from=st.sampled_from(["c1", "c2", "mixed"]), m=st.integers(12, 61),
        rows=st.integers(4, 40), option=st.integers(0, 1))
 def test_rows_through_the_end_points_keep_the_invariants(seed, rows_from, m, rows, option):
     """Random skew surfaces between two smooth curves: every face planar, convex and with
     area, every vertex on its generator inside the patch, with the rows through either
-    curve's end points."""
+    curve's end points (or, per generator, from either or the primary)."""
     rng = np.random.default_rng(seed)
     s = np.linspace(0.0, 1.0, m)[:, None]
     k1, k2 = rng.normal(size=(2, 3)), rng.normal(size=(2, 3))
     c1 = np.c_[10 * s, np.zeros_like(s), np.zeros_like(s)] + np.sin(3 * s) * k1[0] + s ** 2 * k1[1]
     c2 = np.c_[10 * s, 2 + 0 * s, 4 + 0 * s] + np.cos(2 * s) * k2[0] + s ** 3 * k2[1]
+    if rows_from == "mixed":     # per generator, at random
+        rows_from = rng.choice(["primary", "c1", "c2"], size=m).tolist()
     mesh = pq_mesh(c1, c2, rows=rows, rows_from=rows_from, option=option)
     check_mesh(mesh)
     g, t = mesh.vertex_data["generator"], mesh.vertex_data["t"]

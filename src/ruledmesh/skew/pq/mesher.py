@@ -2,7 +2,8 @@
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from collections.abc import Sequence
+from dataclasses import dataclass, field, replace
 from enum import Enum
 
 import numpy as np
@@ -94,6 +95,20 @@ class _Plan:
     crease_generators: frozenset = frozenset()
     hops: HopMaps | None = None     # of all the generators: each run takes its part
     respace: bool = False           # restart where the rows spread (.respacing)
+    # (m,) where the rows of a segment with a division of its own start, by the generator
+    # they start from (RowsFrom.ends, -1 for the primary's division); None: the Division's.
+    ends: np.ndarray | None = None
+    # [lo, hi, ends] of each segment built with a division of its own, filled by _build_all.
+    own: list = field(default_factory=list)
+
+    def division(self, div: Division, lo: int, hi: int, primary: int) -> Division:
+        """``div`` with the end points of the segment ``lo..hi`` (rows from global
+        generator ``primary``), recorded in :attr:`own`."""
+        if self.ends is not None:
+            e = int(self.ends[primary])
+            div = replace(div, ends=None if e < 0 else e)
+        self.own.append([lo, hi, -1 if div.ends is None else div.ends])
+        return div
 
 
 def _cut_at(run: Run, lo: int, primary: int, m: int, plan: _Plan, rows: int) -> tuple[int | None, int | None]:
@@ -280,7 +295,8 @@ def _listed(ks: np.ndarray) -> str:
 def pq_mesh(a, b, rows: int = 20, primary: int | str = "middle", option: int = 0,
             extend: float | str = "auto", trim: bool = True, *, max_extend: float = 20.0,
             creases=None, crease_generators=None, planarity_tolerance: float | None = None,
-            respace: bool = False, rows_from: str = "primary", tol: Tolerances = DEFAULT) -> Mesh:
+            respace: bool = False, rows_from: str | Sequence[str] = "primary",
+            tol: Tolerances = DEFAULT) -> Mesh:
     """The §4.3 PQ mesh of the ruled surface through generators ``a_i b_i``.
 
     Parameters
@@ -314,8 +330,9 @@ def pq_mesh(a, b, rows: int = 20, primary: int | str = "middle", option: int = 0
         ``tol.planarity`` (exact to rounding).
     respace : bool
         Also restart the rows where they spread, evened there (:mod:`.respacing`).
-    rows_from : {"primary", "c1", "c2"}
-        Where the rows start (:class:`RowsFrom`).
+    rows_from : {"primary", "c1", "c2"} or (m,) sequence of them
+        Where the rows start (:class:`RowsFrom`); per generator, a segment with a division of
+        its own (between torsal generators) taking the value where its rows start.
     tol : Tolerances
 
     Returns
@@ -325,8 +342,9 @@ def pq_mesh(a, b, rows: int = 20, primary: int | str = "middle", option: int = 0
         coplanar generators), FILL (notch, torsal, border triangles) and SPLIT
         (halves of quads that were not convex); members are the generator
         segments between vertices; ``vertex_data`` holds ``t`` and ``generator``;
-        ``info`` the ``warnings``, ``runs``, ``restarts``, ``option``, ``primary``, ``rows_from``, how
-        many ``flips``, ``collapsed``, ``paired``, ``snapped``, ``trimmed``, ``opened`` and
+        ``info`` the ``warnings``, ``runs``, ``restarts``, ``option``, ``primary``, ``rows_from``
+        (``"mixed"`` if the segments differ; ``row_segments``: ``[lo, hi, rows_from]`` of each),
+        how many ``flips``, ``collapsed``, ``paired``, ``snapped``, ``trimmed``, ``opened`` and
         ``cut`` faces the passes after the grid made.
 
     Raises
@@ -351,20 +369,17 @@ def pq_mesh(a, b, rows: int = 20, primary: int | str = "middle", option: int = 0
     """
     a, b, args = _checked(a, b, rows, primary, option, extend, trim, max_extend,
                           planarity_tolerance, respace, tol, rows_from)
-    rows, ptol = args.rows, args.ptol
-    d = b - a
+    rows, ptol, d = args.rows, args.ptol, b - a
     scale = _patch_scale(a, b, d, tol)
     warnings: list[str] = []
-    m_given = len(a)
     kept = _single_generators(a, d, rows, warnings)
-    a, d, creases, crease_generators = _keep(kept, a, d, creases, crease_generators)
+    m_given, (a, d, creases, crease_generators) = len(a), _keep(kept, a, d, creases, crease_generators)
     m = len(a)
     flat, torsal, cg, segs = _cut(a, d, rows, ptol, scale, tol, creases, crease_generators, warnings)
-    plan = _Plan(a, d, tol, scale, warnings, frozenset(cg.tolist()), hop_maps(a, d), args.respace)
+    plan = _Plan(a, d, tol, scale, warnings, frozenset(cg.tolist()), hop_maps(a, d), args.respace,
+                 args.ends[kept])
     primary = int(np.searchsorted(kept, args.primary, side="right") - 1)
-    parts = _build_all(plan, segs, primary, args.middle,
-                       Division(rows, args.option, args.extend, args.max_extend,
-                                ends=args.rows_from.ends), m)
+    parts = _build_all(plan, segs, primary, args.middle, Division(rows, args.option, args.extend, args.max_extend), m)
     restarts = max(len([r for r in parts if len(r.left)]) - len([s for s in segs if s.hi - s.lo >= 2]), 0)
     even = _even_ranges(parts, segs, warnings, exact=ptol <= tol.planarity)
     meet = np.r_[flat, False] | np.r_[False, flat]      # generators of a coplanar pair
@@ -375,7 +390,7 @@ def pq_mesh(a, b, rows: int = 20, primary: int | str = "middle", option: int = 0
     if kept.size < m_given:
         mesh = _renumbered(mesh, kept)
     return mesh.with_info(runs=len(parts), restarts=restarts, planarity_tolerance=ptol, extend=args.extend,
-                          respace=plan.respace, rows_from=args.rows_from.value, option=args.option,
+                          respace=plan.respace, **_rows_from_info(plan.own, kept), option=args.option,
                           primary="middle" if args.middle else args.primary, **fattening)
 
 
@@ -487,11 +502,11 @@ class _Args:
     max_extend: float
     ptol: float
     respace: bool
-    rows_from: RowsFrom = RowsFrom.PRIMARY
+    ends: np.ndarray = field(default_factory=lambda: np.zeros(0, np.int64))   # (m,) RowsFrom.ends or -1
 
 
 def _checked(a, b, rows, primary, option, extend, trim, max_extend, planarity_tolerance, respace,
-             tol: Tolerances, rows_from: str = "primary") -> tuple[np.ndarray, np.ndarray, _Args]:
+             tol: Tolerances, rows_from: str | Sequence[str] = "primary") -> tuple[np.ndarray, np.ndarray, _Args]:
     """Validate the arguments of :func:`pq_mesh` (ParameterError naming the parameter)."""
     a = check_points(a, "a", min_count=3)
     b = check_points(b, "b", min_count=3)
@@ -518,7 +533,30 @@ def _checked(a, b, rows, primary, option, extend, trim, max_extend, planarity_to
         planarity_tolerance, "planarity_tolerance", lo=0.0, hi=0.1)
     _check_grid_budget(m, rows, extend)
     return a, b, _Args(rows, p, middle, option, extend, trim, max_extend, max(ptol, tol.planarity),
-                       check_bool(respace, "respace"), check_choice(rows_from, RowsFrom, "rows_from"))
+                       check_bool(respace, "respace"), _ends(rows_from, m))
+
+
+def _ends(rows_from, m: int) -> np.ndarray:
+    """(m,) int64: ``rows_from`` (one value, or one per generator) as :attr:`RowsFrom.ends`,
+    -1 for the primary's division."""
+    if isinstance(rows_from, str) or not hasattr(rows_from, "__len__"):
+        values = [check_choice(rows_from, RowsFrom, "rows_from")] * m
+    elif len(rows_from) != m:
+        raise ParameterError(f"expected one value or one per generator ({m}), got {len(rows_from)}",
+                             "rows_from")
+    else:
+        values = [check_choice(v, RowsFrom, f"rows_from[{i}]") for i, v in enumerate(rows_from)]
+    return np.array([-1 if v.ends is None else v.ends for v in values], np.int64)
+
+
+_FROM_ENDS = {-1: RowsFrom.PRIMARY.value, 0: RowsFrom.C1.value, 1: RowsFrom.C2.value}
+
+
+def _rows_from_info(own: list, kept: np.ndarray) -> dict:
+    """``rows_from`` and ``row_segments`` of the info, in the given generators' numbering."""
+    segments = [[int(kept[lo]), int(kept[hi]), _FROM_ENDS[e]] for lo, hi, e in own]
+    sides = {s[2] for s in segments}
+    return {"rows_from": sides.pop() if len(sides) == 1 else "mixed", "row_segments": segments}
 
 
 def _check_grid_budget(m: int, rows: int, extend: float | str) -> None:
@@ -740,7 +778,8 @@ def _build_all(plan: _Plan, segs: list[_Segment], p: int, middle: bool, div: Div
     built: dict[int, list[Run]] = {}
     s = segs[home]
     pr = (p - s.lo) if not middle else _well_twisted(plan, s.lo, s.hi)
-    built[home] = _build_segment(plan, s.lo, s.hi, pr, div, budget, home=True)
+    built[home] = _build_segment(plan, s.lo, s.hi, pr, plan.division(div, s.lo, s.hi, s.lo + pr), budget,
+                                 home=True)
     for step in (1, -1):
         k = home + step
         while 0 <= k < len(segs):
@@ -756,8 +795,9 @@ def _build_all(plan: _Plan, segs: list[_Segment], p: int, middle: bool, div: Div
                 # Rows started on a torsal generator (K = 0 there) bunch and fan out:
                 # each segment takes its own division from its middle; the two meet
                 # on the torsal generator in a zipper.
-                built[k] = _build_segment(plan, s.lo, s.hi, _well_twisted(plan, s.lo, s.hi), div,
-                                          budget)
+                own = _well_twisted(plan, s.lo, s.hi)
+                built[k] = _build_segment(plan, s.lo, s.hi, own,
+                                          plan.division(div, s.lo, s.hi, s.lo + own), budget)
             else:
                 t = _boundary_t(built[k - step], src)
                 sub = matched(div, t if t.size else None)
