@@ -69,7 +69,7 @@ def build_pq(rulings, table: Mapping[str, Any], ctx: BuildContext) -> Built:
             mesh, chosen = _other_rows(kept, options, free=(
                 "option" not in table, "primary" not in table, rows_from == "auto"))
             notes += chosen
-            if mesh.info.get("rows_from", options["rows_from"]) != options["rows_from"]:
+            if mesh.info["rows_from"] != options["rows_from"] or mesh.info["option"] == "mixed":
                 notes.append(_rows_from_note(mesh.info))
             if notes:
                 mesh = mesh.with_info(warnings=list(mesh.info.get("warnings", [])) + notes)
@@ -317,19 +317,19 @@ def _other_rows(kept: tuple, options: dict, free: tuple[bool, bool, bool]) -> tu
     goal = _goal(options)
     best, rulings, mesh = kept, kept[3], kept[4]
     options = {**options, **{k: mesh.info[k] for k in ("planarity_tolerance", "extend", "respace")}}
-    said: list[str] = []
     if sum(_goals_met(best, goal)) < 2 and any(free[:2]):
         best = _more_fabricable(best, rulings, goal, _checkerboards(rulings, options, free))
-        if best is not kept:
-            other = best[4]
-            named = [f"option {other.info['option']}"] if free[0] else []
-            named += [f"the primary generator {other.info['primary']} of {len(rulings.a)}"] if free[1] else []
-            said = [f"rows from {' and '.join(named)} (of the two checkerboards and three primary "
-                    f"generators tried): that mesh had more of its area in quads or fewer splinters; "
-                    f"[mesh] option and primary choose them"]
     # Untrimmed, a mesh has no border to cut teeth along.
     if free[2] and options["trim"]:
-        best = _from_either_curve(best, rulings, options, goal)
+        best = _from_either_curve(best, rulings, options, goal, free[0])
+    info, was = best[4].info, mesh.info
+    # A checkerboard per segment ("mixed") is named with the starts (_rows_from_note).
+    named = [f"option {info['option']}"] if free[0] and info["option"] not in (was["option"], "mixed") else []
+    named += [f"the primary generator {info['primary']} of {len(rulings.a)}"] if free[1] and \
+        info["primary"] != was["primary"] else []
+    said = [f"rows from {' and '.join(named)} (of the two checkerboards and three primary "
+            f"generators tried): that mesh had more of its area in quads or fewer splinters; "
+            f"[mesh] option and primary choose them"] if named else []
     return best[4], said
 
 
@@ -369,19 +369,19 @@ def _more_fabricable(best: tuple, rulings, goal: float, tries: list[dict], price
 def _rows_from_note(info: Mapping[str, Any]) -> str:
     """What a note says of where a mesh's rows start (its ``info``, as :func:`pq_mesh` gives it)."""
     side = info["rows_from"]
-    if side != "mixed":
+    if "mixed" not in (side, info["option"]):
         return (f"rows through the generators' end points on director curve {side} (no teeth of "
                 f"triangles along it): that mesh had more of its area in quads or fewer splinters; "
                 f"[mesh] rows_from chooses it")
-    ranges: dict[str, list[str]] = {}
-    for lo, hi, where in sorted(info["row_segments"]):
-        ranges.setdefault(where, []).append(f"{lo}-{hi}")
+    ranges: dict[tuple, list[str]] = {}
+    for lo, hi, where, option in sorted(info["row_segments"]):
+        ranges.setdefault((where, option), []).append(f"{lo}-{hi}")
     start = {RowsFrom.PRIMARY.value: "from the primary"}
-    said = "; ".join(f"{start.get(where, 'through the end points on ' + where)} for generators {', '.join(r)}"
-                     for where, r in ranges.items())
-    return (f"rows {said} (each stretch between torsal generators where its mesh had the fewest "
+    said = "; ".join(f"{start.get(where, 'through the end points on ' + where)}, option {option}, "
+                     f"for generators {', '.join(r)}" for (where, option), r in ranges.items())
+    return (f"rows {said} (each stretch between torsal generators where its faces had the fewest "
             "splinters and triangles): that mesh had more of its area in quads or fewer splinters; "
-            '[mesh] rows_from = "c1" or "c2" takes one curve everywhere')
+            '[mesh] rows_from and option set one start and checkerboard everywhere')
 
 
 def _short(round_: tuple, goal: float) -> bool:
@@ -390,7 +390,7 @@ def _short(round_: tuple, goal: float) -> bool:
     return sum(_goals_met(round_, goal)) < 2 or 1.0 - round_[0] > _typical(goal)
 
 
-def _from_either_curve(kept: tuple, rulings, options: dict, goal: float) -> tuple:
+def _from_either_curve(kept: tuple, rulings, options: dict, goal: float, colours: bool = True) -> tuple:
     """Where the mesh of ``kept`` misses a goal or has more than the typical share of its area
     in triangles: the more fabricable of it and its rows through the end points of the
     generators on director curve c1 or c2 (``rows_from``), with its option and primary.
@@ -408,33 +408,40 @@ def _from_either_curve(kept: tuple, rulings, options: dict, goal: float) -> tupl
     mesh = kept[4]
     base = {**options, "option": mesh.info["option"], "primary": mesh.info["primary"]}
     tries = [{**base, "rows_from": side.value} for side in (RowsFrom.C1, RowsFrom.C2)]
-    mixed = _per_segment(rulings, mesh, tries)
-    return _more_fabricable(kept, rulings, goal, tries + ([{**base, "rows_from": mixed}] if mixed else []),
-                            priced=True)
+    mixed = _per_segment(rulings, mesh, base, colours)
+    return _more_fabricable(kept, rulings, goal, tries + ([{**base, **mixed}] if mixed else []), priced=True)
 
 
-def _per_segment(rulings, mesh, tries: list[dict]) -> list[str] | None:
-    """Per generator (as ``pq_mesh``'s ``rows_from``), where the rows of each segment between
-    torsal generators start: of ``mesh`` and the meshes of ``tries`` (the same generators and
-    segments, rows from c1 and c2), the one whose faces there have the fewest splinters, then
-    the least area in triangles; None where that is one choice everywhere.
+def _per_segment(rulings, mesh, base: dict, colours: bool = True) -> dict | None:
+    """``rows_from`` and ``option`` per generator (as :func:`pq_mesh` takes them): for each
+    segment between torsal generators, the start (the primary, c1 or c2) and checkerboard
+    whose faces there have the fewest splinters, then the least area in triangles, of
+    ``mesh`` and the meshes of its generators with the other five of those pairs (the other
+    two starts only, without ``colours``: the design sets the checkerboard); None where that is
+    ``mesh``'s own everywhere.
 
-    The segments take divisions of their own, so a segment's faces hardly depend on where the
-    others' rows start: on skew-bspline-51x30 the pick from the three meshes made 11.8 % of
+    Each segment takes a division of its own, so its faces hardly depend on the others' rows:
+    on skew-bspline-51x30 the pick from the meshes with the kept checkerboard made 11.8 % of
     the area triangles against 12.5 % for the best of them (the best of all 81 combinations:
-    10.6 %, with a face of 1.2 degrees), millimetre-scale 13.9 -> 12.9 % (the best of all).
+    10.6 %, with a face of 1.2 degrees), millimetre-scale 13.9 -> 12.9 % (the best of all);
+    with either checkerboard per segment too, skew-bspline-51x30 10.9 %, building-offset
+    10.8 -> 10.1 %, skew-bspline-b-51x30 21.8 -> 20.9 %, plucker-lines-a1-41 22.2 -> 21.1 %.
     """
     from ..analysis.faces import SPLINTER_DEG, face_min_angles
 
     segments = mesh.info.get("row_segments", [])
+    own = (mesh.info["rows_from"], mesh.info["option"])
+    if len(segments) < 2 or "mixed" in own:
+        return None
+    pairs = [own] + [(side.value, o) for o in (own[1], 1 - own[1])[:1 + colours] for side in RowsFrom
+                     if (side.value, o) != own]
     meshes = [mesh]
-    for opts in tries:
+    for side, o in pairs[1:]:
         try:
-            meshes.append(_mesh(rulings, opts))
+            meshes.append(_mesh(rulings, {**base, "rows_from": side, "option": o}))
         except GeometryError:
             return None
-    if len(segments) < 2 or any([s[:2] for s in m.info["row_segments"]] != [s[:2] for s in segments]
-                                for m in meshes):
+    if any([s[:2] for s in m.info["row_segments"]] != [s[:2] for s in segments] for m in meshes):
         return None
     lo = np.array([s[0] for s in segments])
     order = np.argsort(lo, kind="stable")
@@ -443,18 +450,17 @@ def _per_segment(rulings, mesh, tries: list[dict]) -> list[str] | None:
         g = np.asarray(m.vertex_data["generator"], dtype=np.float64)
         centre = np.add.reduceat(g[m.face_indices], m.face_offsets[:-1]) / m.valences
         seg = order[np.clip(np.searchsorted(lo[order], centre, side="right") - 1, 0, len(lo) - 1)]
-        area = _measured(m)[1]
         thin = np.bincount(seg, weights=face_min_angles(m) < SPLINTER_DEG, minlength=len(lo))
-        off = np.bincount(seg, weights=np.where(m.valences != 4, area, 0.0), minlength=len(lo))
+        off = np.bincount(seg, weights=np.where(m.valences != 4, _measured(m)[1], 0.0), minlength=len(lo))
         scores.append(np.stack([thin, off], axis=1))
     pick = [min(range(len(meshes)), key=lambda k: tuple(scores[k][j])) for j in range(len(lo))]
-    sides = [m.info["rows_from"] for m in meshes]
-    if len({sides[k] for k in pick}) < 2:
+    if all(k == 0 for k in pick):
         return None
-    out = [mesh.info["rows_from"]] * len(rulings.a)
-    for (a, b, _), k in zip(segments, pick, strict=True):
-        out[a:b + 1] = [sides[k]] * (b - a + 1)
-    return out
+    rows_from, option = [own[0]] * len(rulings.a), [own[1]] * len(rulings.a)
+    for (a, b, *_), k in zip(segments, pick, strict=True):
+        rows_from[a:b + 1] = [pairs[k][0]] * (b - a + 1)
+        option[a:b + 1] = [pairs[k][1]] * (b - a + 1)
+    return {"rows_from": rows_from, "option": option}
 
 
 def _candidates(rulings, mesh, options: dict, grid: np.ndarray, user: int, goal: float) -> list[tuple]:

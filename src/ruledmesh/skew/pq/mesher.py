@@ -95,19 +95,23 @@ class _Plan:
     crease_generators: frozenset = frozenset()
     hops: HopMaps | None = None     # of all the generators: each run takes its part
     respace: bool = False           # restart where the rows spread (.respacing)
-    # (m,) where the rows of a segment with a division of its own start, by the generator
-    # they start from (RowsFrom.ends, -1 for the primary's division); None: the Division's.
+    # (m,) where the rows of a segment with a division of its own start (RowsFrom.ends, -1
+    # for the primary's division) and its checkerboard colour, by the generator they start
+    # from; None: the Division's.
     ends: np.ndarray | None = None
-    # [lo, hi, ends] of each segment built with a division of its own, filled by _build_all.
+    options: np.ndarray | None = None
+    # [lo, hi, ends, option] of each segment built with a division of its own (_build_all).
     own: list = field(default_factory=list)
 
     def division(self, div: Division, lo: int, hi: int, primary: int) -> Division:
-        """``div`` with the end points of the segment ``lo..hi`` (rows from global
-        generator ``primary``), recorded in :attr:`own`."""
+        """``div`` with the end points and the colour of the segment ``lo..hi`` (rows from
+        global generator ``primary``), recorded in :attr:`own`."""
         if self.ends is not None:
             e = int(self.ends[primary])
             div = replace(div, ends=None if e < 0 else e)
-        self.own.append([lo, hi, -1 if div.ends is None else div.ends])
+        if self.options is not None:
+            div = replace(div, option=int(self.options[primary]))
+        self.own.append([lo, hi, -1 if div.ends is None else div.ends, div.option])
         return div
 
 
@@ -308,8 +312,8 @@ def pq_mesh(a, b, rows: int = 20, primary: int | str = "middle", option: int = 0
         Divisions of the primary generator between ``t = 0`` and ``t = 1``.
     primary : int or "middle"
         Index of the primary generator (negative indices count from the end).
-    option : {0, 1}
-        Which colour of the checkerboard carries the vertices (the paper's two options).
+    option : {0, 1} or (m,) sequence of them
+        The checkerboard colour carrying the vertices (the paper's two options); as ``rows_from``.
     extend : "auto", "full" or float
         How far the division of the primary continues beyond ``[0, 1]`` (in its
         lengths); ``"auto"`` covers the patch on every generator, leaving out rows
@@ -332,7 +336,7 @@ def pq_mesh(a, b, rows: int = 20, primary: int | str = "middle", option: int = 0
         Also restart the rows where they spread, evened there (:mod:`.respacing`).
     rows_from : {"primary", "c1", "c2"} or (m,) sequence of them
         Where the rows start (:class:`RowsFrom`); per generator, a segment with a division of
-        its own (between torsal generators) taking the value where its rows start.
+        its own (between torsal generators) takes the value where its rows start.
     tol : Tolerances
 
     Returns
@@ -343,7 +347,7 @@ def pq_mesh(a, b, rows: int = 20, primary: int | str = "middle", option: int = 0
         (halves of quads that were not convex); members are the generator
         segments between vertices; ``vertex_data`` holds ``t`` and ``generator``;
         ``info`` the ``warnings``, ``runs``, ``restarts``, ``option``, ``primary``, ``rows_from``
-        (``"mixed"`` if the segments differ; ``row_segments``: ``[lo, hi, rows_from]`` of each),
+        (``"mixed"`` if segments differ; ``row_segments``: ``[lo, hi, rows_from, option]`` each),
         how many ``flips``, ``collapsed``, ``paired``, ``snapped``, ``trimmed``, ``opened`` and
         ``cut`` faces the passes after the grid made.
 
@@ -377,9 +381,9 @@ def pq_mesh(a, b, rows: int = 20, primary: int | str = "middle", option: int = 0
     m = len(a)
     flat, torsal, cg, segs = _cut(a, d, rows, ptol, scale, tol, creases, crease_generators, warnings)
     plan = _Plan(a, d, tol, scale, warnings, frozenset(cg.tolist()), hop_maps(a, d), args.respace,
-                 args.ends[kept])
+                 args.ends[kept], args.option[kept])
     primary = int(np.searchsorted(kept, args.primary, side="right") - 1)
-    parts = _build_all(plan, segs, primary, args.middle, Division(rows, args.option, args.extend, args.max_extend), m)
+    parts = _build_all(plan, segs, primary, args.middle, Division(rows, 0, args.extend, args.max_extend), m)
     restarts = max(len([r for r in parts if len(r.left)]) - len([s for s in segs if s.hi - s.lo >= 2]), 0)
     even = _even_ranges(parts, segs, warnings, exact=ptol <= tol.planarity)
     meet = np.r_[flat, False] | np.r_[False, flat]      # generators of a coplanar pair
@@ -390,7 +394,7 @@ def pq_mesh(a, b, rows: int = 20, primary: int | str = "middle", option: int = 0
     if kept.size < m_given:
         mesh = _renumbered(mesh, kept)
     return mesh.with_info(runs=len(parts), restarts=restarts, planarity_tolerance=ptol, extend=args.extend,
-                          respace=plan.respace, **_rows_from_info(plan.own, kept), option=args.option,
+                          respace=plan.respace, **_rows_from_info(plan.own, kept),
                           primary="middle" if args.middle else args.primary, **fattening)
 
 
@@ -496,7 +500,7 @@ class _Args:
     rows: int
     primary: int
     middle: bool
-    option: int
+    option: np.ndarray      # (m,) 0 or 1
     extend: float | str
     trim: bool
     max_extend: float
@@ -514,7 +518,7 @@ def _checked(a, b, rows, primary, option, extend, trim, max_extend, planarity_to
         raise ParameterError(f"expected the shape of a {a.shape}, got {b.shape}", "b")
     m = len(a)
     rows = check_int(rows, "rows", lo=1)
-    option = check_int(option, "option", lo=0, hi=1)
+    option = _per_generator(option, m, "option", lambda v, name: check_int(v, name, lo=0, hi=1))
     trim = check_bool(trim, "trim")
     middle = isinstance(primary, str)
     if middle:
@@ -533,30 +537,35 @@ def _checked(a, b, rows, primary, option, extend, trim, max_extend, planarity_to
         planarity_tolerance, "planarity_tolerance", lo=0.0, hi=0.1)
     _check_grid_budget(m, rows, extend)
     return a, b, _Args(rows, p, middle, option, extend, trim, max_extend, max(ptol, tol.planarity),
-                       check_bool(respace, "respace"), _ends(rows_from, m))
+                       check_bool(respace, "respace"), _per_generator(rows_from, m, "rows_from", _end_of))
 
 
-def _ends(rows_from, m: int) -> np.ndarray:
-    """(m,) int64: ``rows_from`` (one value, or one per generator) as :attr:`RowsFrom.ends`,
-    -1 for the primary's division."""
-    if isinstance(rows_from, str) or not hasattr(rows_from, "__len__"):
-        values = [check_choice(rows_from, RowsFrom, "rows_from")] * m
-    elif len(rows_from) != m:
-        raise ParameterError(f"expected one value or one per generator ({m}), got {len(rows_from)}",
-                             "rows_from")
-    else:
-        values = [check_choice(v, RowsFrom, f"rows_from[{i}]") for i, v in enumerate(rows_from)]
-    return np.array([-1 if v.ends is None else v.ends for v in values], np.int64)
+def _end_of(value, name: str) -> int:
+    side = check_choice(value, RowsFrom, name)
+    return -1 if side.ends is None else side.ends
+
+
+def _per_generator(value, m: int, name: str, check) -> np.ndarray:
+    """(m,) int64: ``value`` (one, or one per generator) through ``check(value, name) -> int``."""
+    if isinstance(value, str) or not hasattr(value, "__len__"):
+        return np.full(m, check(value, name), np.int64)
+    if len(value) != m:
+        raise ParameterError(f"expected one value or one per generator ({m}), got {len(value)}", name)
+    return np.array([check(v, f"{name}[{i}]") for i, v in enumerate(value)], np.int64)
 
 
 _FROM_ENDS = {-1: RowsFrom.PRIMARY.value, 0: RowsFrom.C1.value, 1: RowsFrom.C2.value}
 
 
 def _rows_from_info(own: list, kept: np.ndarray) -> dict:
-    """``rows_from`` and ``row_segments`` of the info, in the given generators' numbering."""
-    segments = [[int(kept[lo]), int(kept[hi]), _FROM_ENDS[e]] for lo, hi, e in own]
-    sides = {s[2] for s in segments}
-    return {"rows_from": sides.pop() if len(sides) == 1 else "mixed", "row_segments": segments}
+    """``rows_from``, ``option`` and ``row_segments`` of the info, in the given generators'
+    numbering (``"mixed"`` where the segments differ)."""
+    segments = [[int(kept[lo]), int(kept[hi]), _FROM_ENDS[e], int(o)] for lo, hi, e, o in own]
+
+    def one(k: int):
+        values = {s[k] for s in segments}
+        return values.pop() if len(values) == 1 else "mixed"
+    return {"rows_from": one(2), "option": one(3), "row_segments": segments}
 
 
 def _check_grid_budget(m: int, rows: int, extend: float | str) -> None:
