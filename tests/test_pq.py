@@ -475,9 +475,9 @@ def _same_mesh(m1, m2) -> bool:
 
 
 def test_rows_from_per_generator_give_each_segment_its_own():
-    """``rows_from`` per generator: each segment between torsal generators (here where the
-    twist changes sign) takes the value of the generator its rows start from; one value for
-    every generator is the mesh of that value, bit for bit."""
+    """``rows_from`` (and ``option``) per generator: each segment between torsal generators
+    (here where the twist changes sign) takes the value of the generator its rows start from;
+    one value for every generator is the mesh of that value, bit for bit."""
     s = np.linspace(0.0, 1.0, 41)[:, None]
     A = np.c_[10 * s, 0 * s, 0 * s]
     B = np.c_[10 * s, 3 * np.sin(2 * np.pi * s), 4 + 0 * s]
@@ -490,7 +490,8 @@ def test_rows_from_per_generator_give_each_segment_its_own():
     mixed = pq_mesh(A, B, rows=12, rows_from=per)
     check_mesh(mixed)
     assert mixed.info["rows_from"] == "mixed"
-    assert sorted(mixed.info["row_segments"]) == [[0, 10, "c1"], [11, 30, "c2"], [31, 40, "c1"]]
+    assert sorted(mixed.info["row_segments"]) == [[0, 10, "c1", 0], [11, 30, "c2", 0], [31, 40, "c1", 0]]
+    assert mixed.info["option"] == 0
     g, t = mixed.vertex_data["generator"], mixed.vertex_data["t"]
     assert np.abs(mixed.vertices - (A[g] + t[:, None] * (B - A)[g])).max() <= 1e-12 * 10
     # The middle segment's faces are those of the mesh with every row from c2.
@@ -502,6 +503,13 @@ def test_rows_from_per_generator_give_each_segment_its_own():
         sel = (first > 12) & (first < 29)
         return np.sort(np.round(face_areas(m)[sel], 12))
     assert np.array_equal(inner(mixed), inner(c2)) and not np.array_equal(inner(mixed), inner(c1))
+    # The checkerboard per generator likewise.
+    colours = pq_mesh(A, B, rows=12, rows_from="c1", option=[0] * 11 + [1] * 20 + [0] * 10)
+    check_mesh(colours)
+    assert colours.info["option"] == "mixed" and colours.info["rows_from"] == "c1"
+    assert sorted(s[3] for s in colours.info["row_segments"]) == [0, 0, 1]
+    with pytest.raises(ParameterError, match=r"option\[3\]"):
+        pq_mesh(A, B, option=[0] * 3 + [2] * 38)
     with pytest.raises(ParameterError, match=r"rows_from.*one per generator"):
         pq_mesh(A, B, rows_from=["c1"] * 40)
     with pytest.raises(ParameterError, match=r"rows_from\[40\]"):
@@ -520,8 +528,9 @@ def test_rows_through_the_end_points_keep_the_invariants(seed, rows_from, m, row
     k1, k2 = rng.normal(size=(2, 3)), rng.normal(size=(2, 3))
     c1 = np.c_[10 * s, np.zeros_like(s), np.zeros_like(s)] + np.sin(3 * s) * k1[0] + s ** 2 * k1[1]
     c2 = np.c_[10 * s, 2 + 0 * s, 4 + 0 * s] + np.cos(2 * s) * k2[0] + s ** 3 * k2[1]
-    if rows_from == "mixed":     # per generator, at random
+    if rows_from == "mixed":     # per generator, at random, and the checkerboard too
         rows_from = rng.choice(["primary", "c1", "c2"], size=m).tolist()
+        option = rng.integers(0, 2, size=m).tolist()
     mesh = pq_mesh(c1, c2, rows=rows, rows_from=rows_from, option=option)
     check_mesh(mesh)
     g, t = mesh.vertex_data["generator"], mesh.vertex_data["t"]
