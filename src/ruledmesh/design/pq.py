@@ -408,9 +408,9 @@ def _from_either_curve(kept: tuple, rulings, options: dict, goal: float, colours
     Moebius band from 97 lines (``moebius-r5-w0.8-97x20``) 27.5 -> 15.5 % of the area in
     triangles, from 24 lines (``moebius-lines``) 24.8 -> 15.4 %.  The rows are then as far
     apart as the end points' rows, so a mesh with more faces is kept only where it pays for
-    them (:func:`_price`).  Above the typical share only, as this ran at first, 16 of 24
-    random designs kept the mesh from the primary at 7.7-11.9 % where a mesh from a curve
-    had 3.5-9.7 % (``right-conoid-wide-arc`` 11.9 -> 3.4 %).
+    them (:func:`_price`).  Run only above the typical share, as at first, it left 16 of 24
+    random designs at 7.7-11.9 % of the area in triangles where it now finds 3.5-9.7 %
+    (``right-conoid-wide-arc`` 11.9 -> 3.4 %).
     """
     if _with_room(kept, goal):
         return kept
