@@ -305,7 +305,8 @@ def _other_rows(kept: tuple, options: dict, free: tuple[bool, bool, bool]) -> tu
     two checkerboards (``option``) and three primaries (the middle, a third and two thirds
     in), where the design leaves them free (``free``: option, primary, rows_from), then of
     that mesh with its rows through the end points on either director curve
-    (:func:`_from_either_curve`), and a note if it is another.
+    (:func:`_from_either_curve`), and a note naming the option or primary where they changed
+    (``build_pq`` names where the rows start).
 
     The rows of §4.3 depend on both; for explicit lines they are the only freedom left.  On
     the Plücker conoid from 41 lines (``plucker-lines-a1-41``) 26.0 % of the area in

@@ -105,7 +105,8 @@ class _Plan:
 
     def division(self, div: Division, lo: int, hi: int, primary: int) -> Division:
         """``div`` with the end points and the colour of the segment ``lo..hi`` (rows from
-        global generator ``primary``), recorded in :attr:`own`."""
+        global generator ``primary``), recorded in :attr:`own`: what a segment's division
+        takes from :func:`pq_mesh`'s ``rows_from`` and ``option``, not from ``div``."""
         if self.ends is not None:
             e = int(self.ends[primary])
             div = replace(div, ends=None if e < 0 else e)
@@ -506,7 +507,7 @@ class _Args:
     max_extend: float
     ptol: float
     respace: bool
-    ends: np.ndarray = field(default_factory=lambda: np.zeros(0, np.int64))   # (m,) RowsFrom.ends or -1
+    ends: np.ndarray        # (m,) RowsFrom.ends, or -1 for the primary's division
 
 
 def _checked(a, b, rows, primary, option, extend, trim, max_extend, planarity_tolerance, respace,
