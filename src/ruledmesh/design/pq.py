@@ -318,11 +318,21 @@ def _other_rows(kept: tuple, options: dict, free: tuple[bool, bool, bool]) -> tu
     goal = _goal(options)
     best, rulings, mesh = kept, kept[3], kept[4]
     options = {**options, **{k: mesh.info[k] for k in ("planarity_tolerance", "extend", "respace")}}
-    if sum(_goals_met(best, goal)) < 2 and any(free[:2]):
+    through = free[2] and options["trim"]      # untrimmed, a mesh has no border to cut teeth along
+    other = None
+    if any(free[:2]) and sum(_goals_met(best, goal)) < 2:
         best = _more_fabricable(best, rulings, goal, _checkerboards(rulings, options, free))
-    # Untrimmed, a mesh has no border to cut teeth along.
-    if free[2] and options["trim"]:
-        best = _from_either_curve(best, rulings, options, goal, free[0])
+    elif any(free[:2]) and through and not _with_room(best, goal):
+        # The goals met, without room: the best of the other checkerboards and primaries is a
+        # second start of the rows from either curve (twisted-arcs-120deg: 13.6 -> 5.9 % from
+        # the primary 21 of 63 with the rows from c1).
+        other = _more_fabricable(best, rulings, goal, _checkerboards(rulings, options, free))
+    if through:
+        first, best = best, _from_either_curve(best, rulings, options, goal, free[0])
+        if other is not None and other is not first:
+            # Weighed against the mesh it would replace: its splinters and its panels.
+            second = _from_either_curve(other, rulings, options, goal, free[0])
+            best = second if _replaces(second, best, best, goal, priced=True) else best
     info, was = best[4].info, mesh.info
     # A checkerboard per segment ("mixed") is named with the starts (_rows_from_note).
     named = [f"option {info['option']}"] if free[0] and info["option"] not in (was["option"], "mixed") else []
@@ -355,16 +365,21 @@ def _more_fabricable(best: tuple, rulings, goal: float, tries: list[dict], price
             other = _round(rulings, _mesh(rulings, opts))
         except GeometryError:
             continue
-        if _fabricable(other, goal) <= _fabricable(best, goal):
-            continue
-        if priced and other[1] > start[1]:
-            continue
-        if priced and other[4].n_faces > start[4].n_faces \
-                and sum(_goals_met(other, goal)) == sum(_goals_met(start, goal)) \
-                and other[0] < start[0] + _price(other[4].n_faces, start[4].n_faces):
-            continue
-        best = other
+        if _replaces(other, best, start, goal, priced):
+            best = other
     return best
+
+
+def _replaces(other: tuple, best: tuple, start: tuple, goal: float, priced: bool) -> bool:
+    """Whether round ``other`` is kept instead of ``best`` (:func:`_more_fabricable`; ``start``
+    is the round the choice began from, what ``priced`` weighs against)."""
+    if _fabricable(other, goal) <= _fabricable(best, goal):
+        return False
+    if priced and other[1] > start[1]:
+        return False
+    return not (priced and other[4].n_faces > start[4].n_faces
+                and sum(_goals_met(other, goal)) == sum(_goals_met(start, goal))
+                and other[0] < start[0] + _price(other[4].n_faces, start[4].n_faces))
 
 
 def _rows_from_note(info: Mapping[str, Any]) -> str:
