@@ -64,9 +64,14 @@ def _triangle_distance(p: np.ndarray, P: np.ndarray) -> np.ndarray:
     inside = np.ones(len(p), bool)
     for x, y in ((A, B), (B, C), (C, A)):
         inside &= np.einsum("ij,ij->i", cross(y - x, q - x), n) >= 0
-    edge = np.minimum(np.minimum(_segment_distance(p, A, B), _segment_distance(p, B, C)),
-                      _segment_distance(p, C, A))
-    return np.where(inside, np.abs(h), edge)
+    out = np.abs(h)
+    # Outside: the nearest edge (only there, where most points are inside).
+    o = np.flatnonzero(~inside)
+    if o.size:
+        p, A, B, C = p[o], A[o], B[o], C[o]
+        out[o] = np.minimum(np.minimum(_segment_distance(p, A, B), _segment_distance(p, B, C)),
+                            _segment_distance(p, C, A))
+    return out
 
 
 def _expand(counts: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -154,7 +159,8 @@ def _collapsed_star(tri, stars: _Stars, v, u):
 
 
 def _evaluate(V, tri, stars: _Stars, keys, faces_at, v, u, scale) -> tuple[np.ndarray, np.ndarray]:
-    """(C,) gain in smallest angle (degrees) of each collapse ``v -> u``, and whether it is allowed."""
+    """(C,) gain in smallest angle (degrees) of each collapse ``v -> u``, and whether it is
+    allowed (it gains more than :data:`~ruledmesh.tolerances.FLIP_MIN_GAIN_DEG` too)."""
     C = v.size
     rep, old, new, gone = _collapsed_star(tri, stars, v, u)
     old_ang = min_corner_angles(V, old)
@@ -175,11 +181,8 @@ def _evaluate(V, tri, stars: _Stars, keys, faces_at, v, u, scale) -> tuple[np.nd
     bend = (np.einsum("ij,ij->i", _normals(P0[keep]), n_new) >= cos) | (
         (old_ang[keep] < RESTART_ANGLE_DEG) & (np.einsum("ij,ij->i", star[rep[keep]], n_new) >= cos))
     bad = ~bend | (np.linalg.norm(n_new, axis=1) < 0.5)
-    ok = np.bincount(rep[keep][bad], minlength=C) == 0
-    # How far the surface moves: the removed vertex's distance from the faces left around it.
-    sag = np.full(C, np.inf)
-    np.minimum.at(sag, rep[keep], _triangle_distance(V[v[rep[keep]]], Pn))
-    ok &= sag <= COLLAPSE_MAX_SAG * scale
+    gain = new_min - old_min
+    ok = (np.bincount(rep[keep][bad], minlength=C) == 0) & (gain > FLIP_MIN_GAIN_DEG)
     removed = np.bincount(rep[gone], minlength=C)
     # A corner opposite the edge u v must keep a face (else it and its area would go).
     third = np.where((old[gone] != v[rep[gone]][:, None]) & (old[gone] != u[rep[gone]][:, None]),
@@ -192,7 +195,12 @@ def _evaluate(V, tri, stars: _Stars, keys, faces_at, v, u, scale) -> tuple[np.nd
     shared = _member(np.minimum(u[r2], w) * n + np.maximum(u[r2], w), keys)
     common = np.bincount(r2[w_ok & shared], minlength=C)
     ok &= (common == removed) & (removed >= 1) & (np.bincount(rep, minlength=C) > removed)
-    return new_min - old_min, ok
+    # How far the surface moves: the removed vertex's distance from the faces left around
+    # it, measured last, for the collapses every other test allows.
+    at = keep & ok[rep]
+    sag = np.full(C, np.inf)
+    np.minimum.at(sag, rep[at], _triangle_distance(V[v[rep[at]]], V[new[at]]))
+    return gain, ok & (sag <= COLLAPSE_MAX_SAG * scale)
 
 
 def _keeps_ghosts(V, tri, stars: _Stars, v, u, ghosts, anchors, scale) -> np.ndarray:
@@ -356,11 +364,12 @@ def collapse_splinters(mesh: Mesh, removable: np.ndarray | None = None,
                                 + np.arange(3)].astype(np.int64)
         stars = _Stars(tri, keys, n)
         gain, ok = _evaluate(V, tri, stars, keys, np.bincount(mesh.face_indices, minlength=n), v, u, size)
-        ok &= gain > FLIP_MIN_GAIN_DEG
         if not ok.any():
             break
         if ghosts.size:
-            ok &= _keeps_ghosts(V, tri, stars, v, u, ghosts, anchors, size)
+            # Only the collapses allowed so far: the check costs the most of a round.
+            at = np.flatnonzero(ok)
+            ok[at] = _keeps_ghosts(V, tri, stars, v[at], u[at], ghosts, anchors, size)
         v, u, gain = v[ok], u[ok], gain[ok]
         take = _chosen(stars, tri, v, gain)
         if take.size == 0:
