@@ -92,14 +92,13 @@ class _Plan:
     tol: Tolerances
     scale: float
     warnings: list
+    # (m,) where the rows of a segment with a division of its own start (RowsFrom.ends, -1
+    # for the primary's division) and its checkerboard colour, by the generator they start from.
+    ends: np.ndarray
+    options: np.ndarray
     crease_generators: frozenset = frozenset()
     hops: HopMaps | None = None     # of all the generators: each run takes its part
     respace: bool = False           # restart where the rows spread (.respacing)
-    # (m,) where the rows of a segment with a division of its own start (RowsFrom.ends, -1
-    # for the primary's division) and its checkerboard colour, by the generator they start
-    # from; None: the Division's.
-    ends: np.ndarray | None = None
-    options: np.ndarray | None = None
     # [lo, hi, ends, option] of each segment built with a division of its own (_build_all).
     own: list = field(default_factory=list)
 
@@ -107,11 +106,8 @@ class _Plan:
         """``div`` with the end points and the colour of the segment ``lo..hi`` (rows from
         global generator ``primary``), recorded in :attr:`own`: what a segment's division
         takes from :func:`pq_mesh`'s ``rows_from`` and ``option``, not from ``div``."""
-        if self.ends is not None:
-            e = int(self.ends[primary])
-            div = replace(div, ends=None if e < 0 else e)
-        if self.options is not None:
-            div = replace(div, option=int(self.options[primary]))
+        e = int(self.ends[primary])
+        div = replace(div, ends=None if e < 0 else e, option=int(self.options[primary]))
         self.own.append([lo, hi, -1 if div.ends is None else div.ends, div.option])
         return div
 
@@ -381,8 +377,8 @@ def pq_mesh(a, b, rows: int = 20, primary: int | str = "middle", option: int = 0
     m_given, (a, d, creases, crease_generators) = len(a), _keep(kept, a, d, creases, crease_generators)
     m = len(a)
     flat, torsal, cg, segs = _cut(a, d, rows, ptol, scale, tol, creases, crease_generators, warnings)
-    plan = _Plan(a, d, tol, scale, warnings, frozenset(cg.tolist()), hop_maps(a, d), args.respace,
-                 args.ends[kept], args.option[kept])
+    plan = _Plan(a, d, tol, scale, warnings, args.ends[kept], args.option[kept], frozenset(cg.tolist()),
+                 hop_maps(a, d), args.respace)
     primary = int(np.searchsorted(kept, args.primary, side="right") - 1)
     parts = _build_all(plan, segs, primary, args.middle, Division(rows, 0, args.extend, args.max_extend), m)
     restarts = max(len([r for r in parts if len(r.left)]) - len([s for s in segs if s.hi - s.lo >= 2]), 0)
