@@ -383,14 +383,14 @@ def pq_mesh(a, b, rows: int = 20, primary: int | str = "middle", option: int = 0
     parts = _build_all(plan, segs, primary, args.middle, Division(rows, 0, args.extend, args.max_extend), m)
     restarts = max(len([r for r in parts if len(r.left)]) - len([s for s in segs if s.hi - s.lo >= 2]), 0)
     even = _even_ranges(parts, segs, warnings, exact=ptol <= tol.planarity)
-    meet = np.r_[flat, False] | np.r_[False, flat]      # generators of a coplanar pair
-    mesh = assemble(parts, a, d, args.trim, tol, ptol, warnings, scale, meet, rows=rows)
-    mesh, fattening, measured = _fattened(mesh, ptol, tol)
+    meet, runs = np.r_[flat, False] | np.r_[False, flat], len(parts)    # meet: of a coplanar pair
+    mesh, fattening, measured = _fattened(assemble(parts, a, d, args.trim, tol, ptol, warnings, scale, meet,
+                                                   rows=rows), ptol, tol)
     _warn_share(mesh, warnings, torsal.size, even, restarts, m, rows, (a, d, ptol), measured)
     _warn_splinters(mesh, warnings, torsal, measured)
     if kept.size < m_given:
         mesh = _renumbered(mesh, kept)
-    return mesh.with_info(runs=len(parts), restarts=restarts, planarity_tolerance=ptol, extend=args.extend,
+    return mesh.with_info(runs=runs, restarts=restarts, planarity_tolerance=ptol, extend=args.extend,
                           respace=plan.respace, **_rows_from_info(plan.own, kept),
                           primary="middle" if args.middle else args.primary, **fattening)
 
@@ -425,6 +425,8 @@ def _fattened(mesh: Mesh, ptol: float, tol: Tolerances) -> tuple[Mesh, dict[str,
 
     The third result: the (F,) smallest angles and areas of the faces of the mesh
     returned, where the opening measured them and left the mesh as it was (else None).
+    The caller does not keep ``mesh``, so each pass frees the mesh it replaces (a
+    1000 x 1000 build's is 50 MB).
     """
     mesh, snapped = snap_to_border(mesh)
     mesh, flips = flip_triangles(mesh)
@@ -440,16 +442,21 @@ def _fattened(mesh: Mesh, ptol: float, tol: Tolerances) -> tuple[Mesh, dict[str,
     from ...analysis.faces import face_min_angles, face_normals
 
     measured = (face_min_angles(mesh), face_normals(mesh)[1]) if mesh.n_faces else None
-    before = mesh
-    mesh, opened = open_walled_splinters(mesh, _reflipped, measured)
+    # Whether the mesh measured is the one returned (each pass returns its input where it
+    # changes nothing), tracked without holding on to it: a large mesh is 50 MB.
+    opened_mesh, opened = open_walled_splinters(mesh, _reflipped, measured)
+    same, mesh = opened_mesh is mesh, opened_mesh
+    del opened_mesh
     if opened:
         mesh, more = _paired(mesh, ptol, tol)
         paired += more
-    mesh, more = flip_splinters(mesh)
-    flips += more
-    mesh, cut = split_strip_quads(mesh)
+    fewer, more = flip_splinters(mesh)
+    same, mesh, flips = same and fewer is mesh, fewer, flips + more
+    del fewer
+    cut_mesh, cut = split_strip_quads(mesh)
+    same, mesh = same and cut_mesh is mesh, cut_mesh
     return mesh, {"flips": flips, "collapsed": collapsed, "paired": paired, "snapped": snapped,
-                  "trimmed": trimmed, "opened": opened, "cut": cut}, (measured if mesh is before else None)
+                  "trimmed": trimmed, "opened": opened, "cut": cut}, (measured if same else None)
 
 
 def _reflipped(mesh: Mesh, frozen: np.ndarray, scale: float) -> Mesh:
