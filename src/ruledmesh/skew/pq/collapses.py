@@ -260,18 +260,23 @@ def _rejoined(members: np.ndarray, member_id: np.ndarray, removed: np.ndarray, n
     if members.size == 0 or not removed[members].any():
         return members, member_id
     m0, m1 = members[:, 0], members[:, 1]
-    # The member that continues each one along its generator: (id, start) = (id, this end).
-    key0 = member_id * n + m0
+    # The member that continues one along its generator: (id, start) = (id, its end).  Only
+    # members ending at a removed vertex are continued, so only those starting at one are
+    # looked up (a large mesh has millions of members and a few removed vertices).
+    starts = np.flatnonzero(removed[m0])
+    key0 = (member_id * n + m0)[starts]
     order = np.argsort(key0, kind="stable")
-    nxt = lookup(member_id * n + m1, key0[order])
-    nxt = np.where(nxt >= 0, order[np.maximum(nxt, 0)], -1)
     end = m1.copy()
-    row = np.arange(len(m1))
-    walk = removed[end] & (nxt[row] >= 0)
-    while walk.any():
-        row = np.where(walk, nxt[row], row)
-        end = np.where(walk, m1[row], end)
-        walk = removed[end] & (nxt[row] >= 0)
+    rows = np.flatnonzero(removed[m1])
+    row = rows
+    nxt = lookup(member_id[row] * n + end[row], key0[order])
+    while True:
+        walk = (nxt >= 0) & removed[end[rows]]
+        if not walk.any():
+            break
+        row = np.where(walk, starts[order[np.maximum(nxt, 0)]], row)
+        end[rows] = np.where(walk, m1[row], end[rows])
+        nxt = lookup(member_id[row] * n + end[rows], key0[order])
     keep = ~removed[m0] & ~removed[end]
     return np.stack([m0[keep], end[keep]], axis=1), member_id[keep]
 
