@@ -2,7 +2,7 @@
 
 from __future__ import annotations
 
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field, replace
 from enum import Enum
 
@@ -443,20 +443,23 @@ def _fattened(mesh: Mesh, ptol: float, tol: Tolerances) -> tuple[Mesh, dict[str,
 
     measured = (face_min_angles(mesh), face_normals(mesh)[1]) if mesh.n_faces else None
     # Whether the mesh measured is the one returned (each pass returns its input where it
-    # changes nothing), tracked without holding on to it: a large mesh is 50 MB.
-    opened_mesh, opened = open_walled_splinters(mesh, _reflipped, measured)
-    same, mesh = opened_mesh is mesh, opened_mesh
-    del opened_mesh
+    # changes nothing), told without holding on to it: a large mesh is 50 MB.
+    mesh, opened, same = _pass(open_walled_splinters, mesh, _reflipped, measured)
     if opened:
         mesh, more = _paired(mesh, ptol, tol)
         paired += more
-    fewer, more = flip_splinters(mesh)
-    same, mesh, flips = same and fewer is mesh, fewer, flips + more
-    del fewer
-    cut_mesh, cut = split_strip_quads(mesh)
-    same, mesh = same and cut_mesh is mesh, cut_mesh
+    mesh, more, kept = _pass(flip_splinters, mesh)
+    flips += more
+    mesh, cut, kept_too = _pass(split_strip_quads, mesh)
+    same = same and kept and kept_too
     return mesh, {"flips": flips, "collapsed": collapsed, "paired": paired, "snapped": snapped,
                   "trimmed": trimmed, "opened": opened, "cut": cut}, (measured if same else None)
+
+
+def _pass(step: Callable[..., tuple[Mesh, int]], mesh: Mesh, *args) -> tuple[Mesh, int, bool]:
+    """``step(mesh, *args)``'s mesh and count, and whether that mesh is ``mesh`` itself."""
+    out, n = step(mesh, *args)
+    return out, n, out is mesh
 
 
 def _reflipped(mesh: Mesh, frozen: np.ndarray, scale: float) -> Mesh:
