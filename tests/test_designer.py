@@ -243,6 +243,29 @@ def test_worker_compiles_the_kernels_when_idle_and_not_inside_an_edit():
         worker.close()
 
 
+def test_a_page_opening_has_the_worker_load_the_kernels_before_the_next_edit():
+    """A user who opens the page and moves a slider at once never leaves the worker its idle
+    second, so every build of the gesture ran in numpy.  A page connecting (the live socket
+    calls Session.page_opened) has it load the kernels before the next edit, which waits
+    for that without its time limit counting it."""
+    import os
+
+    from ruledmesh.web import builder
+
+    worker = builder.BuildWorker(timeout=60)
+    try:
+        s = Session(SMALL, builder=worker)
+        worker.start()
+        s.edit([(["mesh", "rows"], 7)])   # at once: built before any idle second
+        assert worker.kernels is None
+        s.page_opened()
+        s.edit([(["mesh", "rows"], 8)])
+        assert worker.kernels is (os.environ.get("RULEDMESH_KERNELS", "auto") not in ("0", "off", "numpy"))
+        assert s.design["mesh"]["rows"] == 8
+    finally:
+        worker.close()
+
+
 def test_an_answer_with_the_same_faces_leaves_them_out():
     from ruledmesh.web.session import topology_key
 

@@ -41,11 +41,13 @@ SUPERSEDE_GRACE = 0.3
 # Seconds a fresh worker process may take to import its modules (and later to compile
 # the kernels: not counted against the edit waiting meanwhile).
 STARTUP_SECONDS = 120.0
-# Seconds without an edit after which the worker compiles (or loads) the kernels: none, it
-# does so as soon as no edit waits.  It used to wait for an idle second, which a user moving a
-# slider right after the page opened never left it: every build of that gesture ran in numpy,
-# twice as long (100 x 100: server part 70 instead of 35 ms).
-IDLE_BEFORE_WARM_UP = 0.0
+# Seconds without an edit after which the worker compiles (or loads) the kernels, unless a
+# page opened before (BuildWorker.warm_up: then at once).  A user moving a slider right after
+# the page opened never left the worker that idle second: every build of the gesture ran in
+# numpy, twice as long (100 x 100: server part 70 instead of 35 ms).
+IDLE_BEFORE_WARM_UP = 1.0
+# The message asking the worker to load the kernels now.
+WARM_UP = "warm-up"
 # Builds kept by design: undo, redo, a slider moved back and forth, the same design sent by
 # two tabs are answered without building again. A 100 x 100 mesh is about 1 MB.
 BUILD_CACHE = 8
@@ -84,15 +86,16 @@ def _worker_main(conn) -> None:  # pragma: no cover - runs in the child process
     warm = False
     while True:
         try:
-            if not warm and not conn.poll(IDLE_BEFORE_WARM_UP):
-                # No edit waiting (usually while the page loads): compile the kernels now,
-                # telling the server, which does not count this time against an edit that
-                # arrives meanwhile.
-                conn.send(("busy", None))
-                conn.send(("idle", _warm_up(lambda: frame_data(default.data, build_design(default)))))
-                warm = True
+            job: Any = None if warm or conn.poll(IDLE_BEFORE_WARM_UP) else WARM_UP
+            job = conn.recv() if job is None else job
+            if job == WARM_UP:
+                # Idle, or a page opened: compile the kernels now, telling the server,
+                # which does not count this time against an edit that arrives meanwhile.
+                if not warm:
+                    conn.send(("busy", None))
+                    conn.send(("idle", _warm_up(lambda: frame_data(default.data, build_design(default)))))
+                    warm = True
                 continue
-            job = conn.recv()
         except (EOFError, OSError):
             return
         if job is None:
@@ -227,6 +230,9 @@ class InProcessBuilder:
             return hit
         return self.remember(key, (build_design(Design(data, source, Path(base_dir))), None))
 
+    def warm_up(self) -> None:
+        """Nothing to prepare: the caller's process builds."""
+
     def close(self) -> None:
         """Nothing to stop."""
 
@@ -248,8 +254,13 @@ class BuildWorker(InProcessBuilder):
         self._proc: Any = None
         self._conn: Any = None
         self._closed = False
+        # One writer on the pipe at a time: an edit's job, a page's warm-up request.
+        self._send = threading.Lock()
+        # Set when a page opened: every worker started from then on loads the kernels at once.
+        self._warm_wanted = False
         #: Whether the running worker builds with the compiled kernels (None: not yet known;
-        #: the worker loads them as soon as no edit waits and says so with its next answer).
+        #: the worker loads them at its first idle second, or at once when a page has opened,
+        #: and says so with its next answer).
         self.kernels: bool | None = None
 
     # ---------------------------------------------------------------- process
@@ -265,13 +276,26 @@ class BuildWorker(InProcessBuilder):
                     raise EOFError
             if parent.recv()[0] != "ready":
                 raise EOFError
+            with self._send:
+                if self._warm_wanted:
+                    parent.send(WARM_UP)
         except (EOFError, OSError):
             self._stop()
             raise RuledMeshError("the build process did not start") from None
 
     def _stop(self) -> None:
-        stop_worker(self._proc, self._conn)
-        self._proc = self._conn = None
+        with self._send:
+            stop_worker(self._proc, self._conn)
+            self._proc = self._conn = None
+
+    def warm_up(self) -> None:
+        """Have the worker load the compiled kernels now, and every later worker at its start
+        (a page opened: edits are coming), instead of at its first idle second."""
+        with self._send:
+            self._warm_wanted = True
+            if self._conn is not None:
+                with contextlib.suppress(OSError, ValueError):
+                    self._conn.send(WARM_UP)
 
     def start(self) -> None:
         """Start the worker process now (so the first edit does not wait for it)."""
@@ -321,7 +345,8 @@ class BuildWorker(InProcessBuilder):
         # "idle" before it reads the next job, so both arrive while one edit waits.
         paused = 0.0
         try:
-            self._conn.send(job)
+            with self._send:
+                self._conn.send(job)
             while True:
                 if self._conn.poll(0.02):
                     kind, value = self._conn.recv()

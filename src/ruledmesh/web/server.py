@@ -556,6 +556,7 @@ class _Live:
             self.loop = asyncio.get_running_loop()
             self.queues.add(queue)
         queue.put_nowait(self.session.version)  # the state on connecting
+        self.session.page_opened()
         try:
             async with anyio.create_task_group() as tasks:
                 tasks.start_soon(self._pump, websocket, queue)

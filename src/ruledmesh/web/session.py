@@ -559,6 +559,11 @@ class Session:
         with self._lock:
             self._builder = builder
 
+    def page_opened(self) -> None:
+        """A page connected: edits are coming, so the builder gets ready for them now (the
+        worker loads the compiled kernels while the page draws its first frame)."""
+        self._builder.warm_up()
+
     # ------------------------------------------------------------- state
     @property
     def design(self) -> dict:
