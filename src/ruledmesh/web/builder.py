@@ -284,9 +284,12 @@ class BuildWorker(InProcessBuilder):
             raise RuledMeshError("the build process did not start") from None
 
     def _stop(self) -> None:
+        # Stopped outside the lock: a page's warm-up request (sent from the server's event
+        # loop) never waits for a process to end; one sent meanwhile meets a closed pipe.
         with self._send:
-            stop_worker(self._proc, self._conn)
+            proc, conn = self._proc, self._conn
             self._proc = self._conn = None
+        stop_worker(proc, conn)
 
     def warm_up(self) -> None:
         """Have the worker load the compiled kernels now, and every later worker at its start
