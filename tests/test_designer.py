@@ -218,12 +218,17 @@ def test_catalogue_surfaces_build_in_the_worker_process():
         worker.close()
 
 
+def _kernels_on() -> bool:
+    """Whether a worker of this test run builds with the compiled kernels (RULEDMESH_KERNELS)."""
+    import os
+
+    return os.environ.get("RULEDMESH_KERNELS", "auto") not in ("0", "off", "numpy")
+
+
 def test_worker_compiles_the_kernels_when_idle_and_not_inside_an_edit():
     """Regression (CI): a session crossing MIN_WORK compiled the kernels inside edit 327, over
     the time limit.  Now the worker loads them after an idle second, telling the server, and
     says with its next answer that they are in use; an edit sent meanwhile is answered."""
-    import os
-
     from ruledmesh.web import builder
 
     worker = builder.BuildWorker(timeout=60)
@@ -237,7 +242,7 @@ def test_worker_compiles_the_kernels_when_idle_and_not_inside_an_edit():
         while worker.kernels is None and time.monotonic() < deadline:
             time.sleep(0.5)
             s.edit([(["mesh", "rows"], 8 + int(time.monotonic() * 10) % 5)])
-        assert worker.kernels is (os.environ.get("RULEDMESH_KERNELS", "auto") not in ("0", "off", "numpy"))
+        assert worker.kernels is _kernels_on()
         assert s.design["mesh"]["rows"] >= 7
     finally:
         worker.close()
@@ -248,8 +253,6 @@ def test_a_page_opening_has_the_worker_load_the_kernels_before_the_next_edit():
     second, so every build of the gesture ran in numpy.  A page connecting (the live socket
     calls Session.page_opened) has it load the kernels before the next edit, which waits
     for that without its time limit counting it."""
-    import os
-
     from ruledmesh.web import builder
 
     worker = builder.BuildWorker(timeout=60)
@@ -260,7 +263,7 @@ def test_a_page_opening_has_the_worker_load_the_kernels_before_the_next_edit():
         assert worker.kernels is None
         s.page_opened()
         s.edit([(["mesh", "rows"], 8)])
-        assert worker.kernels is (os.environ.get("RULEDMESH_KERNELS", "auto") not in ("0", "off", "numpy"))
+        assert worker.kernels is _kernels_on()
         assert s.design["mesh"]["rows"] == 8
     finally:
         worker.close()
