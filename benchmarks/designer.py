@@ -16,6 +16,12 @@ with the load average before and after:
 * ``POST /api/edit`` from a plain HTTP client to ``make_server``'s server, answered
   ``{version}`` as the page's edits are, the client's wall time and ``Server-Timing``.
 
+With ``--refining NAME ...`` it measures instead, for bundled example designs that refine
+their generators, the edit of a row count until the session has a mesh (``Session.edit``
+with the build worker, warm, the kernels loaded; minimum of three edits): without quick
+meshes (``previews=False``, as before), and with them until the quick mesh and until the
+full one (``Session.settled``).
+
 Wall-clock times follow the load of a shared machine: state it with every figure.  The
 page's part (decoding, drawing, the frame) is measured in the browser by
 ``tests/test_designer_browser.py::test_update_latency_100_by_100``.
@@ -126,12 +132,54 @@ def over_http(steps: range) -> tuple[list[float], list[float]]:
     return walls, timings
 
 
+def refining(name: str, previews: bool, edits: int = 3) -> tuple[float, float]:
+    """Edit to mesh of example ``name`` (ms, minimum of ``edits`` row changes): until the
+    edit returns (its mesh current) and until the full mesh is (the same without previews)."""
+    import tomllib
+
+    from ruledmesh import bundled
+    from ruledmesh.web.builder import BuildWorker
+    from ruledmesh.web.session import Session
+
+    text = bundled.text(name)
+    rows = tomllib.loads(text).get("mesh", {}).get("rows", 20)
+    worker = BuildWorker()
+    session = Session(text, builder=worker, previews=previews)
+    worker.start()
+    session.page_opened()                    # the worker loads the kernels
+    try:
+        session.edit([(["mesh", "rows"], rows + 1)])
+        session.settled(600)
+        first, full = [], []
+        for k in range(edits):
+            t = time.perf_counter()
+            session.edit([(["mesh", "rows"], rows + 2 + k)])
+            first.append(1000 * (time.perf_counter() - t))
+            session.settled(600)
+            full.append(1000 * (time.perf_counter() - t))
+        return min(first), min(full)
+    finally:
+        worker.close()
+
+
 def main(argv: list[str] | None = None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--steps", type=int, default=12)
+    parser.add_argument("--refining", nargs="+", metavar="NAME",
+                        help="bundled examples to time edits of with and without quick meshes")
     args = parser.parse_args(argv)
     steps = range(101, 101 + args.steps)
     before = os.getloadavg()
+    if args.refining:
+        print("| design | before: edit to mesh | now: edit to quick mesh | now: edit to full mesh |")
+        print("|---|---:|---:|---:|")
+        for name in args.refining:
+            old, _ = refining(name, previews=False)
+            quick, full = refining(name, previews=True)
+            print(f"| `{name}` | {old:,.0f} ms | {quick:,.0f} ms | {full:,.0f} ms |", flush=True)
+        print(f"load average {before[0]:.1f} before, {os.getloadavg()[0]:.1f} after; "
+              f"{os.cpu_count()} cores")
+        return 0
     for name, samples in in_process(steps).items():
         print(f"{name:24s} {_ms(samples)}")
     print(f"{'Session.edit, worker':24s} {_ms(with_worker(steps))}")

@@ -269,6 +269,135 @@ def test_a_page_opening_has_the_worker_load_the_kernels_before_the_next_edit():
         worker.close()
 
 
+def _built(text: str):
+    return build_design(parse_design(text)).mesh
+
+
+def test_an_edit_shows_the_quick_mesh_at_once_and_the_full_mesh_when_built():
+    """With previews (the server's sessions), an edit of a design that refines its generators
+    makes the design current with its quick mesh ([mesh] refine = false: one mesh instead of
+    tens) and the full mesh replaces it when the worker has built it: a new version, the same
+    design and undo step; exports wait for the full mesh."""
+    from ruledmesh.web import builder
+
+    worker = builder.BuildWorker(timeout=60)
+    try:
+        s = Session(SMALL, builder=worker, previews=True)
+        worker.start()
+        version = s.edit([(["mesh", "rows"], 7)])
+        design = SMALL.replace("rows = 6", "rows = 7")
+        assert s.describe()["refining"] and s.describe()["refine_error"] is None
+        assert same_mesh(s.built.mesh, _built(design + "refine = false\n"))
+        header, _ = decode(s.payload())
+        assert header["refining"] is True
+        assert s.settled(60)
+        full = _built(design)
+        assert same_mesh(s.built.mesh, full) and s.version == version + 1
+        assert s.design["mesh"] == {"method": "pq", "rows": 7}
+        assert s.history() == {"undo": ["opened"], "current": "mesh.rows = 7", "redo": []}
+        assert decode(s.payload())[0]["refining"] is False
+        # Undo shows the quick mesh of the design before, then its full one.
+        s.undo()
+        assert s.settled(60) and same_mesh(s.built.mesh, _built(SMALL))
+        # Redo finds the full mesh built: no quick one.
+        s.redo()
+        assert not s.describe()["refining"] and same_mesh(s.built.mesh, full)
+        s.edit([(["mesh", "rows"], 8)])
+        assert s.describe()["refining"]
+        obj = s.export_bytes(".obj")      # waits for the full mesh
+        assert not s.describe()["refining"]
+        assert obj == Session(SMALL.replace("rows = 6", "rows = 8")).export_bytes(".obj")
+    finally:
+        worker.close()
+
+
+def test_quick_meshes_only_where_the_last_full_build_was_slow(monkeypatch):
+    """A design whose full build is quick is not built twice for each step (quick, then
+    full): previews wait until the session's last full build took more than
+    QUICK_AFTER_SECONDS."""
+    from ruledmesh.web import session as session_module
+
+    s = Session(SMALL, previews=True)         # in this thread, as a script would
+    monkeypatch.setattr(session_module, "QUICK_AFTER_SECONDS", 600.0)
+    s.edit([(["mesh", "rows"], 7)])
+    assert not s.describe()["refining"]
+    assert same_mesh(s.built.mesh, _built(SMALL.replace("rows = 6", "rows = 7")))
+    monkeypatch.setattr(session_module, "QUICK_AFTER_SECONDS", 0.0)
+    s.edit([(["mesh", "rows"], 8)])
+    assert s.describe()["refining"]
+    assert s.settled(60) and same_mesh(s.built.mesh, _built(SMALL.replace("rows = 6", "rows = 8")))
+
+
+def test_the_full_build_starts_from_the_quick_mesh_the_worker_kept(monkeypatch):
+    """The worker keeps the one mesh of a quick build (keeping_meshes), and the design's full
+    build, next, starts its refinement from it instead of making it again: the same mesh
+    as a build on its own, for one mesh less."""
+    from ruledmesh.design import pq as design_pq
+
+    made = []
+    real = design_pq.pq_mesh
+    monkeypatch.setattr(design_pq, "pq_mesh", lambda *a, **k: made.append(1) or real(*a, **k))
+    alone = build_design(parse_design(SMALL)).mesh
+    meshes = len(made)
+    made.clear()
+    with design_pq.keeping_meshes({}) as store:
+        build_design(parse_design(SMALL + "refine = false\n"))
+        assert len(made) == len(store) == 1
+        full = build_design(parse_design(SMALL)).mesh
+    assert len(made) == meshes and meshes > 2
+    assert same_mesh(full, alone)
+
+
+def test_a_newer_edit_stops_the_full_build_and_keeps_the_worker():
+    """The full build of an edit's design gives way to the next edit: the worker stops it
+    between two meshes of the refinement (a CANCEL message), not by being killed, so the next
+    edit does not wait for a new process and its kernels."""
+    from ruledmesh.web import builder
+
+    worker = builder.BuildWorker(timeout=60)
+    try:
+        s = Session(SMALL, builder=worker, previews=True)
+        worker.start()
+        s.edit([(["mesh", "rows"], 7)])
+        pid = worker._proc.pid
+        time.sleep(0.3)                   # the full build of rows = 7 runs in the worker
+        s.edit([(["mesh", "rows"], 8)])
+        assert s.settled(60)
+        assert same_mesh(s.built.mesh, _built(SMALL.replace("rows = 6", "rows = 8")))
+        assert worker._proc.pid == pid
+        stopped = s.design
+        stopped["mesh"]["rows"] = 7
+        assert worker.cached(stopped, s.source, s.base_dir)[1] is None   # never finished
+    finally:
+        worker.close()
+
+
+def test_a_full_build_over_the_time_limit_leaves_the_quick_mesh_and_says_why():
+    from ruledmesh.errors import RuledMeshError
+    from ruledmesh.web import builder
+
+    text = (ROOT / "examples" / "right-conoid-arc.toml").read_text()   # refines for seconds
+    worker = builder.BuildWorker(timeout=1.0)
+    try:
+        s = Session(SMALL, builder=worker, previews=True)
+        worker.start()
+        s.load_text(text)
+        assert s.describe()["refining"]
+        assert not s.settled(60)
+        state = s.describe()
+        assert not state["refining"] and "longer than 1 s" in state["refine_error"]
+        assert "refine = false" in state["refine_error"]
+        assert same_mesh(s.built.mesh, _built(text.replace("[mesh]\n", "[mesh]\nrefine = false\n")))
+        with pytest.raises(RuledMeshError, match="full mesh is not at hand: the build took longer"):
+            s.export_bytes(".obj")
+        # The next edit builds in a new worker (a design without refinement: within 1 s).
+        s.load_text(SMALL + "refine = false\n")
+        assert not s.describe()["refining"] and s.describe()["refine_error"] is None
+        assert same_mesh(s.built.mesh, _built(SMALL + "refine = false\n"))
+    finally:
+        worker.close()
+
+
 def test_an_answer_with_the_same_faces_leaves_them_out():
     from ruledmesh.web.session import topology_key
 

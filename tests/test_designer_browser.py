@@ -1323,3 +1323,32 @@ def test_catalogue_parameters_have_handles(browser, tmp_path, example, label, fi
         pg.close()
         server.shutdown()
         server.server_close()
+
+
+def test_a_design_that_refines_shows_its_quick_mesh_then_the_full_one(page, designer):
+    """The TOML pane applies the design without ``refine = false`` (built in full: the last
+    full build was quick), then the same design at 13 rows: the page draws the quick mesh at
+    once and says the full one is being built, then draws the full mesh (pushed on the live
+    socket) and the note goes."""
+    refining = DESIGN.replace("refine = false\n", "")
+    page.click("#toml-pane summary")
+    page.fill("#toml", refining)
+    before = page.evaluate("window.designer.version")
+    page.click("#apply-toml")
+    wait_version(page, before)
+    assert page.is_hidden("#refining")
+    assert page.inner_text("[data-fig=faces]") == str(build_design(parse_design(refining)).mesh.n_faces)
+    thirteen = refining.replace("rows = 12", "rows = 13")
+    full = build_design(parse_design(thirteen)).mesh
+    assert full.n_faces != build_design(parse_design(thirteen + "refine = false\n")).mesh.n_faces
+    page.fill("#toml", thirteen)
+    before = page.evaluate("window.designer.version")
+    page.click("#apply-toml")
+    page.wait_for_function("!document.getElementById('refining').hidden", timeout=20_000)
+    assert "refining the generators" in page.inner_text("#refining")
+    shot(page, "refining-quick-mesh")
+    page.wait_for_function("document.getElementById('refining').hidden", timeout=60_000)
+    assert page.evaluate("window.designer.version") >= before + 2
+    assert page.inner_text("[data-fig=faces]") == str(full.n_faces)
+    assert page.evaluate(DRAWN_JS)["faces"] == full.n_faces
+    assert designer.session.built.mesh.n_faces == full.n_faces

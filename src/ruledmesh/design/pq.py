@@ -2,9 +2,10 @@
 
 from __future__ import annotations
 
+import contextlib
 import contextvars
 import hashlib
-from collections.abc import Mapping
+from collections.abc import Iterator, Mapping
 from typing import Any
 
 import numpy as np
@@ -17,7 +18,7 @@ from ..registry import BuildContext, Built, mesh_method
 from ..skew.pq import MAX_GRID_POINTS, RowsFrom, pq_mesh
 from ..tolerances import DEFAULT, TINY
 
-__all__ = ["MESH_KEYS", "build_pq"]
+__all__ = ["MESH_KEYS", "build_pq", "keeping_meshes"]
 
 MESH_KEYS = ("method", "rows", "primary", "option", "extend", "trim", "max_extend",
              "planarity_tolerance", "refine", "respace", "rows_from")
@@ -60,7 +61,8 @@ def build_pq(rulings, table: Mapping[str, Any], ctx: BuildContext) -> Built:
                "respace": respace is True,
                "rows_from": RowsFrom.PRIMARY.value if rows_from == "auto" else rows_from}
     token = _PROGRESS.set([ctx.task, 0]) if ctx.task is not None else None
-    made = _MADE.set({})
+    kept = _KEPT.get()
+    made = _MADE.set(kept if kept is not None else {})
     try:
         mesh = _mesh(rulings, options)
         if refine:
@@ -95,6 +97,25 @@ _PROGRESS: contextvars.ContextVar[list | None] = contextvars.ContextVar("pq_prog
 # and starts often come back to the same generators (twisted-arcs-160deg: 6 of 24 meshes,
 # 2.2 of 9 s), and the same input makes the same mesh.
 _MADE: contextvars.ContextVar[dict | None] = contextvars.ContextVar("pq_made", default=None)
+
+
+# Where a caller keeps the meshes across builds (keeping_meshes).
+_KEPT: contextvars.ContextVar[dict | None] = contextvars.ContextVar("pq_kept", default=None)
+
+
+@contextlib.contextmanager
+def keeping_meshes(store: dict) -> Iterator[dict]:
+    """Builds inside share ``store`` for the meshes they make (by generators and options).
+
+    For a caller that builds related designs in a row: the designer's worker builds a
+    design's quick mesh (``refine = false``) and then the design itself, whose refinement
+    starts from that very mesh.  The store keeps every mesh put in it; the caller bounds it.
+    """
+    token = _KEPT.set(store)
+    try:
+        yield store
+    finally:
+        _KEPT.reset(token)
 
 
 def _mesh(rulings, options: dict):

@@ -7,9 +7,13 @@ sends each candidate design to one long-lived worker process (started with
 off the event loop.  The worker is killed and restarted when
 
 - the build takes longer than the limit (the edit is refused with the figure),
-- a newer edit arrives while an older one is still building after a short
-  grace period (the older one is superseded: its result would be discarded
-  anyway, and finishing it would only delay the newer one).
+- a build asked to stop (a newer edit superseded it) does not stop within
+  :data:`CANCEL_SECONDS`.
+
+A build the server no longer wants (a newer edit superseded it, or an edit
+arrives while a background refinement runs) is asked to stop with a
+:data:`CANCEL` message, which the worker reads between two meshes of the
+refinement: the process, its imports and its compiled kernels stay.
 
 Every edit takes a *generation* number from :meth:`BuildWorker.generation`
 when it reads the design it changes; a build whose generation is older than
@@ -30,14 +34,18 @@ from pathlib import Path
 from typing import Any
 
 from ..errors import RuledMeshError
+from ..progress import Progress, Task
 
 __all__ = ["MAX_BUILD_SECONDS", "BuildTimeout", "BuildWorker", "InProcessBuilder", "Superseded"]
 
 # Wall-clock limit of one designer build (the CLI has none: it is the user's own job there).
 MAX_BUILD_SECONDS = 20.0
-# A superseded build younger than this is left to finish (and its result dropped): a fresh
-# worker process needs about a second to import numpy and scipy, most builds take milliseconds.
-SUPERSEDE_GRACE = 0.3
+# Seconds a build asked to stop (CANCEL) may take to stop before its worker is killed: it
+# stops between two meshes of the refinement (tens of milliseconds at designer sizes), and a
+# killed worker costs the next edit a new process (imports and kernels, a second or more).
+CANCEL_SECONDS = 2.0
+# The message asking the worker to drop the build it runs.
+CANCEL = "cancel"
 # Seconds a fresh worker process may take to import its modules (and later to compile
 # the kernels: not counted against the edit waiting meanwhile).
 STARTUP_SECONDS = 120.0
@@ -72,9 +80,47 @@ class BuildTimeout(RuledMeshError):
     """A build took longer than the designer's limit and was stopped."""
 
 
+class _Cancelled(Exception):
+    """Raised inside the worker's build when the server asked it to stop (not a
+    :class:`RuledMeshError`: no layer of the build reports it as the design's fault)."""
+
+
+class _Listening(Progress):
+    """Build progress that reads the server's messages between the stages of a build.
+
+    Every mesh the refinement makes is a stage (:func:`ruledmesh.design.pq._mesh`), so
+    a :data:`CANCEL` stops a long build within one mesh.  A :data:`WARM_UP` that comes
+    meanwhile is remembered for when the build is over.
+    """
+
+    def __init__(self, conn: Any):
+        self.conn = conn
+        self.warm_up = False
+
+    def task(self, label: str, total: int | None = None) -> Task:
+        return _ListeningTask(self)
+
+    def check(self) -> None:
+        while self.conn.poll():
+            message = self.conn.recv()
+            if message == CANCEL:
+                raise _Cancelled
+            if message == WARM_UP:
+                self.warm_up = True
+
+
+class _ListeningTask(Task):
+    def __init__(self, owner: _Listening):
+        self.owner = owner
+
+    def advance(self, n: int = 1, note: str | None = None) -> None:
+        self.owner.check()
+
+
 def _worker_main(conn) -> None:  # pragma: no cover - runs in the child process
     from .. import kernels
     from ..design import Design, build_design, parse_design
+    from ..design.pq import keeping_meshes
     from ..registry import load_plugins
     from .session import DEFAULT_DESIGN, frame_data
 
@@ -84,10 +130,18 @@ def _worker_main(conn) -> None:  # pragma: no cover - runs in the child process
     frame_data(default.data, build_design(default))  # imports the mesher's modules (lazy elsewhere)
     conn.send(("ready", None))  # the time limit counts from here
     warm = False
+    asked = False  # a page asked for the kernels while a build ran
+    # The meshes of the last build that made just one (a quick mesh: the session builds the
+    # design in full next, and its refinement starts from that mesh).
+    kept: dict = {}
     while True:
         try:
-            job: Any = None if warm or conn.poll(IDLE_BEFORE_WARM_UP) else WARM_UP
+            job: Any = WARM_UP if asked else None
+            job = job or (None if warm or conn.poll(IDLE_BEFORE_WARM_UP) else WARM_UP)
             job = conn.recv() if job is None else job
+            asked = False
+            if job == CANCEL:
+                continue  # the build it was meant for had already answered
             if job == WARM_UP:
                 # Idle, or a page opened: compile the kernels now, telling the server,
                 # which does not count this time against an edit that arrives meanwhile.
@@ -101,8 +155,11 @@ def _worker_main(conn) -> None:  # pragma: no cover - runs in the child process
         if job is None:
             return
         data, source, base_dir = job
+        listening = _Listening(conn)
+        made = dict(kept)
         try:
-            built = build_design(Design(data, source, Path(base_dir)))
+            with keeping_meshes(made):
+                built = build_design(Design(data, source, Path(base_dir)), listening)
             # The page's arrays and figures are made here, while the server waits anyway: it
             # then only encodes them (and stays free for other requests meanwhile).
             frame = frame_data(data, built)
@@ -110,12 +167,18 @@ def _worker_main(conn) -> None:  # pragma: no cover - runs in the child process
             # figures process builds its own), and the catalogue's references are closures,
             # which cannot be pickled.
             reply: tuple[str, Any] = ("ok", (dataclasses.replace(built, reference=None), frame))
+        except _Cancelled:
+            reply = ("cancelled", None)
+        except (EOFError, OSError):
+            return
         except RuledMeshError as exc:
             reply = ("error", exc)
         except MemoryError:
             reply = ("memory", None)
         except Exception as exc:  # noqa: BLE001 - reported to the page, never a dead worker
             reply = ("bug", f"{type(exc).__name__}: {exc}")
+        asked = listening.warm_up
+        kept = made if len(made) == 1 else {}
         try:
             conn.send(reply)
         except Exception:  # noqa: BLE001 - an unpicklable error: say so instead of hanging
@@ -178,6 +241,8 @@ class InProcessBuilder:
         self._issued = 0
         self._cache: OrderedDict[str, Any] = OrderedDict()
         self.builds = 0  # designs built (not answered from the cache), for the tests
+        #: Seconds the last design built took (the wait for a worker's kernels not counted).
+        self.last_seconds = 0.0
 
     def cached(self, data: dict, source: str, base_dir: str | Path) -> tuple[str | None, Any]:
         """``(key, (built, frame))``: the cached build of this design, or ``(key, None)``."""
@@ -223,12 +288,23 @@ class InProcessBuilder:
         The page's message of it (:func:`~ruledmesh.web.session.frame_data`)
         is made by the session when asked for.
         """
+        return self._here(data, source, base_dir)
+
+    def refine_frame(self, data: dict, source: str, base_dir: str | Path) -> tuple[Any, dict | None] | None:
+        """Build design ``data`` here and now, as :meth:`build_frame` (nothing else waits
+        for this builder, so it never gives the build up: never None)."""
+        return self._here(data, source, base_dir)
+
+    def _here(self, data: dict, source: str, base_dir: str | Path) -> tuple[Any, dict | None]:
         from ..design import Design, build_design
 
         key, hit = self.cached(data, source, base_dir)
         if hit is not None:
             return hit
-        return self.remember(key, (build_design(Design(data, source, Path(base_dir))), None))
+        started = time.perf_counter()
+        built = build_design(Design(data, source, Path(base_dir)))
+        self.last_seconds = time.perf_counter() - started
+        return self.remember(key, (built, None))
 
     def warm_up(self) -> None:
         """Nothing to prepare: the caller's process builds."""
@@ -258,6 +334,8 @@ class BuildWorker(InProcessBuilder):
         self._send = threading.Lock()
         # Set when a page opened: every worker started from then on loads the kernels at once.
         self._warm_wanted = False
+        # Edits waiting for the worker or building in it: a background build gives way to them.
+        self._foreground = 0
         #: Whether the running worker builds with the compiled kernels (None: not yet known;
         #: the worker loads them at its first idle second, or at once when a page has opened,
         #: and says so with its next answer).
@@ -316,7 +394,8 @@ class BuildWorker(InProcessBuilder):
 
         ``built`` is the :class:`~ruledmesh.registry.Built` (without its smooth
         reference), ``frame_data`` the page's message parts made in the worker
-        (:func:`~ruledmesh.web.session.frame_data`).
+        (:func:`~ruledmesh.web.session.frame_data`).  A background build
+        (:meth:`refine_frame`) running meanwhile is asked to stop.
 
         Raises
         ------
@@ -332,21 +411,53 @@ class BuildWorker(InProcessBuilder):
         key, hit = self.cached(data, source, base_dir)
         if hit is not None:
             return hit
-        with self._run_lock:
-            if self._closed:
-                raise Superseded("the designer is stopping")
-            if self.superseded(generation):
-                raise Superseded("superseded by a newer edit")
-            if self._proc is None or not self._proc.is_alive():
-                self._stop()
-                self._start()
-            return self.remember(key, self._wait(generation, (data, source, str(base_dir))))
+        with self._state:
+            self._foreground += 1
+        try:
+            with self._run_lock:
+                if self._closed:
+                    raise Superseded("the designer is stopping")
+                if self.superseded(generation):
+                    raise Superseded("superseded by a newer edit")
+                built = self._run((data, source, str(base_dir)), lambda: self.superseded(generation))
+        finally:
+            with self._state:
+                self._foreground -= 1
+        if built is None or self.superseded(generation):
+            raise Superseded("superseded by a newer edit")
+        return self.remember(key, built)
 
-    def _wait(self, generation: int, job: tuple) -> Any:
+    def refine_frame(self, data: dict, source: str, base_dir: str | Path) -> tuple[Any, dict | None] | None:
+        """Build design ``data`` in the worker when no edit waits for it: ``(built,
+        frame_data)``, or None where an edit asked for the worker before it was done
+        (the build was stopped, the worker kept).
+
+        The session's background work (the full build of a design whose quick
+        preview is shown): any :meth:`build_frame` goes first.
+        """
+        key, hit = self.cached(data, source, base_dir)
+        if hit is not None:
+            return hit
+        with self._run_lock:
+            if self._closed or self._foreground:
+                return None
+            built = self._run((data, source, str(base_dir)), lambda: self._foreground > 0)
+        return None if built is None else self.remember(key, built)
+
+    def _run(self, job: tuple, unwanted: Any) -> Any:
+        """``job``'s ``(built, frame)`` from the worker (started if need be), or None where
+        ``unwanted()`` turned true and the build stopped; under the run lock."""
+        if self._proc is None or not self._proc.is_alive():
+            self._stop()
+            self._start()
+        return self._wait(job, unwanted)
+
+    def _wait(self, job: tuple, unwanted: Any) -> Any:
         started = time.monotonic()
         # When the worker said it is compiling the kernels (0: it is not).  It says "busy" and
         # "idle" before it reads the next job, so both arrive while one edit waits.
         paused = 0.0
+        cancelled = 0.0  # when the build was asked to stop (0: it was not)
         try:
             with self._send:
                 self._conn.send(job)
@@ -369,24 +480,31 @@ class BuildWorker(InProcessBuilder):
                     elapsed = max(paused, started) - started
                 else:
                     elapsed = now - started
+                if self._closed:
+                    self._stop()
+                    raise Superseded("the designer is stopping")
+                if cancelled and now - cancelled > CANCEL_SECONDS:
+                    self._stop()        # it did not stop between two meshes: a long mesh
+                    return None
                 if elapsed > self.timeout:
                     self._stop()
                     raise BuildTimeout(f"the build took longer than {self.timeout:g} s and was "
                                        "stopped; reduce the generator count or the rows")
-                # Not while the kernels compile: a new worker would compile them again.
-                if self._closed or (not paused and now - started > SUPERSEDE_GRACE
-                                    and self.superseded(generation)):
-                    self._stop()
-                    raise Superseded("superseded by a newer edit")
+                # Not while the kernels compile: the worker reads the request after them.
+                if not cancelled and not paused and unwanted():
+                    cancelled = now
+                    with self._send:
+                        self._conn.send(CANCEL)
                 if not self._proc.is_alive():
                     raise EOFError
         except (EOFError, OSError):
             self._stop()
             raise RuledMeshError("the build process stopped unexpectedly (out of memory?); "
                                  "reduce the counts in the design") from None
-        if self.superseded(generation):
-            raise Superseded("superseded by a newer edit")
+        if kind == "cancelled" or unwanted():
+            return None
         if kind == "ok":
+            self.last_seconds = time.monotonic() - started   # started moved past the pauses
             return value
         if kind == "error":
             raise value

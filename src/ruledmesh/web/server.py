@@ -632,6 +632,10 @@ class DesignerServer:
     token : str, optional
         The secret of the API; a new random one by default.
     limits : Limits, optional
+        Bounds on requests, builds and sockets.
+    previews : bool
+        Show a design that refines its generators with its quick mesh at once and
+        the full one when built (see :class:`Session`); on by default.
 
     Raises
     ------
@@ -640,7 +644,7 @@ class DesignerServer:
     """
 
     def __init__(self, session: Session, host: str = DEFAULT_HOST, port: int = 0, *,
-                 token: str | None = None, limits: Limits | None = None):
+                 token: str | None = None, limits: Limits | None = None, previews: bool = True):
         self.session = session
         self.limits = limits or Limits()
         self.token = token or secrets.token_urlsafe(32)
@@ -651,7 +655,7 @@ class DesignerServer:
         self._figures_lock = threading.Lock()
         self._closing = False
         self._builder = BuildWorker(self.limits.build_seconds)
-        session.set_builder(self._builder)
+        session.set_builder(self._builder, previews)
         api = _Api(self)
         self.live = _Live(session)
         session.add_listener(self.live.notify)
@@ -720,6 +724,7 @@ class DesignerServer:
 
 
 def make_server(session: Session, host: str = DEFAULT_HOST, port: int = 0, *,
-                token: str | None = None, limits: Limits | None = None) -> DesignerServer:
+                token: str | None = None, limits: Limits | None = None,
+                previews: bool = True) -> DesignerServer:
     """A :class:`DesignerServer` bound to ``host:port`` (not yet serving)."""
-    return DesignerServer(session, host, port, token=token, limits=limits)
+    return DesignerServer(session, host, port, token=token, limits=limits, previews=previews)

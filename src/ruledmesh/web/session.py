@@ -17,10 +17,12 @@ from __future__ import annotations
 
 import contextlib
 import copy
+import dataclasses
 import importlib
 import json
 import math
 import threading
+import time
 from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass
 from pathlib import Path
@@ -30,10 +32,10 @@ import numpy as np
 
 from .._arrays import ranks
 from ..design import Design, build_design, parse_design
-from ..errors import DesignError, ExportError, ParameterError
+from ..errors import DesignError, ExportError, ParameterError, RuledMeshError
 from ..mesh import FaceKind, Mesh
 from ..registry import Built
-from .builder import InProcessBuilder, Superseded
+from .builder import MAX_BUILD_SECONDS, BuildTimeout, InProcessBuilder, Superseded
 from .toml_writer import dumps
 
 __all__ = [
@@ -83,6 +85,10 @@ trim = true
 MAX_PANEL_FACES = 200_000
 # Undo steps kept; older ones are dropped so a long session stays bounded in memory.
 UNDO_LIMIT = 200
+# With previews, an edit shows the quick mesh first only where the session's last full build
+# took longer than this: a quick design (examples/skew: 40 ms) would otherwise be built twice
+# and drawn twice for each step of a slider, for nothing.
+QUICK_AFTER_SECONDS = 0.15
 # Points sampled along each director curve for display.
 CURVE_SAMPLES = 160
 # Control points of one curve (or points of one list of a catalogue surface): each one is a
@@ -417,6 +423,10 @@ class _Snapshot:
     version: int
     toml: str
     frame: dict[str, Any] | None = None  # frame_data, when the build worker made it
+    # The quick mesh of a design that refines ([mesh] refine = false) while its full build
+    # runs in the background (Session.previews); refine_error: why that build gave no mesh.
+    refining: bool = False
+    refine_error: str | None = None
 
 
 # The sampled curves of the last design: they change only when the curves do (not with the
@@ -497,6 +507,14 @@ class Session:
     builder : InProcessBuilder, optional
         Builds the edits (the server passes a :class:`~ruledmesh.web.builder.BuildWorker`:
         a separate process with a time limit); default: in the calling thread.
+    previews : bool
+        Make an edit of a design that refines its generators current at once with
+        its quick mesh (the same design with ``[mesh] refine = false``: one mesh
+        instead of tens) and build the full mesh in the background, which replaces
+        it when done (:meth:`settled`); the next edit stops that build.  Only while
+        the last full build took more than :data:`QUICK_AFTER_SECONDS`.  The server
+        turns this on: a slider dragged over a design that takes seconds to refine
+        shows a mesh for every step.
 
     Raises
     ------
@@ -506,7 +524,7 @@ class Session:
 
     def __init__(self, text: str | None = None, path: str | Path | None = None,
                  base_dir: str | Path | None = None, undo_limit: int = UNDO_LIMIT,
-                 builder: InProcessBuilder | None = None):
+                 builder: InProcessBuilder | None = None, previews: bool = False):
         # Resolved: a design file that is a link is edited where it really lives.
         self.path = Path(path).resolve() if path is not None else None
         if base_dir is None:
@@ -524,7 +542,10 @@ class Session:
         data = _plain(design.data)
         check_limits(data, self.base_dir)
         self._lock = threading.RLock()
+        started = time.perf_counter()
         self._current = _Snapshot(data, self._build(data), 0, dumps(data))
+        # How long the last full build of a design took (previews: see QUICK_AFTER_SECONDS).
+        self._full_seconds = time.perf_counter() - started
         self._undo: list[dict] = []
         self._redo: list[dict] = []
         # What each step did, in the words of the page's history list (parallel to the stacks).
@@ -539,6 +560,11 @@ class Session:
         self._panels: tuple[int, dict[str, np.ndarray], Any] | None = None
         self._frame: tuple[int, dict[str, Any]] | None = None  # (version, frame_data)
         self._frame_lock = threading.Lock()
+        self.previews = bool(previews)
+        # Told whenever the current snapshot changes: settled() waits on it.
+        self._changed = threading.Condition(self._lock)
+        # The background build of a quick snapshot: (that snapshot, its thread).
+        self._refiner: tuple[_Snapshot, threading.Thread] | None = None
 
     def add_listener(self, listener: Callable[[int], None]) -> None:
         """Call ``listener(version)`` after every change of the current design."""
@@ -554,10 +580,13 @@ class Session:
             return {"undo": list(self._undo_labels), "current": self._label,
                     "redo": list(reversed(self._redo_labels))}
 
-    def set_builder(self, builder: InProcessBuilder) -> None:
-        """Build the next edits with ``builder`` (the server's worker process)."""
+    def set_builder(self, builder: InProcessBuilder, previews: bool | None = None) -> None:
+        """Build the next edits with ``builder`` (the server's worker process), with quick
+        meshes first where ``previews`` says so (None: as before; see :class:`Session`)."""
         with self._lock:
             self._builder = builder
+            if previews is not None:
+                self.previews = bool(previews)
 
     def page_opened(self) -> None:
         """A page connected: edits are coming, so the builder gets ready for them now (the
@@ -598,7 +627,7 @@ class Session:
 
     def _commit(self, generation: int, push: bool, data: dict, built: Built,
                 text: str | None = None, coalesce: str | None = None,
-                label: str | None = None, frame: dict | None = None) -> int:
+                label: str | None = None, frame: dict | None = None, quick: bool = False) -> int:
         """Make ``data`` current unless a newer edit arrived while it built (under the lock)."""
         if self._builder.superseded(generation):
             raise Superseded("superseded by a newer edit")
@@ -612,7 +641,7 @@ class Session:
             self._redo_labels.clear()
             self._label = label or "edit"
         self._coalesce = coalesce
-        self._make_current(data, built, text, frame)
+        self._make_current(data, built, text, frame, quick)
         return self.version
 
     def _notify(self, version: int) -> None:
@@ -621,9 +650,99 @@ class Session:
                 listener(version)
 
     def _make_current(self, data: dict, built: Built, text: str | None = None,
-                      frame: dict | None = None) -> None:
+                      frame: dict | None = None, refining: bool = False) -> None:
         self._current = _Snapshot(data, built, self._current.version + 1,
-                                  dumps(data) if text is None else text, frame)
+                                  dumps(data) if text is None else text, frame, refining)
+        self._changed.notify_all()
+
+    # ------------------------------------------------------------- quick meshes
+    def _quick(self, data: dict) -> dict | None:
+        """The design to show at once while ``data`` builds in full: ``data`` with
+        ``[mesh] refine = false``, or None (no previews, nothing to refine, the last full
+        build was quick, or this one's is at hand)."""
+        mesh = data.get("mesh")
+        if not self.previews or "rulings" not in data or not isinstance(mesh, dict) \
+                or mesh.get("method", "pq") != "pq" or mesh.get("refine", True) is not True \
+                or self._full_seconds <= QUICK_AFTER_SECONDS:
+            return None
+        if self._builder.cached(data, self.source, self.base_dir)[1] is not None:
+            return None
+        return {**data, "mesh": {**mesh, "refine": False}}
+
+    def _build_frame(self, generation: int, data: dict) -> tuple[Built, dict | None, bool]:
+        """``(built, frame, quick)``: the build to make current for ``data`` now, and
+        whether it is the quick one (:meth:`_quick`)."""
+        quick = self._quick(data)
+        builds = self._builder.builds
+        built, frame = self._builder.build_frame(generation, data if quick is None else quick,
+                                                 self.source, self.base_dir)
+        if quick is None and self._builder.builds > builds:
+            self._full_seconds = self._builder.last_seconds
+        return built, frame, quick is not None
+
+    def _keep_refining(self) -> None:
+        """Build the current snapshot in full in the background, if it is a quick one and
+        no build of it runs (an edit that took the worker stopped the last one)."""
+        with self._lock:
+            snap = self._current
+            if not snap.refining or snap.refine_error is not None:
+                return
+            if self._refiner is not None and self._refiner[0] is snap and self._refiner[1].is_alive():
+                return
+            thread = threading.Thread(target=self._refine, args=(snap,), daemon=True,
+                                      name="ruledmesh-refine")
+            self._refiner = (snap, thread)
+            thread.start()
+
+    def _refine(self, snap: _Snapshot) -> None:
+        """The background build of quick snapshot ``snap``: it becomes current with the full
+        mesh (a new version, the same design and undo step) while ``snap`` is current."""
+        error = None
+        builds = self._builder.builds
+        try:
+            done = self._builder.refine_frame(snap.design, self.source, self.base_dir)
+            if done is not None and self._builder.builds > builds:
+                self._full_seconds = self._builder.last_seconds
+        except BuildTimeout as exc:
+            done, error = None, f"{exc} (the quick mesh is shown: [mesh] refine = false)"
+        except MemoryError:
+            done, error = None, "out of memory (the quick mesh is shown: [mesh] refine = false)"
+        except RuledMeshError as exc:
+            done, error = None, str(exc)
+        with self._lock:
+            if self._current is not snap:
+                return                   # an edit, undo or redo made another design current
+            if done is None and error is None:
+                return                   # an edit took the worker: _keep_refining starts again
+            if done is None:
+                self._current = dataclasses.replace(snap, version=snap.version + 1, refine_error=error)
+                self._changed.notify_all()
+            else:
+                self._make_current(snap.design, done[0], snap.toml, done[1])
+            version = self.version
+        self._notify(version)
+
+    def settled(self, timeout: float | None = None) -> bool:
+        """Wait until the current mesh is the full build of the current design (not a quick
+        one, :class:`Session` ``previews``); whether it is (False: timed out, or the full
+        build failed: :meth:`describe`'s ``refine_error`` says why)."""
+        with self._lock:
+            self._keep_refining()
+            ok = self._changed.wait_for(
+                lambda: not self._current.refining or self._current.refine_error is not None, timeout)
+            return ok and not self._current.refining
+
+    def _full(self) -> _Snapshot:
+        """The current snapshot once it is a full build (exports, panels of a design that
+        refines); a :class:`RuledMeshError` where that build failed."""
+        if not self.settled(self._builder_timeout()):
+            with self._lock:
+                error = self._current.refine_error or "the full build did not finish in time"
+            raise RuledMeshError(f"the design's full mesh is not at hand: {error}")
+        return self._current
+
+    def _builder_timeout(self) -> float:
+        return float(getattr(self._builder, "timeout", MAX_BUILD_SECONDS)) + 5.0
 
     # ------------------------------------------------------------- edits
     def replace(self, data: Mapping[str, Any], coalesce: str | None = None,
@@ -659,11 +778,13 @@ class Session:
         text = dumps(candidate)
         parse_design(text, self.source, self.base_dir)
         # Built outside the lock: state requests (and newer edits) never wait for a build.
-        built, frame = self._builder.build_frame(generation, candidate, self.source,
-                                                 self.base_dir)
-        with self._lock:
-            version = self._commit(generation, True, candidate, built, text, coalesce, label,
-                                   frame)
+        try:
+            built, frame, quick = self._build_frame(generation, candidate)
+            with self._lock:
+                version = self._commit(generation, True, candidate, built, text, coalesce, label,
+                                       frame, quick)
+        finally:
+            self._keep_refining()
         self._notify(version)
         return version
 
@@ -696,17 +817,20 @@ class Session:
                 raise ParameterError(f"nothing to {name}", name)
             generation = self._builder.generation()
             data = stack[-1]
-        built, frame = self._builder.build_frame(generation, data, self.source, self.base_dir)
-        with self._lock:
-            if self._builder.superseded(generation):
-                raise Superseded("superseded by a newer edit")
-            stack.pop()
-            labels = self._undo_labels if back else self._redo_labels
-            label = labels.pop() if labels else "edit"
-            (self._redo if back else self._undo).append(self._current.design)
-            (self._redo_labels if back else self._undo_labels).append(self._label)
-            self._label = label
-            version = self._commit(generation, False, data, built, frame=frame)
+        try:
+            built, frame, quick = self._build_frame(generation, data)
+            with self._lock:
+                if self._builder.superseded(generation):
+                    raise Superseded("superseded by a newer edit")
+                stack.pop()
+                labels = self._undo_labels if back else self._redo_labels
+                label = labels.pop() if labels else "edit"
+                (self._redo if back else self._undo).append(self._current.design)
+                (self._redo_labels if back else self._undo_labels).append(self._label)
+                self._label = label
+                version = self._commit(generation, False, data, built, frame=frame, quick=quick)
+        finally:
+            self._keep_refining()
         self._notify(version)
         return version
 
@@ -805,7 +929,8 @@ class Session:
         from .. import io
 
         ext, module = self._writer(ext)
-        mesh = self._current.built.mesh
+        # The file ruledmesh build writes: the full mesh, not the quick one (previews).
+        mesh = self._full().built.mesh
         io.check_finite(mesh)
         try:
             files = {Path(target): module.dumpb(mesh)}
@@ -859,6 +984,10 @@ class Session:
         load_plugins()
         return {
             "version": self.version,
+            # The mesh is the quick one while the full build runs (previews), and stays it
+            # where that build failed (refine_error: why).
+            "refining": self._current.refining and self._current.refine_error is None,
+            "refine_error": self._current.refine_error,
             "design": self._current.design,
             "toml": self.toml(),
             "path": str(self.path) if self.path else None,

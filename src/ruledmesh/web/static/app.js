@@ -1680,6 +1680,7 @@ function applyState(msg) {
     updateDownload();
   }
   if (!tomlDirty) $('toml').value = h.toml;
+  showRefining(h);
   showFigures(h.figures);
   if (h.history) showHistory(h.history);
   buildKindChooser();
@@ -1692,6 +1693,16 @@ function applyState(msg) {
   window.designer.renders += 1;
   window.designer.applyMs = performance.now() - applyStart;
   if (changed) scheduleSlowFigures();
+}
+
+// A design that refines its generators shows its quick mesh ([mesh] refine = false) while
+// the server builds the full one, which then arrives as a new state.
+function showRefining(h) {
+  const box = $('refining');
+  box.hidden = !h.refining && !h.refine_error;
+  box.classList.toggle('failed', !!h.refine_error);
+  box.textContent = h.refine_error ? `quick mesh shown, the full build failed: ${h.refine_error}`
+    : h.refining ? 'quick mesh shown (refine = false); refining the generators\u2026' : '';
 }
 
 function updateDownload() {
