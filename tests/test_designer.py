@@ -29,6 +29,10 @@ from ruledmesh.web.toml_writer import dumps
 ROOT = Path(__file__).resolve().parents[1]
 
 SMALL = _shared.SMALL_DESIGN
+# The small design with its own nine generators: one mesh a build instead of about thirty
+# (0.6-1 s), for the tests of the session, the server and the files, which are not about the
+# refinement (the tests of quick meshes and of the worker keep SMALL).
+QUICK = SMALL + "refine = false\n"
 
 
 def decode(data: bytes) -> tuple[dict, dict[str, np.ndarray]]:
@@ -85,7 +89,7 @@ def test_toml_writer_special_floats_and_refusals():
 
 # ---------------------------------------------------------------- geometry helpers
 def test_display_triangles_cover_every_face():
-    s = Session(SMALL)
+    s = Session(QUICK)
     mesh = s.built.mesh
     tris, face = fan_triangles(mesh)
     # a k-gon gives k - 2 triangles, all from its own corners
@@ -96,7 +100,7 @@ def test_display_triangles_cover_every_face():
 
 # ---------------------------------------------------------------- session
 def test_session_edit_undo_redo():
-    s = Session(SMALL)
+    s = Session(QUICK)
     v0, m0 = s.version, s.built.mesh
     s.edit([(["rulings", "count"], 12)])
     assert s.design["rulings"]["count"] == 12 and s.version == v0 + 1
@@ -112,7 +116,7 @@ def test_session_edit_undo_redo():
 
 
 def test_session_drag_gesture_is_one_undo_step():
-    s = Session(SMALL)
+    s = Session(QUICK)
     for k in range(5):
         s.edit([(["curves", "c1", "points", 1], [3, 1 + 0.1 * k, 0])], coalesce="drag:1")
     s.edit([(["rulings", "count"], 10)])
@@ -123,7 +127,7 @@ def test_session_drag_gesture_is_one_undo_step():
 
 
 def test_history_lists_every_step_and_follows_undo_and_redo():
-    s = Session(SMALL)
+    s = Session(QUICK)
     seen = []
     s.add_listener(seen.append)
     s.edit([(["mesh", "rows"], 8)])
@@ -151,7 +155,7 @@ def test_history_lists_every_step_and_follows_undo_and_redo():
 def test_panel_read_out_is_the_schedule_row_and_the_unrolled_outline():
     from ruledmesh.fabricate import panel_table
 
-    s = Session(SMALL)
+    s = Session(QUICK)
     mesh = s.built.mesh
     table = panel_table(mesh)
     f = mesh.n_faces // 2
@@ -195,7 +199,7 @@ def test_panel_of_a_face_chosen_among_other_faces_is_stale():
 def test_panel_read_out_is_bounded(monkeypatch):
     from ruledmesh.web import session as session_module
 
-    s = Session(SMALL)
+    s = Session(QUICK)
     monkeypatch.setattr(session_module, "MAX_PANEL_FACES", s.built.mesh.n_faces - 1)
     with pytest.raises(ParameterError, match=r"up to .* faces; this one has"):
         s.panel(0)
@@ -401,7 +405,7 @@ def test_a_full_build_over_the_time_limit_leaves_the_quick_mesh_and_says_why():
 def test_an_answer_with_the_same_faces_leaves_them_out():
     from ruledmesh.web.session import topology_key
 
-    s = Session(SMALL)
+    s = Session(QUICK)
     full, arrays = decode(s.payload())
     key = full["topology"]
     assert key == topology_key(s.built.mesh) and not full["same_topology"]
@@ -418,7 +422,7 @@ def test_an_answer_with_the_same_faces_leaves_them_out():
 
 
 def test_bad_edit_is_refused_with_the_field_and_state_kept():
-    s = Session(SMALL)
+    s = Session(QUICK)
     before, v = s.design, s.version
     with pytest.raises(DesignError, match=r"rulings\.count.*>= 3"):
         s.edit([(["rulings", "count"], 1)])
@@ -430,7 +434,7 @@ def test_bad_edit_is_refused_with_the_field_and_state_kept():
 
 
 def test_save_rebuilds_the_same_mesh(tmp_path):
-    s = Session(SMALL, tmp_path / "small.toml")
+    s = Session(QUICK, tmp_path / "small.toml")
     s.edit([(["curves", "c2", "points", 2], [6.5, 3.25, 2.75]), (["mesh", "rows"], 7)])
     path = s.save()
     assert path == tmp_path / "small.toml"
@@ -442,7 +446,7 @@ def test_save_rebuilds_the_same_mesh(tmp_path):
 
 @pytest.mark.parametrize("ext", io.formats())
 def test_export_every_format(tmp_path, ext):
-    s = Session(SMALL, tmp_path / "small.toml")
+    s = Session(QUICK, tmp_path / "small.toml")
     try:
         path = s.export(ext)
     except ExportError as exc:  # an optional writer package missing: a clear message, no file
@@ -457,7 +461,7 @@ def test_export_every_format(tmp_path, ext):
 
 
 def test_payload_matches_the_mesh():
-    s = Session(SMALL)
+    s = Session(QUICK)
     header, arrays = decode(s.payload())
     mesh = s.built.mesh
     np.testing.assert_array_equal(arrays["vertices"], mesh.vertices.astype(np.float32))
@@ -476,7 +480,7 @@ def test_payload_panel_figures_are_the_reports():
     from ruledmesh.analysis.faces import face_min_angles
     from ruledmesh.analysis.report import analyze
 
-    s = Session(SMALL)
+    s = Session(QUICK)
     header, arrays = decode(s.payload())
     mesh = s.built.mesh
     fig, report = header["figures"], analyze(mesh, extras=s.built.extras)
@@ -493,7 +497,7 @@ def test_payload_panel_figures_are_the_reports():
 # ---------------------------------------------------------------- HTTP
 @pytest.fixture
 def server(tmp_path):
-    srv = make_server(Session(SMALL, tmp_path / "small.toml"), port=0)
+    srv = make_server(Session(QUICK, tmp_path / "small.toml"), port=0)
     thread = threading.Thread(target=srv.serve_forever, daemon=True)
     thread.start()
     yield srv
@@ -666,7 +670,7 @@ def test_cli_serves_on_loopback_and_stops_on_sigterm(tmp_path):
     from urllib.request import Request, urlopen
 
     design = tmp_path / "small.toml"
-    design.write_text(SMALL)
+    design.write_text(QUICK)
     proc, url = start_cli(str(design))
     try:
         base, token = re.fullmatch(r"(http://127\.0\.0\.1:\d+/)\?token=([\w-]{40,})", url).groups()
@@ -686,7 +690,7 @@ def test_cli_refuses_bad_input(tmp_path, capsys):
     assert "no such design file" in capsys.readouterr().err
     assert main(["design", "--port", "70000", "--no-browser"]) == 2
     bad = tmp_path / "bad.toml"
-    bad.write_text(SMALL.replace("count = 9", "count = 1"))
+    bad.write_text(QUICK.replace("count = 9", "count = 1"))
     assert main(["design", str(bad), "--no-browser"]) == 2
     assert "rulings.count" in capsys.readouterr().err
 
@@ -697,8 +701,8 @@ def test_export_writes_the_files_the_command_line_writes(tmp_path, ext, monkeypa
     (tmp_path / "designer").mkdir()
     (tmp_path / "cli").mkdir()
     design = tmp_path / "designer" / "small.toml"
-    design.write_text(SMALL)
-    s = Session(SMALL, design)
+    design.write_text(QUICK)
+    s = Session(QUICK, design)
     try:
         s.export(ext)
     except ExportError as exc:
@@ -723,7 +727,7 @@ def test_one_build_per_design_undo_and_redo_from_the_cache(tmp_path):
     from ruledmesh.web.builder import BUILD_CACHE, InProcessBuilder
 
     builder = InProcessBuilder()
-    s = Session(SMALL, tmp_path / "small.toml", builder=builder)
+    s = Session(QUICK, tmp_path / "small.toml", builder=builder)
     s.edit([(["mesh", "rows"], 7)])
     s.edit([(["mesh", "rows"], 8)])
     assert builder.builds == 2

@@ -31,6 +31,9 @@ def decode(data: bytes) -> tuple[dict, bytes]:
 
 
 SMALL = _shared.SMALL_DESIGN
+# The small design with its own nine generators (one mesh a build, not about thirty): the
+# servers of these tests are about safety, not the refinement.
+QUICK = SMALL + "refine = false\n"
 
 
 def tree(folder: Path) -> dict[str, bytes]:
@@ -47,7 +50,7 @@ def tree(folder: Path) -> dict[str, bytes]:
 class Designer:
     """A running designer over ``folder/user.toml`` and an ``outside`` folder next to it."""
 
-    def __init__(self, root: Path, limits: Limits | None = None, design: str | None = SMALL):
+    def __init__(self, root: Path, limits: Limits | None = None, design: str | None = QUICK):
         self.folder = root / "work"
         self.outside = root / "outside"
         self.folder.mkdir()
@@ -530,7 +533,7 @@ def test_long_build_is_stopped_and_never_blocks_state_requests(tmp_path):
     # Without the refinement: the small design's own builds (9 generators refined to up to
     # 122, about 27 mesher runs: 0.3-1 s of CPU) came close to the 1.5 s limit on a loaded
     # machine, and the edit after the restart must build well inside it.
-    d = Designer(tmp_path, limits=Limits(build_seconds=1.5), design=SMALL + "refine = false\n")
+    d = Designer(tmp_path, limits=Limits(build_seconds=1.5), design=QUICK)
     try:
         d.request("POST", "/api/edit", {"changes": [[["mesh", "rows"], 7]]})  # worker warm
         result = {}
