@@ -703,6 +703,8 @@ class Session:
             done = self._builder.refine_frame(snap.design, self.source, self.base_dir)
             if done is not None and self._builder.builds > builds:
                 self._full_seconds = self._builder.last_seconds
+        except Superseded:
+            done = None                  # the designer is stopping
         except BuildTimeout as exc:
             done, error = None, f"{exc} (the quick mesh is shown: [mesh] refine = false)"
         except MemoryError:
