@@ -322,6 +322,8 @@ def test_quick_meshes_only_where_the_last_full_build_was_slow(monkeypatch):
     from ruledmesh.web import session as session_module
 
     s = Session(SMALL, previews=True)         # in this thread, as a script would
+    assert s.describe()["refining"]           # opened with the quick mesh
+    assert s.settled(60) and same_mesh(s.built.mesh, _built(SMALL))
     monkeypatch.setattr(session_module, "QUICK_AFTER_SECONDS", 600.0)
     s.edit([(["mesh", "rows"], 7)])
     assert not s.describe()["refining"]
@@ -677,6 +679,33 @@ def test_cli_serves_on_loopback_and_stops_on_sigterm(tmp_path):
         req = Request(base + "api/state", headers={"Authorization": f"Bearer {token}"})
         header, _ = decode(urlopen(req, timeout=30).read())
         assert header["path"] == str(design) and header["design"]["rulings"]["count"] == 9
+    finally:
+        proc.terminate()
+        code = proc.wait(timeout=30)
+    assert code == 0, proc.stderr.read()
+
+
+def test_cli_opens_a_design_that_refines_with_its_quick_mesh(tmp_path):
+    """ruledmesh design does not wait for the refinement before it serves: the page opens on
+    the quick mesh (refine = false) and the full mesh follows from the worker."""
+    from urllib.request import Request, urlopen
+
+    design = tmp_path / "small.toml"
+    design.write_text(SMALL)
+    proc, url = start_cli(str(design))
+    try:
+        base, token = re.fullmatch(r"(http://127\.0\.0\.1:\d+/)\?token=([\w-]{40,})", url).groups()
+        req = Request(base + "api/state", headers={"Authorization": f"Bearer {token}"})
+        header, _ = decode(urlopen(req, timeout=30).read())
+        full = _built(SMALL)
+        if header["refining"]:            # else the worker was done already
+            assert header["figures"]["faces"] == _built(QUICK).n_faces != full.n_faces
+        deadline = time.monotonic() + 120
+        while header["refining"] and time.monotonic() < deadline:
+            time.sleep(0.2)
+            header, _ = decode(urlopen(req, timeout=30).read())
+        assert not header["refining"] and header["refine_error"] is None
+        assert header["figures"]["faces"] == full.n_faces
     finally:
         proc.terminate()
         code = proc.wait(timeout=30)

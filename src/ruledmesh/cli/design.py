@@ -65,7 +65,8 @@ def run(args) -> int:
             raise ParameterError(f"{path}: {exc.strerror}", "design") from None
         except (OSError, UnicodeDecodeError) as exc:
             raise ParameterError(f"cannot read {path}: {exc}", "design") from None
-    session = Session(text, path)
+    # Quick meshes first: the page opens without waiting for the refinement of the design.
+    session = Session(text, path, previews=True)
     host = args.host if args.host is not None else DEFAULT_HOST
     try:
         server = make_server(session, host, args.port)

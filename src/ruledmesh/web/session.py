@@ -512,9 +512,12 @@ class Session:
         its quick mesh (the same design with ``[mesh] refine = false``: one mesh
         instead of tens) and build the full mesh in the background, which replaces
         it when done (:meth:`settled`); the next edit stops that build.  Only while
-        the last full build took more than :data:`QUICK_AFTER_SECONDS`.  The server
-        turns this on: a slider dragged over a design that takes seconds to refine
-        shows a mesh for every step.
+        the last full build took more than :data:`QUICK_AFTER_SECONDS`; the starting
+        design opens with its quick mesh, built in full once the builder is set
+        (:meth:`set_builder`) or the session waits for it (:meth:`settled`).  The
+        server turns this on, and ``ruledmesh design`` opens with it: a slider
+        dragged over a design that takes seconds to refine shows a mesh for every
+        step, and the page opens without waiting for the refinement.
 
     Raises
     ------
@@ -542,10 +545,20 @@ class Session:
         data = _plain(design.data)
         check_limits(data, self.base_dir)
         self._lock = threading.RLock()
+        self.previews = bool(previews)
+        # Told whenever the current snapshot changes: settled() waits on it.
+        self._changed = threading.Condition(self._lock)
+        # The background build of a quick snapshot: (that snapshot, its thread).
+        self._refiner: tuple[_Snapshot, threading.Thread] | None = None
+        # How long the last full build of a design took (previews: see QUICK_AFTER_SECONDS);
+        # none yet: the starting design opens with its quick mesh.
+        self._full_seconds = math.inf
+        quick = self._quick(data)
         started = time.perf_counter()
-        self._current = _Snapshot(data, self._build(data), 0, dumps(data))
-        # How long the last full build of a design took (previews: see QUICK_AFTER_SECONDS).
-        self._full_seconds = time.perf_counter() - started
+        self._current = _Snapshot(data, self._build(quick or data), 0, dumps(data), None,
+                                  quick is not None)
+        if quick is None:
+            self._full_seconds = time.perf_counter() - started
         self._undo: list[dict] = []
         self._redo: list[dict] = []
         # What each step did, in the words of the page's history list (parallel to the stacks).
@@ -560,11 +573,6 @@ class Session:
         self._panels: tuple[int, dict[str, np.ndarray], Any] | None = None
         self._frame: tuple[int, dict[str, Any]] | None = None  # (version, frame_data)
         self._frame_lock = threading.Lock()
-        self.previews = bool(previews)
-        # Told whenever the current snapshot changes: settled() waits on it.
-        self._changed = threading.Condition(self._lock)
-        # The background build of a quick snapshot: (that snapshot, its thread).
-        self._refiner: tuple[_Snapshot, threading.Thread] | None = None
 
     def add_listener(self, listener: Callable[[int], None]) -> None:
         """Call ``listener(version)`` after every change of the current design."""
@@ -587,6 +595,8 @@ class Session:
             self._builder = builder
             if previews is not None:
                 self.previews = bool(previews)
+            # A starting design opened with its quick mesh is built in full by this builder.
+            self._keep_refining()
 
     def page_opened(self) -> None:
         """A page connected: edits are coming, so the builder gets ready for them now (the
