@@ -386,12 +386,19 @@ def test_a_full_build_over_the_time_limit_leaves_the_quick_mesh_and_says_why():
     worker = builder.BuildWorker(timeout=1.0)
     try:
         s = Session(SMALL, builder=worker, previews=True)
+        notes = []
+        s.add_progress_listener(lambda version, note: notes.append((version, note)))
         worker.start()
         s.load_text(text)
         assert s.describe()["refining"]
+        quick = s.version
         assert not s.settled(60)
         state = s.describe()
         assert not state["refining"] and "longer than 1 s" in state["refine_error"]
+        # Meanwhile the build said what it was at (every PROGRESS_SECONDS), of the quick version.
+        assert notes and all(v == quick and re.fullmatch(r"mesh \d+, \d+ generators", n)
+                             for v, n in notes), notes
+        assert state["refine_note"] is None
         assert "refine = false" in state["refine_error"]
         assert same_mesh(s.built.mesh, _built(text.replace("[mesh]\n", "[mesh]\nrefine = false\n")))
         with pytest.raises(RuledMeshError, match="full mesh is not at hand: the build took longer"):

@@ -1348,6 +1348,9 @@ def test_a_design_that_refines_shows_its_quick_mesh_then_the_full_one(page, desi
     assert "refining the generators" in page.inner_text("#refining")
     shot(page, "refining-quick-mesh")
     page.wait_for_function("document.getElementById('refining').hidden", timeout=60_000)
+    # The live socket told what the full build was at, as it went on.
+    assert page.evaluate("window.designer.refineNotes") >= 1
+    assert re.fullmatch(r"mesh \d+, \d+ generators", page.evaluate("window.designer.refineNote"))
     assert page.evaluate("window.designer.version") >= before + 2
     assert page.inner_text("[data-fig=faces]") == str(full.n_faces)
     assert page.evaluate(DRAWN_JS)["faces"] == full.n_faces

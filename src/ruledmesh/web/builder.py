@@ -30,6 +30,7 @@ import multiprocessing as mp
 import threading
 import time
 from collections import OrderedDict
+from collections.abc import Callable
 from pathlib import Path
 from typing import Any
 
@@ -46,6 +47,8 @@ MAX_BUILD_SECONDS = 20.0
 CANCEL_SECONDS = 2.0
 # The message asking the worker to drop the build it runs.
 CANCEL = "cancel"
+# A long build tells the server what it is at (the refinement's mesh) at most this often.
+PROGRESS_SECONDS = 0.25
 # Seconds a fresh worker process may take to import its modules (and later to compile
 # the kernels: not counted against the edit waiting meanwhile).
 STARTUP_SECONDS = 120.0
@@ -86,16 +89,26 @@ class _Cancelled(Exception):
 
 
 class _Listening(Progress):
-    """Build progress that reads the server's messages between the stages of a build.
+    """Build progress that reads the server's messages between the stages of a build, and
+    tells the server what the build is at.
 
     Every mesh the refinement makes is a stage (:func:`ruledmesh.design.pq._mesh`), so
     a :data:`CANCEL` stops a long build within one mesh.  A :data:`WARM_UP` that comes
-    meanwhile is remembered for when the build is over.
+    meanwhile is remembered for when the build is over.  The stage's note ("mesh 7, 60
+    generators") goes to the server as ``("progress", note)``, at most every
+    :data:`PROGRESS_SECONDS`.
     """
 
     def __init__(self, conn: Any):
         self.conn = conn
         self.warm_up = False
+        self.said = time.monotonic()
+
+    def tell(self, note: str | None) -> None:
+        now = time.monotonic()
+        if note and now - self.said >= PROGRESS_SECONDS:
+            self.said = now
+            self.conn.send(("progress", note))
 
     def task(self, label: str, total: int | None = None) -> Task:
         return _ListeningTask(self)
@@ -115,6 +128,7 @@ class _ListeningTask(Task):
 
     def advance(self, n: int = 1, note: str | None = None) -> None:
         self.owner.check()
+        self.owner.tell(note)
 
 
 def _worker_main(conn) -> None:  # pragma: no cover - runs in the child process
@@ -290,9 +304,11 @@ class InProcessBuilder:
         """
         return self._here(data, source, base_dir)
 
-    def refine_frame(self, data: dict, source: str, base_dir: str | Path) -> tuple[Any, dict | None] | None:
+    def refine_frame(self, data: dict, source: str, base_dir: str | Path,
+                     progress: Callable[[str], None] | None = None) -> tuple[Any, dict | None] | None:
         """Build design ``data`` here and now, as :meth:`build_frame` (nothing else waits
-        for this builder, so it never gives the build up: never None)."""
+        for this builder, so it never gives the build up: never None; ``progress`` is not
+        told anything)."""
         return self._here(data, source, base_dir)
 
     def _here(self, data: dict, source: str, base_dir: str | Path) -> tuple[Any, dict | None]:
@@ -427,13 +443,15 @@ class BuildWorker(InProcessBuilder):
             raise Superseded("superseded by a newer edit")
         return self.remember(key, built)
 
-    def refine_frame(self, data: dict, source: str, base_dir: str | Path) -> tuple[Any, dict | None] | None:
+    def refine_frame(self, data: dict, source: str, base_dir: str | Path,
+                     progress: Callable[[str], None] | None = None) -> tuple[Any, dict | None] | None:
         """Build design ``data`` in the worker when no edit waits for it: ``(built,
         frame_data)``, or None where an edit asked for the worker before it was done
         (the build was stopped, the worker kept).
 
         The session's background work (the full build of a design whose quick
-        preview is shown): any :meth:`build_frame` goes first.
+        preview is shown): any :meth:`build_frame` goes first.  ``progress(note)``
+        is told what the build is at (``"mesh 7, 60 generators"``).
         """
         key, hit = self.cached(data, source, base_dir)
         if hit is not None:
@@ -441,18 +459,18 @@ class BuildWorker(InProcessBuilder):
         with self._run_lock:
             if self._closed or self._foreground:
                 return None
-            built = self._run((data, source, str(base_dir)), lambda: self._foreground > 0)
+            built = self._run((data, source, str(base_dir)), lambda: self._foreground > 0, progress)
         return None if built is None else self.remember(key, built)
 
-    def _run(self, job: tuple, unwanted: Any) -> Any:
+    def _run(self, job: tuple, unwanted: Any, progress: Callable[[str], None] | None = None) -> Any:
         """``job``'s ``(built, frame)`` from the worker (started if need be), or None where
         ``unwanted()`` turned true and the build stopped; under the run lock."""
         if self._proc is None or not self._proc.is_alive():
             self._stop()
             self._start()
-        return self._wait(job, unwanted)
+        return self._wait(job, unwanted, progress)
 
-    def _wait(self, job: tuple, unwanted: Any) -> Any:
+    def _wait(self, job: tuple, unwanted: Any, progress: Callable[[str], None] | None = None) -> Any:
         started = time.monotonic()
         # When the worker said it is compiling the kernels (0: it is not).  It says "busy" and
         # "idle" before it reads the next job, so both arrive while one edit waits.
@@ -471,6 +489,11 @@ class BuildWorker(InProcessBuilder):
                         started += time.monotonic() - max(paused, started)
                         paused = 0.0
                         self.kernels = bool(value)
+                        continue
+                    if kind == "progress":
+                        if progress is not None and not cancelled:
+                            with contextlib.suppress(Exception):  # a listener's bug: not the build's
+                                progress(str(value))
                         continue
                     break
                 now = time.monotonic()

@@ -521,26 +521,38 @@ class _Live:
 
     def notify(self, version: int) -> None:
         """Called in any thread after the session changed."""
+        self._put(version)
+
+    def progress(self, version: int, note: str) -> None:
+        """Called in any thread as the full build of version ``version``'s quick mesh goes on."""
+        self._put(("progress", version, note))
+
+    def _put(self, item: int | tuple[str, int, str]) -> None:
         with self.lock:
             loop, queues = self.loop, list(self.queues)
         if loop is None:
             return
         for q in queues:
             try:
-                loop.call_soon_threadsafe(q.put_nowait, version)
+                loop.call_soon_threadsafe(q.put_nowait, item)
             except RuntimeError:  # the loop closed: the server is stopping
                 return
 
     async def _pump(self, websocket: WebSocket, queue: asyncio.Queue) -> None:
         sent: str | None = None  # the faces this socket's page has
         while True:
-            await queue.get()
-            while not queue.empty():  # only the newest matters
-                queue.get_nowait()
-            # The frame is of the design current when it is encoded: never an older one.
-            data, sent = await anyio.to_thread.run_sync(self.session.frame, sent)
+            items = [await queue.get()]
+            while not queue.empty():  # only the newest state and note matter
+                items.append(queue.get_nowait())
             try:
-                await websocket.send_bytes(data)
+                if any(isinstance(item, int) for item in items):
+                    # The frame is of the design current when it is encoded: never an older one.
+                    data, sent = await anyio.to_thread.run_sync(self.session.frame, sent)
+                    await websocket.send_bytes(data)
+                if isinstance(items[-1], tuple):
+                    # A text frame: what the full build of the quick mesh shown is at.
+                    _, version, note = items[-1]
+                    await websocket.send_text(json.dumps({"version": version, "refining": note}))
             except (WebSocketDisconnect, RuntimeError, OSError):
                 return  # the page went away; the receiving side notices and ends
 
@@ -659,6 +671,7 @@ class DesignerServer:
         api = _Api(self)
         self.live = _Live(session)
         session.add_listener(self.live.notify)
+        session.add_progress_listener(self.live.progress)
         routes = [WebSocketRoute("/api/live", self.live.endpoint),
                   Route("/api/{name:str}", api.dispatch, methods=["GET", "HEAD", "POST"]),
                   Mount("/", StaticFiles(directory=_static_root(), html=True))]

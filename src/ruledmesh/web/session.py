@@ -550,6 +550,9 @@ class Session:
         self._changed = threading.Condition(self._lock)
         # The background build of a quick snapshot: (that snapshot, its thread).
         self._refiner: tuple[_Snapshot, threading.Thread] | None = None
+        # What that build is at ("mesh 7, 60 generators"), and who is told.
+        self._note: tuple[_Snapshot, str] | None = None
+        self._progress_listeners: list[Callable[[int, str], None]] = []
         # How long the last full build of a design took (previews: see QUICK_AFTER_SECONDS);
         # none yet: the starting design opens with its quick mesh.
         self._full_seconds = math.inf
@@ -577,6 +580,20 @@ class Session:
     def add_listener(self, listener: Callable[[int], None]) -> None:
         """Call ``listener(version)`` after every change of the current design."""
         self._listeners.append(listener)
+
+    def add_progress_listener(self, listener: Callable[[int, str], None]) -> None:
+        """Call ``listener(version, note)`` as the full build of the quick mesh of version
+        ``version`` goes on (``note``: what it is at, e.g. ``"mesh 7, 60 generators"``)."""
+        self._progress_listeners.append(listener)
+
+    def _told(self, snap: _Snapshot, note: str) -> None:
+        with self._lock:
+            if self._current is not snap:
+                return
+            self._note = (snap, note)
+        for listener in list(self._progress_listeners):
+            with contextlib.suppress(Exception):  # a closed page must not stop the build
+                listener(snap.version, note)
 
     def history(self) -> dict[str, Any]:
         """The session's steps: ``{"undo": [...], "current": label, "redo": [...]}``.
@@ -710,7 +727,8 @@ class Session:
         error = None
         builds = self._builder.builds
         try:
-            done = self._builder.refine_frame(snap.design, self.source, self.base_dir)
+            done = self._builder.refine_frame(snap.design, self.source, self.base_dir,
+                                              lambda note: self._told(snap, note))
             if done is not None and self._builder.builds > builds:
                 self._full_seconds = self._builder.last_seconds
         except Superseded:
@@ -1000,6 +1018,8 @@ class Session:
             # where that build failed (refine_error: why).
             "refining": self._current.refining and self._current.refine_error is None,
             "refine_error": self._current.refine_error,
+            "refine_note": self._note[1] if self._note is not None and self._note[0] is self._current
+            and self._current.refining else None,
             "design": self._current.design,
             "toml": self.toml(),
             "path": str(self.path) if self.path else None,

@@ -1601,7 +1601,18 @@ function connectLive(delay = 500) {
   live.binaryType = 'arraybuffer';
   live.addEventListener('open', () => { window.designer.live = true; delay = 500; });
   live.addEventListener('message', (event) => {
-    if (typeof event.data === 'string') return;
+    if (typeof event.data === 'string') {
+      // What the full build of the quick mesh shown is at ("mesh 7, 60 generators").
+      const note = JSON.parse(event.data);
+      if (note.refining && current && note.version === current.header.version
+          && current.header.refining) {
+        current.header.refine_note = note.refining;
+        showRefining(current.header);
+        window.designer.refineNotes += 1;
+        window.designer.refineNote = note.refining;
+      }
+      return;
+    }
     const received = performance.now();
     const msg = decode(event.data);
     msg.raw = event.data;
@@ -1702,7 +1713,8 @@ function showRefining(h) {
   box.hidden = !h.refining && !h.refine_error;
   box.classList.toggle('failed', !!h.refine_error);
   box.textContent = h.refine_error ? `quick mesh shown, the full build failed: ${h.refine_error}`
-    : h.refining ? 'quick mesh shown (refine = false); refining the generators\u2026' : '';
+    : h.refining ? `quick mesh shown (refine = false); refining the generators\u2026${
+      h.refine_note ? ` (${h.refine_note})` : ''}` : '';
 }
 
 function updateDownload() {
@@ -2040,7 +2052,7 @@ window.addEventListener('keydown', (event) => {
 // ------------------------------------------------------------------ test and debugging hooks
 window.designer = {
   version: null, renders: 0, frames: 0, figuresVersion: null, lastExport: null, timings,
-  breakdown, frameTimes, frameLog, liveFrames: 0, kept: {}, sameTopology: 0, legend: null, panelFigures: null, hover: null, readoutSide: null, panel: null, panelsDropped: 0, reused: false, view: null,
+  breakdown, frameTimes, frameLog, liveFrames: 0, refineNotes: 0, kept: {}, sameTopology: 0, legend: null, panelFigures: null, hover: null, readoutSide: null, panel: null, panelsDropped: 0, reused: false, view: null,
   busy: () => inFlight || jobs.length > 0,
   softwareGL: SOFTWARE_GL,
   // The page's own part of an update, without the server: decode the last state message
