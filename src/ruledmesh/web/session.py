@@ -763,8 +763,8 @@ class Session:
             return ok and not self._current.refining
 
     def _full(self) -> _Snapshot:
-        """The current snapshot once it is a full build (exports, panels of a design that
-        refines); a :class:`RuledMeshError` where that build failed."""
+        """The current snapshot once it is a full build (what exports write); a
+        :class:`RuledMeshError` where that build failed or did not finish in time."""
         if not self.settled(self._builder_timeout()):
             with self._lock:
                 error = self._current.refine_error or "the full build did not finish in time"
