@@ -42,7 +42,7 @@ from typing import Any
 
 import numpy as np
 
-from ._arrays import unique
+from ._arrays import diagonal, unique
 from ._validation import (
     check_float,
     check_int,
@@ -689,7 +689,7 @@ class Curve:
     def _size(self) -> float:
         """Characteristic size (diagonal of a sampled bounding box) for tolerances."""
         pts = self._eval(np.linspace(0.0, 1.0, 129))
-        diag = float(np.linalg.norm(pts.max(axis=0) - pts.min(axis=0)))
+        diag = diagonal(pts)
         return diag if diag > 0 else 1.0
 
     def bounding_box(self) -> np.ndarray:
@@ -960,7 +960,7 @@ def _plane_text(n: np.ndarray, offset: float) -> str:
 
 def _check_distinct(points: np.ndarray, name: str) -> None:
     seg = np.linalg.norm(np.diff(points, axis=0), axis=1)
-    size = float(np.linalg.norm(points.max(axis=0) - points.min(axis=0)))
+    size = diagonal(points)
     bad = np.nonzero(seg <= DEFAULT.degenerate * max(size, TINY))[0]
     if len(bad):
         i = int(bad[0])

@@ -18,7 +18,7 @@ from typing import Any
 
 import numpy as np
 
-from ._arrays import diagonal, unique
+from ._arrays import diagonal, extent, unique
 from ._validation import check_points
 from .errors import ParameterError
 from .tolerances import ROUNDING, TINY
@@ -301,7 +301,7 @@ class Mesh:
         """(2, 3) float64: min and max corner."""
         if self.n_vertices == 0:
             return np.zeros((2, 3))
-        return np.stack([self.vertices.min(axis=0), self.vertices.max(axis=0)])
+        return np.stack(extent(self.vertices))
 
     def diagonal(self) -> float:
         """Length of the bounding-box diagonal (the scale of relative measures)."""

@@ -26,6 +26,7 @@ from typing import Any, TypeVar
 
 import numpy as np
 
+from ._arrays import extent as _extent
 from .errors import GeometryError
 from .tolerances import MIN_EXTENT, MIN_RELATIVE_EXTENT
 
@@ -66,7 +67,7 @@ def check_range(points: np.ndarray, what: str = "the generators") -> tuple[float
         raise GeometryError(f"{what} reach {largest:.3g}; coordinates must lie within "
                             f"+-{MAX_COORDINATE:g} (scale the design, or move it nearer "
                             "the origin)")
-    lo, hi = points.min(axis=0), points.max(axis=0)
+    lo, hi = _extent(points)
     extent = float(np.linalg.norm(hi - lo))
     if 0.0 < extent < MIN_EXTENT:
         raise GeometryError(f"{what} span {extent:.3g}; the design must be at least "
@@ -91,7 +92,7 @@ def unit_frame(points: np.ndarray) -> tuple[np.ndarray, float]:
     scale : float
         ``2**k``; ``(points - centre) / scale`` fits a box with longest side in [1, 2).
     """
-    lo, hi = points.min(axis=0), points.max(axis=0)
+    lo, hi = _extent(points)
     centre = 0.5 * lo + 0.5 * hi
     half = float(np.max(0.5 * hi - 0.5 * lo))
     if half == 0.0 or not math.isfinite(half):

@@ -42,7 +42,7 @@ from typing import Any
 
 import numpy as np
 
-from ._arrays import unique
+from ._arrays import diagonal, unique
 from ._validation import (
     check_choice,
     check_int,
@@ -373,7 +373,7 @@ class Rulings:
 
 def _check_generators(a: np.ndarray, b: np.ndarray, what: str, tol: Tolerances) -> None:
     pts = np.concatenate([a, b])
-    size = max(float(np.linalg.norm(pts.max(axis=0) - pts.min(axis=0))), TINY)
+    size = max(diagonal(pts), TINY)
     short = np.nonzero(np.linalg.norm(b - a, axis=1) <= tol.degenerate * size)[0]
     if len(short):
         i = int(short[0])
@@ -908,7 +908,7 @@ def from_lines(lines: Any, *, tol: Tolerances = DEFAULT) -> Rulings:
     step = 0.5 * (np.linalg.norm(np.diff(a, axis=0), axis=1)
                   + np.linalg.norm(np.diff(b, axis=0), axis=1))
     pts = np.concatenate([a, b])
-    size = float(np.linalg.norm(pts.max(axis=0) - pts.min(axis=0)))
+    size = diagonal(pts)
     dup = np.nonzero(step <= tol.degenerate * size)[0]
     if len(dup):
         i = int(dup[0])

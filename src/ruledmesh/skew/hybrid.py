@@ -43,7 +43,7 @@ from typing import Any
 
 import numpy as np
 
-from .._arrays import member, unique
+from .._arrays import diagonal, member, unique
 from .._validation import check_bool, check_int, check_points
 from ..budget import HYBRID_BYTES_PER_NODE, MAX_BUILD_BYTES, MAX_DIVISIONS, MAX_GRID_NODES, gib
 from ..errors import GeometryError, ParameterError
@@ -562,7 +562,7 @@ def hybrid_mesh(a: Any, b: Any, *, midpoints: int = 1, divisions: int = 8, flip:
     flip = check_bool(flip, "flip")
     orient = check_bool(orient, "orient")
     pts = np.concatenate([a, b])
-    scale = max(float(np.linalg.norm(pts.max(axis=0) - pts.min(axis=0))), TINY)
+    scale = max(diagonal(pts), TINY)
     short = np.nonzero(np.linalg.norm(b - a, axis=1) <= tol.degenerate * scale)[0]
     if short.size:
         raise GeometryError(f"generator {int(short[0])} has zero length: a line needs two "
