@@ -675,16 +675,22 @@ def start_cli(*args: str):
     return proc, match.group(0)
 
 
-def test_cli_serves_on_loopback_and_stops_on_sigterm(tmp_path):
+def cli_state(url: str):
+    """A function reading the state header from the designer at the printed ``url`` (its
+    token checked for shape: loopback, 40 or more URL-safe characters)."""
     from urllib.request import Request, urlopen
 
+    base, token = re.fullmatch(r"(http://127\.0\.0\.1:\d+/)\?token=([\w-]{40,})", url).groups()
+    req = Request(base + "api/state", headers={"Authorization": f"Bearer {token}"})
+    return lambda: decode(urlopen(req, timeout=30).read())[0]
+
+
+def test_cli_serves_on_loopback_and_stops_on_sigterm(tmp_path):
     design = tmp_path / "small.toml"
     design.write_text(QUICK)
     proc, url = start_cli(str(design))
     try:
-        base, token = re.fullmatch(r"(http://127\.0\.0\.1:\d+/)\?token=([\w-]{40,})", url).groups()
-        req = Request(base + "api/state", headers={"Authorization": f"Bearer {token}"})
-        header, _ = decode(urlopen(req, timeout=30).read())
+        header = cli_state(url)()
         assert header["path"] == str(design) and header["design"]["rulings"]["count"] == 9
     finally:
         proc.terminate()
@@ -695,22 +701,19 @@ def test_cli_serves_on_loopback_and_stops_on_sigterm(tmp_path):
 def test_cli_opens_a_design_that_refines_with_its_quick_mesh(tmp_path):
     """ruledmesh design does not wait for the refinement before it serves: the page opens on
     the quick mesh (refine = false) and the full mesh follows from the worker."""
-    from urllib.request import Request, urlopen
-
     design = tmp_path / "small.toml"
     design.write_text(SMALL)
     proc, url = start_cli(str(design))
     try:
-        base, token = re.fullmatch(r"(http://127\.0\.0\.1:\d+/)\?token=([\w-]{40,})", url).groups()
-        req = Request(base + "api/state", headers={"Authorization": f"Bearer {token}"})
-        header, _ = decode(urlopen(req, timeout=30).read())
+        state = cli_state(url)
+        header = state()
         full = _built(SMALL)
         if header["refining"]:            # else the worker was done already
             assert header["figures"]["faces"] == _built(QUICK).n_faces != full.n_faces
         deadline = time.monotonic() + 120
         while header["refining"] and time.monotonic() < deadline:
             time.sleep(0.2)
-            header, _ = decode(urlopen(req, timeout=30).read())
+            header = state()
         assert not header["refining"] and header["refine_error"] is None
         assert header["figures"]["faces"] == full.n_faces
     finally:
