@@ -1097,7 +1097,7 @@ function setFig(name, text, pending = false) {
   cell.classList.toggle('pending', pending);
 }
 
-function showFigures(fig) {
+function showFigures(fig, quick = false) {
   setFig('faces', fig.faces);
   setFig('kinds', fig.kinds_text || '-');
   setFig('planarity', fmt(fig.planarity_max));
@@ -1109,6 +1109,10 @@ function showFigures(fig) {
     $('report').textContent = 'not computed for this version';
   }
   $('warnings').innerHTML = '';
+  // A quick mesh's warnings (its share of triangles, its strips without rows) are not the
+  // design's: the full mesh that replaces it has its own. Said above them, not hidden.
+  $('warnings').classList.toggle('quick', quick && fig.warnings.length > 0);
+  $('warnings').dataset.caption = quick ? 'warnings of the quick mesh (the full mesh has its own):' : '';
   for (const w of fig.warnings) {
     const li = document.createElement('li');
     li.textContent = w;
@@ -1692,7 +1696,7 @@ function applyState(msg) {
   }
   if (!tomlDirty) $('toml').value = h.toml;
   showRefining(h);
-  showFigures(h.figures);
+  showFigures(h.figures, !!h.refining || !!h.refine_error);
   if (h.history) showHistory(h.history);
   buildKindChooser();
   buildControls();
