@@ -517,19 +517,20 @@ def test_rows_from_per_generator_give_each_segment_its_own():
 
 
 @settings(max_examples=30, deadline=None, suppress_health_check=[HealthCheck.too_slow])
-@given(seed=st.integers(0, 2**32 - 1), rows_from=st.sampled_from(["c1", "c2", "mixed"]), m=st.integers(12, 61),
+@given(seed=st.integers(0, 2**32 - 1), rows_from=st.sampled_from(["c1", "c2", "none", "mixed"]),
+       m=st.integers(12, 61),
        rows=st.integers(4, 40), option=st.integers(0, 1))
 def test_rows_through_the_end_points_keep_the_invariants(seed, rows_from, m, rows, option):
     """Random skew surfaces between two smooth curves: every face planar, convex and with
     area, every vertex on its generator inside the patch, with the rows through either
-    curve's end points (or, per generator, from either or the primary)."""
+    curve's end points, without rows (or, per generator, from either, the primary or none)."""
     rng = np.random.default_rng(seed)
     s = np.linspace(0.0, 1.0, m)[:, None]
     k1, k2 = rng.normal(size=(2, 3)), rng.normal(size=(2, 3))
     c1 = np.c_[10 * s, np.zeros_like(s), np.zeros_like(s)] + np.sin(3 * s) * k1[0] + s ** 2 * k1[1]
     c2 = np.c_[10 * s, 2 + 0 * s, 4 + 0 * s] + np.cos(2 * s) * k2[0] + s ** 3 * k2[1]
     if rows_from == "mixed":     # per generator, at random, and the checkerboard too
-        rows_from = rng.choice(["primary", "c1", "c2"], size=m).tolist()
+        rows_from = rng.choice(["primary", "c1", "c2", "none"], size=m).tolist()
         option = rng.integers(0, 2, size=m).tolist()
     mesh = pq_mesh(c1, c2, rows=rows, rows_from=rows_from, option=option)
     check_mesh(mesh)

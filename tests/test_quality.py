@@ -60,8 +60,6 @@ SHORT_OF_SHARE = {
     "plucker-lines-tol1e-3": "17.4% of the area in triangles",
     "moebius-lines-tol1e-3": "15.0% of the area in triangles (teeth along the edge the rows do not start on)",
     "skew-bspline-301x300": "17.3% of the area in triangles",
-    "twisted-arcs-160deg-tol1e-3": "11.9% of the area in triangles (no splinter; the mesh with "
-                                   "8.6% had three faces of 0.79-1.46 deg)",
 }
 
 

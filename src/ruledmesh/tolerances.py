@@ -23,15 +23,16 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
-__all__ = ["BORDER_TRIM_MAX_GAP", "BRENTQ_XTOL", "CLOSENESS_SEARCH", "COLLINEAR", "COLLINEAR_SQ",
-           "CONGRUENCE_ANGLE_DEG", "CONVERGED",
-           "COLLAPSE_MAX_SAG", "DEFAULT", "DEPTH_BIAS", "FLAT_PAIR_MAX_SAG", "FLIP_ACTIVE_DEG", "FLIP_MAX_BEND_DEG",
-           "FLIP_MAX_SAG", "FLIP_MIN_GAIN_DEG", "FLOAT32_WARNING", "INTERIOR", "KKT_REGULARISATION",
-           "MIN_EXTENT", "MIN_HALF_ANGLE", "MIN_RELATIVE_EXTENT", "MITRE_FLOOR", "NEARLY_DEVELOPABLE", "OCCT_FACE",
-           "ON_BORDER", "PARAMETER_SLACK", "PLANARITY_FLOOR", "RESTART_ANGLE_DEG", "ROOT_RTOL", "ROOT_XTOL",
-           "ROUNDING", "ROUNDING_SQ", "SAME_ROOT", "SETTLED", "SNAP_GAP", "SNAP_MIN_GAIN_DEG",
-           "SPLINTER_AREA_WORTH", "SPLINTER_FLIP_MAX_SAG", "TINY",
-           "ULPS", "Tolerances"]
+__all__ = ["BORDER_TRIM_MAX_GAP", "BRENTQ_XTOL", "CLOSENESS_SEARCH", "COLLAPSE_MAX_SAG",
+           "COLLINEAR", "COLLINEAR_SQ", "CONGRUENCE_ANGLE_DEG", "CONVERGED", "DEFAULT",
+           "DEPTH_BIAS", "EVEN_MAX_HALVINGS", "EVEN_PINCH_SHARE", "EVEN_PINCH_STEP_PER_WIDTH",
+           "EVEN_STEP_PER_WIDTH", "FLAT_PAIR_MAX_SAG", "FLIP_ACTIVE_DEG", "FLIP_MAX_BEND_DEG",
+           "FLIP_MAX_SAG", "FLIP_MIN_GAIN_DEG", "FLOAT32_WARNING", "INTERIOR", "KKT_REGULARISATION", "MIN_EXTENT",
+           "MIN_HALF_ANGLE", "MIN_RELATIVE_EXTENT", "MITRE_FLOOR", "NEARLY_DEVELOPABLE",
+           "OCCT_FACE", "ON_BORDER", "PARAMETER_SLACK", "PLANARITY_FLOOR", "RESTART_ANGLE_DEG",
+           "ROOT_RTOL", "ROOT_XTOL", "ROUNDING", "ROUNDING_SQ", "SAME_ROOT", "SETTLED", "SNAP_GAP",
+           "SNAP_MIN_GAIN_DEG", "SPLINTER_AREA_WORTH", "SPLINTER_FLIP_MAX_SAG", "TINY", "ULPS",
+           "Tolerances"]
 
 
 @dataclass(frozen=True)
@@ -213,6 +214,23 @@ FLAT_PAIR_MAX_SAG = 1e-3
 #: A strip whose strip quads are planar within this (the planarity tolerance the mesher's
 #: warnings suggest) counts as nearly developable in a build's warnings.
 NEARLY_DEVELOPABLE = 1e-3
+
+#: A step of an even division (generators without §4.3 rows) this many times longer than
+#: the distance to a neighbouring generator there would leave a zipper triangle of about
+#: atan(1 / 19) = 3 degrees (the splinter bar): the strip pinches there (a hyperboloid's
+#: waist near its asymptotic cone), and the division is graded.
+EVEN_PINCH_STEP_PER_WIDTH = 19.0
+#: ... where the strip is narrower there than this share of its width at the wider of its
+#: ends: it pinches.  Strips narrow from end to end (generators the refinement added close
+#: together) are not graded: the collapses join their triangles across several strips.
+EVEN_PINCH_SHARE = 0.25
+#: Where an even division is graded, its steps are halved until at most this many times the
+#: distance to a neighbouring generator: the zipper triangles keep about atan(1 / 9.5) = 6
+#: degrees, twice the splinter bar.
+EVEN_STEP_PER_WIDTH = 9.5
+#: How many times an even division's step is halved at most where the strips pinch (a
+#: generator meeting its neighbour has no width to step by).
+EVEN_MAX_HALVINGS = 10
 
 # A §4.3 face whose smallest angle is below this (degrees) counts as failing: runs
 # end before such faces (ruledmesh.skew.pq.runs).  The splinter bar of the analysis

@@ -23,7 +23,17 @@ import numpy as np
 from ...budget import MAX_GRID_POINTS, PQ_BYTES_PER_GRID_POINT
 from ...errors import GeometryError
 from ...kernels import wanted
-from ...tolerances import INTERIOR, RESTART_ANGLE_DEG, ROUNDING, TINY, Tolerances
+from ...tolerances import (
+    EVEN_MAX_HALVINGS,
+    EVEN_PINCH_SHARE,
+    EVEN_PINCH_STEP_PER_WIDTH,
+    EVEN_STEP_PER_WIDTH,
+    INTERIOR,
+    RESTART_ANGLE_DEG,
+    ROUNDING,
+    TINY,
+    Tolerances,
+)
 from .extension import LANDING_SLACK, thinned_rows
 from .maps import (
     ChainMaps,
@@ -38,7 +48,7 @@ from .maps import (
     propagate,
 )
 
-__all__ = ["MAX_GRID_POINTS", "Division", "Run", "carrier", "matched", "mesh_run"]
+__all__ = ["MAX_GRID_POINTS", "Division", "Run", "carrier", "graded_carrier", "matched", "mesh_run"]
 
 # The grid-point limit and the memory per point: ruledmesh.budget.
 BYTES_PER_GRID_POINT = PQ_BYTES_PER_GRID_POINT
@@ -471,7 +481,105 @@ def carrier(a: np.ndarray, d: np.ndarray, first: int, t: np.ndarray) -> Run:
     m = len(a)
     tt = np.tile(np.asarray(t, dtype=np.float64), m)
     gen = np.repeat(np.arange(first, first + m), len(t))
+    return _carried(a, d, first, tt, gen)
+
+
+def _carried(a: np.ndarray, d: np.ndarray, first: int, tt: np.ndarray, gen: np.ndarray) -> Run:
+    """The :class:`Run` of vertices at parameters ``tt`` on global generators ``gen`` (no faces)."""
+    m = len(a)
     X = a[gen - first] + tt[:, None] * d[gen - first]
     none = np.zeros((0, 3), np.int64)
     return Run(X, tt, gen, np.zeros(len(tt), bool), none, none, np.zeros(0, bool),
                np.zeros(0, np.int64), np.zeros(m, np.int64), np.zeros(m, np.int64))
+
+
+def graded_carrier(a: np.ndarray, d: np.ndarray, lo: int, hi: int, t: np.ndarray) -> Run:
+    """Vertices of an even division ``t`` on generators ``lo..hi``, graded where the strips pinch.
+
+    A strip without rows is closed by zipper triangles between the divisions of its two
+    generators; where the strip is much narrower than a step of the division (a
+    hyperboloid's waist near its asymptotic cone, where every generator passes close to
+    its neighbours), those triangles are splinters.  So each step of a generator's
+    division longer than :data:`~ruledmesh.tolerances.EVEN_PINCH_STEP_PER_WIDTH` times the
+    least distance to a neighbouring generator line over that step (a splinter's worth) is
+    halved, and its halves again while longer than
+    :data:`~ruledmesh.tolerances.EVEN_STEP_PER_WIDTH` times theirs, at most
+    :data:`~ruledmesh.tolerances.EVEN_MAX_HALVINGS` times: the steps shrink geometrically
+    towards the pinch.  Where no strip pinches, the division is ``t`` on every generator.
+
+    Parameters
+    ----------
+    a, d : (m, 3) float64
+        All the generators (the neighbours of ``lo`` and ``hi`` bound strips too).
+    lo, hi : int
+        The generators carrying the division.
+    t : (k,) float64
+        Increasing parameters of the even division.
+
+    Returns
+    -------
+    Run
+        Its vertices only (global generator indices ``lo..hi``).
+    """
+    m = len(a)
+    t = np.asarray(t, dtype=np.float64)
+    gens = np.arange(lo, hi + 1)
+    t0 = np.tile(t[:-1], len(gens))
+    t1 = np.tile(t[1:], len(gens))
+    g = np.repeat(gens, len(t) - 1)
+    extra_t, extra_g = [], []
+    # Only the steps that would leave a splinter where the strip pinches are graded.  Strips
+    # narrow from end to end (generators added close together) stay: the collapses join
+    # their triangles across several strips.
+    pinched = _too_long(a, d, g, t0, t1, m, EVEN_PINCH_STEP_PER_WIDTH) \
+        & (_least_width(a, d, g, t0, t1, m) < EVEN_PINCH_SHARE * _least_width(
+            a, d, g, np.zeros(len(g)), np.zeros(len(g)), m, widest=True))
+    g, t0, t1 = g[pinched], t0[pinched], t1[pinched]
+    for _ in range(EVEN_MAX_HALVINGS):
+        split = _too_long(a, d, g, t0, t1, m, EVEN_STEP_PER_WIDTH)
+        if not split.any():
+            break
+        g, t0, t1 = g[split], t0[split], t1[split]
+        mid = 0.5 * (t0 + t1)
+        extra_t.append(mid)
+        extra_g.append(g)
+        g, t0, t1 = np.r_[g, g], np.r_[t0, mid], np.r_[mid, t1]
+    tt = np.tile(t, len(gens))
+    gen = np.repeat(gens, len(t))
+    if extra_t:
+        tt, gen = np.concatenate([tt, *extra_t]), np.concatenate([gen, *extra_g])
+        order = np.lexsort((tt, gen))
+        tt, gen = tt[order], gen[order]
+    return _carried(a[lo:hi + 1], d[lo:hi + 1], lo, tt, gen)
+
+
+def _too_long(a: np.ndarray, d: np.ndarray, g: np.ndarray, t0: np.ndarray, t1: np.ndarray,
+              m: int, per_width: float) -> np.ndarray:
+    """(n,) bool: the steps ``[t0, t1]`` on generators ``g`` longer than ``per_width`` times
+    the least distance to a neighbouring generator line over the step."""
+    length = np.linalg.norm(d[g], axis=1) * (t1 - t0)
+    return length > per_width * _least_width(a, d, g, t0, t1, m)
+
+
+def _least_width(a: np.ndarray, d: np.ndarray, g: np.ndarray, t0: np.ndarray, t1: np.ndarray,
+                 m: int, widest: bool = False) -> np.ndarray:
+    """(n,) the least distance from the points of generator ``g`` with ``t0 <= t <= t1`` to a
+    neighbouring generator line; with ``widest``, the larger of those at ``t = 0`` and ``t = 1``
+    instead (the distance is convex in ``t``: the widest of the patch is at an end)."""
+    width = np.full(len(g), np.inf)
+    for step in (-1, 1):
+        j = g + step
+        has = (j >= 0) & (j < m)
+        gi, gj = g[has], j[has]
+        u = d[gj] / np.maximum(np.linalg.norm(d[gj], axis=1, keepdims=True), TINY)
+        # The distance from a_i + t d_i to the line j is |c0 + t c1|: least at t* (clamped).
+        c0 = np.cross(a[gi] - a[gj], u)
+        c1 = np.cross(d[gi], u)
+        cc = np.einsum("ij,ij->i", c1, c1)
+        if widest:
+            w = np.maximum(np.linalg.norm(c0, axis=1), np.linalg.norm(c0 + c1, axis=1))
+        else:
+            ts = np.where(cc > 0, -np.einsum("ij,ij->i", c0, c1) / np.where(cc > 0, cc, 1.0), t0[has])
+            w = np.linalg.norm(c0 + np.clip(ts, t0[has], t1[has])[:, None] * c1, axis=1)
+        width[has] = np.minimum(width[has], w)
+    return width
