@@ -150,6 +150,24 @@ def test_vertices_on_the_quadric(surface, measured):
     assert row["max_quadric_distance"] <= ON_GENERATOR + _rounding(row)
 
 
+def test_the_quadric_of_explicit_lines_is_fitted_to_the_lines():
+    """The checker's quadric of a line set passes through the lines, not through its own
+    interpolated patch between them (which lies on no quadric: a hyperboloid of 48 lines
+    read 1.4e-8 of the diagonal off its quadric, its vertices being 3e-14 off)."""
+    import numpy as np
+
+    phi = np.linspace(0.0, np.pi, 20)
+    a = np.stack([np.cos(phi) - np.sin(phi), np.sin(phi) + np.cos(phi), -np.ones(20)], axis=1)
+    b = np.stack([np.cos(phi) + np.sin(phi), np.sin(phi) - np.cos(phi), np.ones(20)], axis=1)
+    t = np.linspace(0.0, 1.0, 11)[None, :, None]
+    grid = a[:, None] + t * (b - a)[:, None]
+    grid = grid + 1e-3 * np.sin(7 * t) * np.array([0.0, 0.0, 1.0])   # off the quadric
+    ref = quality.Reference(a, b, grid, phi, None, True)
+    on_lines = (0.3 * a + 0.7 * b)
+    assert quality.quadric_distance(on_lines, ref).max() <= 1e-12
+    assert quality.quadric_distance(on_lines + [0.0, 0.0, 1e-3], ref).min() > 1e-4
+
+
 @pytest.mark.parametrize("surface", ALL, ids=_ids(ALL))
 def test_coverage_of_the_patch(surface, measured):
     row = measured(surface)

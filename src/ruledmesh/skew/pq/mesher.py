@@ -344,9 +344,8 @@ def pq_mesh(a, b, rows: int = 20, primary: int | str = "middle", option: int = 0
     respace : bool
         Also restart the rows where they spread, evened there (:mod:`.respacing`).
     rows_from : {"primary", "c1", "c2", "none"} or (m,) sequence of them
-        Where the rows start (:class:`RowsFrom`; ``"none"``: no §4.3 rows, an even division
-        graded where the strips pinch); per generator, a segment with a division of its own
-        (between torsal generators) takes the value where its rows start.
+        Where the rows start (:class:`RowsFrom`; ``"none"``: no rows); per generator, a segment
+        with a division of its own (between torsal generators) takes the value where its rows start.
     tol : Tolerances
 
     Returns
