@@ -323,7 +323,7 @@ def _build(data):
 
 
 @min_built(0.25)
-@fuzz(1500)
+@fuzz(1000)
 @given(data=ruled_designs())
 def test_fuzz_ruled_designs(data):
     built = _build(data)
