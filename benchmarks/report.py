@@ -1,9 +1,15 @@
 """Render a benchmark JSON as the Markdown of docs/benchmarks.md.
 
-    python benchmarks/report.py RESULTS.json [--plot PATH-IN-DOCS] [--notes NOTES.md] > docs/benchmarks.md
+    python benchmarks/report.py RESULTS.json [--plot PATH-IN-DOCS] [--notes NOTES.md ...] > docs/benchmarks.md
 
 Every figure in the output comes from the JSON; ``--notes`` appends a
-hand-written reading of the run.
+hand-written reading of the run.  docs/benchmarks.md is made as::
+
+    python benchmarks/report.py docs/benchmarks.json --plot benchmarks.png \
+        --notes benchmarks/reading.md --notes benchmarks/measured.md > docs/benchmarks.md
+
+(``reading.md``: the reading of this run; ``measured.md``: the later measurements with
+scripts of their own, each stating its machine and load.)
 """
 
 from __future__ import annotations
@@ -50,7 +56,7 @@ def render(r: dict, plot: str | None = None) -> str:
              "displacement_max_quadrics": "max vertex distance from the quadric / diagonal, ruledmesh",
              "latency_100x100_ms": "100 x 100 build + trim + analysis (ms)",
              "ratio_1000x1000_to_bilinear": "1000 x 1000 build / numpy bilinear grid",
-             "scaling_exponent": "time ~ faces^k, 1e3..1e7 faces"}
+             "scaling_exponent": "time ~ faces^k, 1e3..3e6 faces"}
     for k, g in r["goals"].items():
         target = (f"{g['goal'][0]} .. {g['goal'][1]}" if isinstance(g["goal"], list)
                   else f"<= {g['goal']:g}")
@@ -76,19 +82,24 @@ def render(r: dict, plot: str | None = None) -> str:
             "build from the generators (median); a peer's run from our arrays to its output "
             "(its own mesh/constraint set-up included, one run, in a child process with a time "
             "limit). `digits/s` is log10(naive grid's max planarity / reached max planarity) per "
-            "second.", "", "| method | tool call | configuration |", "|---|---|---|",
+            "second. `quads` is the share of the mesh area in four-cornered faces and `min ang` "
+            "the smallest interior angle of any face (degrees); the JSON rows also count the "
+            "splinters (faces with an angle below 3 degrees). The peers keep the grid's quads, so "
+            "their share is 100 % by construction: what they give up is planarity, where ruledmesh "
+            "gives up area to triangles.", "", "| method | tool call | configuration |", "|---|---|---|",
             "| ruledmesh | `ruledmesh.pq.pq_mesh` | rows = n, trim, automatic extension |"]
     for p in PEERS:
         out.append(f"| {p.name} | `{p.call}` | {p.config} |")
     out += ["", "## Side by side", "",
             "| method | surface | n | faces | planarity max | planarity mean | displacement max "
-            "| seconds | digits/s |", "|---|---|---:|---:|---:|---:|---:|---:|---:|"]
+            "| quads | min ang | seconds | digits/s |", "|---|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|"]
     rows = sorted(r["methods"], key=lambda x: (x["surface"], x["size"], x["tool"] != "ruledmesh",
                                                x["name"]))
     for x in rows:
         out.append(f"| {x['name']} | {x['surface']} | {x['size']} | {x['faces']} | "
                    f"{_e(x['planarity_max'])} | {_e(x['planarity_mean'])} | "
-                   f"{_e(x['displacement_max'])} | {_g(x['seconds'])} | "
+                   f"{_e(x['displacement_max'])} | {_share(x.get('quad_area_share'))} | "
+                   f"{_deg(x.get('min_angle_deg'))} | {_g(x['seconds'])} | "
                    f"{_g(x['planarity_digits_per_second'])} |")
     out += ["", "The naive grids the peers started from:", "",
             "| surface | n | planarity max | planarity mean | displacement max |",
@@ -139,15 +150,26 @@ def render(r: dict, plot: str | None = None) -> str:
     return "\n".join(out)
 
 
+def _share(x) -> str:
+    """An area share as a percentage ("-" where the run did not measure it)."""
+    return "-" if x is None else f"{100 * x:.1f} %"
+
+
+def _deg(x) -> str:
+    """An angle in degrees ("-" where the run did not measure it)."""
+    return "-" if x is None else f"{x:.2f}"
+
+
 def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     ap.add_argument("json", type=Path)
     ap.add_argument("--plot", help="path of the plot as the Markdown should link it")
-    ap.add_argument("--notes", type=Path, help="Markdown appended at the end")
+    ap.add_argument("--notes", type=Path, action="append", default=[],
+                    help="Markdown appended at the end (repeatable, in order)")
     args = ap.parse_args(argv)
     text = render(json.loads(args.json.read_text()), args.plot)
-    if args.notes:
-        text += "\n" + args.notes.read_text()
+    for notes in args.notes:
+        text += "\n" + notes.read_text()
     sys.stdout.write(text)
     return 0
 

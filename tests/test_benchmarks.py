@@ -107,6 +107,17 @@ def test_tiny_run_writes_the_json_and_plot(bench, tmp_path, capsys):
     assert all(f["reason"] for f in data["failures"] + data["skipped"])
     printed = capsys.readouterr().out
     assert "ruledmesh" in printed and "planarity_max" in printed
+    # The page made from it has the fabricator's figures side by side with the peers'.
+    import report
+
+    notes = tmp_path / "notes.md"
+    notes.write_text("## Later\n\nmeasured elsewhere\n")
+    assert report.main([str(out), "--notes", str(notes), "--notes", str(notes)]) == 0
+    page = capsys.readouterr().out
+    assert "| quads | min ang |" in page and page.count("## Later") == 2
+    for m in rm:
+        assert 0.0 <= m["quad_area_share"] <= 1.0 and m["min_angle_deg"] > 0
+        assert f"| {100 * m['quad_area_share']:.1f} % | {m['min_angle_deg']:.2f} |" in page
     try:
         import matplotlib  # noqa: F401
     except ImportError:
