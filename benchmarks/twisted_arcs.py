@@ -20,8 +20,10 @@ RADII = (4, 3)
 HEIGHTS = (3, 6)
 
 
-def design(turn: int, span: int, radius: int, height: int) -> tuple[str, str]:
-    """The name and TOML text of one surface of the sweep."""
+def design(turn: float, span: int, radius: float, height: float, count: int = 51,
+           rows: int = 24, mesh: str = "") -> tuple[str, str]:
+    """The name and TOML text of one surface of the sweep (``count`` generators, ``rows``,
+    and ``mesh``: more lines of its ``[mesh]`` table)."""
     name = f"arcs-t{turn}-s{span}-r{radius}-h{height}"
     text = f'''# Hyperboloid between an arc of {span} degrees, r = 4 at z = 0, and one of r = {radius} at
 # z = {height} turned by {turn} degrees.
@@ -47,11 +49,11 @@ end_angle = {turn + span}
 [rulings]
 between = ["c1", "c2"]
 distribution = "arc-length"
-count = 51
+count = {count}
 
 [mesh]
-rows = 24
-'''
+rows = {rows}
+{mesh}'''
     return name, text
 
 

@@ -5,7 +5,10 @@ by nearly 180 degrees: close to their asymptotic cone, every generator passes ne
 axis half way up, so every strip pinches there to a small part of a row step.
 """
 
+import importlib.util
 import itertools
+import sys
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -19,6 +22,13 @@ from ruledmesh.mesh import FaceKind
 from ruledmesh.pq import pq_mesh
 from ruledmesh.skew.pq.runs import graded_carrier
 from ruledmesh.tolerances import EVEN_MAX_HALVINGS, EVEN_PINCH_STEP_PER_WIDTH, EVEN_STEP_PER_WIDTH
+
+_PATH = Path(__file__).resolve().parents[1] / "benchmarks" / "twisted_arcs.py"
+_spec = importlib.util.spec_from_file_location("ruledmesh_bench_twisted_arcs", _PATH)
+assert _spec is not None and _spec.loader is not None
+twisted_arcs = importlib.util.module_from_spec(_spec)
+sys.modules[_spec.name] = twisted_arcs
+_spec.loader.exec_module(twisted_arcs)
 
 
 def _twisted_arcs(turn_deg: float, count: int, height: float = 2.5, radius: float = 4.0):
@@ -42,32 +52,10 @@ def _width(a, d, i, t):
 
 
 def _design(turn_deg: float, tolerance: float | None = None, count: int = 41, rows: int = 20) -> str:
+    """Half circles r = 4 at z = 0 and 2.5, the top one turned by ``turn_deg`` (the sweep of
+    benchmarks/twisted_arcs.py)."""
     extra = "" if tolerance is None else f"planarity_tolerance = {tolerance}\n"
-    return f"""
-[curves.c1]
-type = "arc"
-center = [0.0, 0.0, 0.0]
-radius = 4
-normal = [0.0, 0.0, 1.0]
-start_angle = 0
-end_angle = 180
-
-[curves.c2]
-type = "arc"
-center = [0.0, 0.0, 2.5]
-radius = 4
-normal = [0.0, 0.0, 1.0]
-start_angle = {turn_deg}
-end_angle = {turn_deg + 180}
-
-[rulings]
-between = ["c1", "c2"]
-distribution = "arc-length"
-count = {count}
-
-[mesh]
-rows = {rows}
-{extra}"""
+    return twisted_arcs.design(turn_deg, 180, 4, 2.5, count=count, rows=rows, mesh=extra)[1]
 
 
 def test_the_division_is_graded_towards_the_waist():

@@ -69,11 +69,12 @@ def build_pq(rulings, table: Mapping[str, Any], ctx: BuildContext) -> Built:
             given = rulings
             rulings, kept, notes = _refined(rulings, mesh, options, respace == "auto",
                                             rows_from == "auto")
-            mesh, chosen = _other_rows(kept, options, free=(
+            chosen_round, chosen = _other_rows(kept, options, free=(
                 "option" not in table, "primary" not in table, rows_from == "auto"))
             notes += chosen
             if rows_from == "auto":
-                rulings, mesh, notes = _rows_or_none(given, (rulings, mesh, notes), options)
+                rulings, chosen_round, notes = _rows_or_none(given, chosen_round, notes, options)
+            mesh = chosen_round[4]
             if mesh.info["rows_from"] != options["rows_from"] or mesh.info["option"] == "mixed":
                 notes.append(_rows_from_note(mesh.info))
             if notes:
@@ -300,11 +301,11 @@ def _refined(rulings, mesh, options: dict, respace_auto: bool = False, rows_from
     return rulings, best, notes
 
 
-def _rows_or_none(rulings, kept: tuple, options: dict) -> tuple:
-    """``kept`` (the refinement's generators, mesh and notes), or where its mesh misses a goal
-    and the mesh without §4.3 rows does better (:func:`_fabricable`), that mesh: the even
-    divisions graded where the strips pinch (``rows_from = "none"``), refined from the
-    given generators ``rulings`` the same way.
+def _rows_or_none(rulings, kept: tuple, notes: list[str], options: dict) -> tuple:
+    """``(generators, round, notes)`` of the round ``kept`` (as :func:`_round`) and its
+    ``notes``, or where its mesh misses a goal and the mesh without §4.3 rows does better
+    (:func:`_fabricable`), of that mesh: the even divisions graded where the strips pinch
+    (``rows_from = "none"``), refined from the given generators ``rulings`` the same way.
 
     Close to its asymptotic cone a hyperboloid's strips pinch at the waist, where the rows
     leave splinters: between two half circles, the top one turned by 170 degrees (41 x 20),
@@ -314,17 +315,16 @@ def _rows_or_none(rulings, kept: tuple, options: dict) -> tuple:
     are nearly planar).  A mesh that meets both goals is kept as it is, unweighed.
     """
     goal = _goal(options)
-    best = _round(kept[0], kept[1])
-    if sum(_goals_met(best, goal)) == 2:
-        return kept
+    if sum(_goals_met(kept, goal)) == 2:
+        return kept[3], kept, notes
     none = {**options, "rows_from": RowsFrom.NONE.value}
     try:
-        spread, other, notes = _refined(rulings, _mesh(rulings, none), none)
+        spread, other, other_notes = _refined(rulings, _mesh(rulings, none), none)
     except GeometryError:
-        return kept
-    if _fabricable(other, goal) <= _fabricable(best, goal):
-        return kept
-    return spread, other[4], notes
+        return kept[3], kept, notes
+    if _fabricable(other, goal) <= _fabricable(kept, goal):
+        return kept[3], kept, notes
+    return spread, other, other_notes
 
 
 def _goal(options: dict) -> float:
@@ -351,8 +351,8 @@ _OTHER_PRIMARIES = (1 / 3, 2 / 3)
 
 
 def _other_rows(kept: tuple, options: dict, free: tuple[bool, bool, bool]) -> tuple:
-    """Where the mesh of the round ``kept`` (as :func:`_round`) misses a goal: ``(mesh, notes)``,
-    the more fabricable (:func:`_fabricable`) of the meshes of its generators from the paper's
+    """Where the mesh of the round ``kept`` (as :func:`_round`) misses a goal: ``(round, notes)``,
+    the round of the more fabricable (:func:`_fabricable`) of the meshes of its generators from the paper's
     two checkerboards (``option``) and three primaries (the middle, a third and two thirds
     in), where the design leaves them free (``free``: option, primary, rows_from), then of
     that mesh with its rows through the end points on either director curve
@@ -392,7 +392,7 @@ def _other_rows(kept: tuple, options: dict, free: tuple[bool, bool, bool]) -> tu
     said = [f"rows from {' and '.join(named)} (of the two checkerboards and three primary "
             f"generators tried): that mesh had more of its area in quads or fewer splinters; "
             f"[mesh] option and primary choose them"] if named else []
-    return best[4], said
+    return best, said
 
 
 def _checkerboards(rulings, options: dict, free: tuple[bool, ...]) -> list[dict]:

@@ -860,8 +860,7 @@ def _without_rows(plan: _Plan, seg: _Segment, div: Division, g: int) -> list[Run
     if plan.ends[g] != _NO_ROWS:
         return []
     plan.own.append([seg.lo, seg.hi, _NO_ROWS, int(plan.options[g])])
-    # A segment of one strip shares its generators with its neighbours' divisions.
-    return _even(plan, seg.lo, seg.hi, div.rows, graded=True) or []
+    return _even(plan, seg.lo, seg.hi, div.rows, graded=True)
 
 
 def _well_twisted(plan: _Plan, lo: int, hi: int) -> int:

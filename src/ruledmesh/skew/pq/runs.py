@@ -531,12 +531,12 @@ def graded_carrier(a: np.ndarray, d: np.ndarray, lo: int, hi: int, t: np.ndarray
     # Only the steps that would leave a splinter where the strip pinches are graded.  Strips
     # narrow from end to end (generators added close together) stay: the collapses join
     # their triangles across several strips.
-    pinched = _too_long(a, d, g, t0, t1, m, EVEN_PINCH_STEP_PER_WIDTH) \
-        & (_least_width(a, d, g, t0, t1, m) < EVEN_PINCH_SHARE * _least_width(
-            a, d, g, np.zeros(len(g)), np.zeros(len(g)), m, widest=True))
+    least, widest = _widths(a, d, g, t0, t1, m)
+    pinched = (_step_length(d, g, t0, t1) > EVEN_PINCH_STEP_PER_WIDTH * least) \
+        & (least < EVEN_PINCH_SHARE * widest)
     g, t0, t1 = g[pinched], t0[pinched], t1[pinched]
     for _ in range(EVEN_MAX_HALVINGS):
-        split = _too_long(a, d, g, t0, t1, m, EVEN_STEP_PER_WIDTH)
+        split = _step_length(d, g, t0, t1) > EVEN_STEP_PER_WIDTH * _widths(a, d, g, t0, t1, m)[0]
         if not split.any():
             break
         g, t0, t1 = g[split], t0[split], t1[split]
@@ -553,20 +553,19 @@ def graded_carrier(a: np.ndarray, d: np.ndarray, lo: int, hi: int, t: np.ndarray
     return _carried(a[lo:hi + 1], d[lo:hi + 1], lo, tt, gen)
 
 
-def _too_long(a: np.ndarray, d: np.ndarray, g: np.ndarray, t0: np.ndarray, t1: np.ndarray,
-              m: int, per_width: float) -> np.ndarray:
-    """(n,) bool: the steps ``[t0, t1]`` on generators ``g`` longer than ``per_width`` times
-    the least distance to a neighbouring generator line over the step."""
-    length = np.linalg.norm(d[g], axis=1) * (t1 - t0)
-    return length > per_width * _least_width(a, d, g, t0, t1, m)
+def _step_length(d: np.ndarray, g: np.ndarray, t0: np.ndarray, t1: np.ndarray) -> np.ndarray:
+    """(n,) length of the steps ``[t0, t1]`` on generators ``g``."""
+    return np.linalg.norm(d[g], axis=1) * (t1 - t0)
 
 
-def _least_width(a: np.ndarray, d: np.ndarray, g: np.ndarray, t0: np.ndarray, t1: np.ndarray,
-                 m: int, widest: bool = False) -> np.ndarray:
+def _widths(a: np.ndarray, d: np.ndarray, g: np.ndarray, t0: np.ndarray, t1: np.ndarray,
+            m: int) -> tuple[np.ndarray, np.ndarray]:
     """(n,) the least distance from the points of generator ``g`` with ``t0 <= t <= t1`` to a
-    neighbouring generator line; with ``widest``, the larger of those at ``t = 0`` and ``t = 1``
-    instead (the distance is convex in ``t``: the widest of the patch is at an end)."""
-    width = np.full(len(g), np.inf)
+    neighbouring generator line, and (n,) the width of the narrower strip at its wider end:
+    over both neighbours, the smaller of the larger distances at ``t = 0`` and ``t = 1`` (the
+    distance is convex in ``t``: the widest of the patch is at an end)."""
+    least = np.full(len(g), np.inf)
+    widest = np.full(len(g), np.inf)
     for step in (-1, 1):
         j = g + step
         has = (j >= 0) & (j < m)
@@ -576,10 +575,9 @@ def _least_width(a: np.ndarray, d: np.ndarray, g: np.ndarray, t0: np.ndarray, t1
         c0 = np.cross(a[gi] - a[gj], u)
         c1 = np.cross(d[gi], u)
         cc = np.einsum("ij,ij->i", c1, c1)
-        if widest:
-            w = np.maximum(np.linalg.norm(c0, axis=1), np.linalg.norm(c0 + c1, axis=1))
-        else:
-            ts = np.where(cc > 0, -np.einsum("ij,ij->i", c0, c1) / np.where(cc > 0, cc, 1.0), t0[has])
-            w = np.linalg.norm(c0 + np.clip(ts, t0[has], t1[has])[:, None] * c1, axis=1)
-        width[has] = np.minimum(width[has], w)
-    return width
+        ts = np.where(cc > 0, -np.einsum("ij,ij->i", c0, c1) / np.where(cc > 0, cc, 1.0), t0[has])
+        w = np.linalg.norm(c0 + np.clip(ts, t0[has], t1[has])[:, None] * c1, axis=1)
+        ends = np.maximum(np.linalg.norm(c0, axis=1), np.linalg.norm(c0 + c1, axis=1))
+        least[has] = np.minimum(least[has], w)
+        widest[has] = np.minimum(widest[has], ends)
+    return least, widest
