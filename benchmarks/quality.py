@@ -34,6 +34,11 @@ bounding box):
 * for quadric line sets, the distance of the vertices to the quadric;
 * coverage: mesh area / area of the smooth patch (a dense bilinear
   tessellation from a much finer generator sampling);
+* slender share: the share of the patch where every exact face with a generator
+  diagonal is at least a 10:1 panel, whatever the rows (the line through a point
+  that meets the two neighbouring generators crosses its own at under 5.7 deg:
+  nearly developable parts, the bands at torsal generators); what exact mode
+  cannot put into quads of good shape;
 * gap: the largest distance from a point of the smooth patch to the mesh
   (exact point-triangle distances), with the surface parameters (u, t) of the
   worst point.
@@ -979,11 +984,50 @@ def _against_reference(mesh: ObjMesh, verts: np.ndarray, total: float, ref: Refe
         out["max_generator_distance"] = out["max_design_generator_distance"]
     if quadric:
         out["max_quadric_distance"] = float(quadric_distance(verts, ref).max() / diag)
+    out["slender_share"] = slender_share(ref)
     gap, gen, tg = max_gap(ref, _triangles(mesh))
     out["max_gap"] = gap / diag
     out["max_gap_at"] = {"u": float(ref.grid_u[gen]), "t": tg,
                          "point": _on_generators(ref, np.array([gen]), np.array([tg]))[0].tolist()}
     return out
+
+
+SLENDER_DEG = float(np.degrees(np.arcsin(0.1)))   # diagonals crossing under this: a 10:1 panel
+SLENDER_GENERATORS = 401    # generators of the reference the slender share is measured on
+
+
+def slender_share(ref: Reference, n: int = SLENDER_GENERATORS) -> float:
+    """Share of the patch area where the exact faces of a PQ mesh with generator diagonals
+    are at least 10 times as elongated as a square, whatever its rows.
+
+    Such a face's other diagonal lies on the line through a point of its generator that
+    meets the two neighbouring generators; where that line crosses the generator at less
+    than :data:`SLENDER_DEG`, ``diameter**2 / (2 area) >= 1 / sin(angle) > 10``.  Measured
+    on ``n`` generators of the smooth patch (the design's own for explicit lines), at the
+    reference's points along each.
+    """
+    grid = ref.grid
+    if len(grid) > n:
+        grid = grid[np.unique(np.linspace(0, len(grid) - 1, n).round().astype(int))]
+    if len(grid) < 3:
+        return 0.0
+    a, d = grid[:, :1, :], grid[:, -1:, :] - grid[:, :1, :]      # (N, 1, 3) lines
+    p = grid[1:-1]                                               # points of the inner generators
+    n_plane = np.cross(d[:-2], a[:-2] - p)                       # plane (p, previous generator)
+    den = np.einsum("ijk,ijk->ij", n_plane, np.broadcast_to(d[2:], p.shape))
+    num = np.einsum("ijk,ijk->ij", n_plane, p - a[2:])
+    ok = np.abs(den) > 1e-14 * _norm(n_plane) * _norm(np.broadcast_to(d[2:], p.shape))
+    q = a[2:] + np.where(ok, num / np.where(ok, den, 1.0), 0.0)[..., None] * d[2:]
+    e = q - p
+    g = np.broadcast_to(d[1:-1], p.shape)
+    angle = np.degrees(np.arctan2(_norm(np.cross(e, g)), np.abs(np.einsum("ijk,ijk->ij", e, g))))
+    angle = np.where(ok & (_norm(e) > 0), angle, 0.0)
+    # Area around each point: the cells of the grid on both sides, halved.
+    cell = 0.5 * _norm(np.cross(grid[1:, :-1] - grid[:-1, :-1], grid[:-1, 1:] - grid[:-1, :-1]))
+    cell = np.pad(cell, ((0, 0), (0, 1))) + np.pad(cell, ((0, 0), (1, 0)))   # per point, along
+    weight = 0.5 * (cell[:-1] + cell[1:])
+    total = float(weight.sum())
+    return float(weight[angle < SLENDER_DEG].sum()) / total if total > 0 else 0.0
 
 
 def obj_path(s: Surface, workdir: Path) -> Path:
@@ -1030,6 +1074,7 @@ COLUMNS = (
     ("build s", "build_seconds", "{:.1f}"),
     ("F3/F4/F5+", None, None),
     ("tri area", "triangle_area_share", "{:.1%}"),
+    ("slender", "slender_share", "{:.0%}"),
     ("non-quad area", "nonquad_area_share", "{:.1%}"),
     ("min angle", "min_angle_deg", "{:.3g}"),
     ("< 3 deg", "faces_below_3deg", "{}"),

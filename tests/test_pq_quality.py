@@ -78,6 +78,10 @@ def test_exact_mode_says_where_a_nearly_developable_surface_has_no_quads():
     said = next(w for w in built.mesh.info["warnings"] if "of the area is not in quads" in w)
     # (All 40 but the one its torsal band was spanned by: a coplanar pair, strip quads.)
     assert int(re.search(r"(\d+) strips nearly developable", said).group(1)) >= 39
+    # ... and slender all over: the rows would cross the generators at under 5.7 degrees.
+    slender = re.search(r"(\d+)% of the area slender \(the rows would cross the generators at "
+                        r"under 5\.7 degrees there: exact quads at least 10:1\)", said)
+    assert slender and int(slender[1]) >= 95, said
     match = re.search(r"(\d+)% at the border, (\d+)% inside, most between generators (\d+)-(\d+)", said)
     assert match, said
     share = int(re.match(r"(\d+)% of the area", said).group(1))

@@ -5,6 +5,7 @@ from __future__ import annotations
 import contextlib
 import contextvars
 import hashlib
+import math
 from collections.abc import Iterator, Mapping
 from typing import Any
 
@@ -89,7 +90,19 @@ def build_pq(rulings, table: Mapping[str, Any], ctx: BuildContext) -> Built:
 
         # Every vertex is a_g + t (b_g - a_g) = point(u_g, t): the closeness needs no search.
         reference = RuledReference(rulings.surface, generator_u=np.asarray(rulings.u, dtype=np.float64))
-    return Built(mesh.with_info(source=ctx.source), reference, rulings)
+    return Built(mesh.with_info(source=ctx.source), reference, rulings, _slender(rulings))
+
+
+def _slender(rulings) -> dict[str, Any]:
+    """The report's ``slender`` figures of the generators meshed: the share of the patch where
+    every exact face is at least a 10:1 panel (:func:`~ruledmesh.analysis.asymptotic.slender_share`)
+    and the crossing angle under which that is so."""
+    from ..analysis.asymptotic import SLENDER_ELONGATION, slender_share
+
+    if len(rulings.a) < 3:
+        return {}
+    return {"slender": {"share": slender_share(rulings.a, rulings.b),
+                        "rows_cross_below_deg": math.degrees(math.asin(1.0 / SLENDER_ELONGATION))}}
 
 
 # The build's progress task and how many meshes it has made, while build_pq runs: the

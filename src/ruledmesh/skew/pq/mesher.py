@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import math
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field, replace
 from enum import Enum
@@ -10,6 +11,7 @@ import numpy as np
 
 from ..._arrays import unique
 from ..._validation import check_bool, check_choice, check_float, check_int, check_points, describe
+from ...analysis.asymptotic import SLENDER_ELONGATION, slender_share
 from ...errors import GeometryError, ParameterError
 from ...hop import coplanarity, sense_changes
 from ...mesh import Mesh
@@ -53,6 +55,9 @@ _DOUBLE = 0.01
 _NO_ROWS_SHARE = 0.5
 # A build with more than this share of its area outside quads says why.
 _WARN_SHARE = 0.3
+# ... and names slender regions as a cause from this share of the area on.
+_SAY_SLENDER = 0.05
+_SLENDER_DEG = math.degrees(math.asin(1.0 / SLENDER_ELONGATION))
 # Tolerance mode pairs triangles into quads planar within this share of the stated tolerance.
 _PAIRING_MARGIN = 0.9
 
@@ -683,7 +688,8 @@ def _warn_share(mesh: Mesh, warnings: list[str], torsal: int, even: list[str], r
 
     ``generators`` is ``(a, d, ptol)``: the generators, to count the strips that
     are nearly developable (their strip quads planar within
-    :data:`~ruledmesh.tolerances.NEARLY_DEVELOPABLE`), and the build's planarity
+    :data:`~ruledmesh.tolerances.NEARLY_DEVELOPABLE`) and to measure the slender
+    share of the area (:func:`~ruledmesh.analysis.asymptotic.slender_share`), and the build's planarity
     tolerance (in tolerance mode a tolerance is no advice); ``measured`` the (F,)
     smallest angles and areas of the faces, if known.
     """
@@ -708,6 +714,11 @@ def _warn_share(mesh: Mesh, warnings: list[str], torsal: int, even: list[str], r
         if a is not None and ptol < NEARLY_DEVELOPABLE else 0
     if flat:
         causes.append(f"{flat} strips nearly developable")
+    slender = slender_share(a, a + d) if a is not None and len(a) >= 3 else 0.0
+    if slender >= _SAY_SLENDER:
+        causes.append(f"{slender:.0%} of the area slender (the rows would cross the generators at "
+                      f"under {_SLENDER_DEG:.1f} degrees there: exact quads at least "
+                      f"{SLENDER_ELONGATION:g}:1)")
     if restarts:
         causes.append(f"the two chains drifted apart ({restarts} restarts)")
     if m < 2 * rows:
