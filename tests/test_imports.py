@@ -27,9 +27,11 @@ LAYERS: list[tuple[str, list[str]]] = [
     ("foundation", ["errors", "_version", "tolerances", "_validation", "_arrays", "units", "progress",
                     "_files", "roots", "budget", "normalise", "kernels"]),
     # Per-face measures and the distance to the smooth patch are geometry of a mesh that the
-    # meshers check their own output with; they depend on the mesh only.
+    # meshers check their own output with; they depend on the mesh only.  The slender share
+    # (analysis.asymptotic) is geometry of the generators, by the hop: the mesher's warnings use it.
     ("core", ["mesh", "notebook", "registry", "curves", "triangulate", "hop", "surfaces", "labels",
-              "analysis.faces", "analysis.circularity", "analysis.surface", "analysis.__init__"]),
+              "analysis.faces", "analysis.circularity", "analysis.surface", "analysis.asymptotic",
+              "analysis.__init__"]),
     ("generators", ["rulings"]),
     ("meshers", ["constructions", "transforms", "pq", "skew", "hybrid", "compound"]),
     ("analysis", ["analysis"]),
