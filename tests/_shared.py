@@ -7,9 +7,27 @@ not on ``sys.path``).
 
 from __future__ import annotations
 
+import importlib.util
+import sys
+from pathlib import Path
+
 import numpy as np
 
-__all__ = ["SMALL_DESIGN", "bspline_design", "check_exact", "same_sense_edges", "small_design"]
+BENCHMARKS = Path(__file__).resolve().parents[1] / "benchmarks"
+
+
+def bench_module(name: str):
+    """The module ``benchmarks/<name>.py`` (not a package), loaded once per test run."""
+    key = f"ruledmesh_bench_{name}"
+    if key not in sys.modules:
+        spec = importlib.util.spec_from_file_location(key, BENCHMARKS / f"{name}.py")
+        assert spec is not None and spec.loader is not None
+        module = importlib.util.module_from_spec(spec)
+        sys.modules[key] = module            # dataclasses look their module up by name
+        spec.loader.exec_module(module)
+    return sys.modules[key]
+
+__all__ = ["SMALL_DESIGN", "bench_module", "bspline_design", "check_exact", "same_sense_edges", "small_design"]
 
 
 def small_design(*, name: str = "small", count: int = 9, rows: int = 6) -> str:

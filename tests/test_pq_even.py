@@ -5,13 +5,11 @@ by nearly 180 degrees: close to their asymptotic cone, every generator passes ne
 axis half way up, so every strip pinches there to a small part of a row step.
 """
 
-import importlib.util
 import itertools
-import sys
-from pathlib import Path
 
 import numpy as np
 import pytest
+from _shared import bench_module
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
@@ -23,12 +21,7 @@ from ruledmesh.pq import pq_mesh
 from ruledmesh.skew.pq.runs import graded_carrier
 from ruledmesh.tolerances import EVEN_MAX_HALVINGS, EVEN_PINCH_STEP_PER_WIDTH, EVEN_STEP_PER_WIDTH
 
-_PATH = Path(__file__).resolve().parents[1] / "benchmarks" / "twisted_arcs.py"
-_spec = importlib.util.spec_from_file_location("ruledmesh_bench_twisted_arcs", _PATH)
-assert _spec is not None and _spec.loader is not None
-twisted_arcs = importlib.util.module_from_spec(_spec)
-sys.modules[_spec.name] = twisted_arcs
-_spec.loader.exec_module(twisted_arcs)
+twisted_arcs = bench_module("twisted_arcs")
 
 
 def _twisted_arcs(turn_deg: float, count: int, height: float = 2.5, radius: float = 4.0):

@@ -18,6 +18,8 @@ construction, up to rounding that does not accumulate.
 - :mod:`~ruledmesh.skew.pq.runs`: one run's grid; chain *b* rooted where its faces
   stay convex; matched divisions for runs that meet on a generator; rows through the
   generators' end points on a director curve (``rows_from``).
+- :mod:`~ruledmesh.skew.pq.grading`: the primary's division graded for faces of even shape
+  on every generator the rows reach (``division = "graded"``).
 - :mod:`~ruledmesh.skew.pq.mesher`: torsal generators, restarts, the whole mesh.
 - :mod:`~ruledmesh.skew.pq.strips` and :mod:`~ruledmesh.skew.pq.assemble`: trimming to
   the patch with every vertex on a generator, closing the strips.
@@ -26,7 +28,7 @@ construction, up to rounding that does not accumulate.
 from __future__ import annotations
 
 from .maps import row_maps
-from .mesher import RowsFrom, pq_mesh
+from .mesher import PrimaryDivision, RowsFrom, pq_mesh
 from .runs import MAX_GRID_POINTS
 
-__all__ = ["MAX_GRID_POINTS", "RowsFrom", "pq_mesh", "row_maps"]
+__all__ = ["MAX_GRID_POINTS", "PrimaryDivision", "RowsFrom", "pq_mesh", "row_maps"]

@@ -36,7 +36,7 @@ from .runs import (
 )
 from .splinters import open_walled_splinters, snap_to_border, trim_border_needles
 
-__all__ = ["RowsFrom", "pq_mesh"]
+__all__ = ["PrimaryDivision", "RowsFrom", "pq_mesh"]
 
 # A run restarts on a generator where this share of its faces on the patch (and
 # at least two) would not be convex; the shared generator costs one strip of
@@ -314,7 +314,7 @@ def pq_mesh(a, b, rows: int = 20, primary: int | str = "middle", option: int = 0
             extend: float | str = "auto", trim: bool = True, *, max_extend: float = 20.0,
             creases=None, crease_generators=None, planarity_tolerance: float | None = None,
             respace: bool = False, rows_from: str | Sequence[str] = "primary",
-            tol: Tolerances = DEFAULT) -> Mesh:
+            division: str = "even", tol: Tolerances = DEFAULT) -> Mesh:
     """The §4.3 PQ mesh of the ruled surface through generators ``a_i b_i``.
 
     Parameters
@@ -325,23 +325,21 @@ def pq_mesh(a, b, rows: int = 20, primary: int | str = "middle", option: int = 0
     rows : int
         Divisions of the primary generator between ``t = 0`` and ``t = 1``.
     primary : int or "middle"
-        Index of the primary generator (negative indices count from the end).
+        Index of the primary generator (negative: from the end).
     option : {0, 1} or (m,) sequence of them
         The checkerboard colour carrying the vertices (the paper's two options); as ``rows_from``.
     extend : "auto", "full" or float
-        How far the division of the primary continues beyond ``[0, 1]`` (in its
-        lengths); ``"auto"`` covers the patch on every generator, leaving out rows
-        that would bunch (:mod:`.extension`); ``"full"`` keeps every row.
+        How far the division of the primary continues beyond ``[0, 1]`` (in its lengths);
+        ``"auto"`` covers the patch on every generator, leaving out rows that would bunch
+        (:mod:`.extension`); ``"full"`` keeps every row.
     trim : bool
         Trim the faces to the patch ``0 <= t <= 1``, every vertex staying on a generator.
     max_extend : float
-        Cap of the automatic extension.
-    creases : (k,) int, optional
+        Cap of the automatic extension (in the primary's lengths).
+    creases, crease_generators : (k,) int, optional
         Strips ``i`` (generators ``i`` to ``i + 1``) holding a crease (a kink of a director
-        curve): the rows restart there, the strip is closed by triangles.
-    crease_generators : (k,) int, optional
-        Generators along which the surface has a crease (through a kink of a
-        director curve): the rows restart there with a matched division.
+        curve), closed by triangles; generators through a kink, where the rows restart with a
+        matched division.
     planarity_tolerance : float, optional
         Relative planarity (the paper's measure, as :func:`ruledmesh.analysis.planarity`)
         that strip quads between nearly coplanar generators may have; default
@@ -351,19 +349,21 @@ def pq_mesh(a, b, rows: int = 20, primary: int | str = "middle", option: int = 0
     rows_from : {"primary", "c1", "c2", "none"} or (m,) sequence of them
         Where the rows start (:class:`RowsFrom`; ``"none"``: no rows); per generator, a segment
         with a division of its own (between torsal generators) takes the value where its rows start.
+    division : {"even", "graded"}
+        The primary's steps: even, or graded for faces of even shape wherever the rows land
+        (:class:`PrimaryDivision`).
     tol : Tolerances
 
     Returns
     -------
     Mesh
-        Faces of kind QUAD, BORDER (reaching a director curve), STRIP (between
-        coplanar generators), FILL (notch, torsal, border triangles) and SPLIT
-        (halves of quads that were not convex); members are the generator
-        segments between vertices; ``vertex_data`` holds ``t`` and ``generator``;
-        ``info`` the ``warnings``, ``runs``, ``restarts``, ``option``, ``primary``, ``rows_from``
-        (``"mixed"`` if segments differ; ``row_segments``: ``[lo, hi, rows_from, option]`` each),
-        how many ``flips``, ``collapsed``, ``paired``, ``snapped``, ``trimmed``, ``opened`` and
-        ``cut`` faces the passes after the grid made.
+        Faces of kind QUAD, BORDER (reaching a director curve), STRIP (between coplanar
+        generators), FILL (notch, torsal, border triangles) and SPLIT (halves of quads that
+        were not convex); members are the generator segments between vertices;
+        ``vertex_data`` holds ``t`` and ``generator``; ``info`` the ``warnings``, ``runs``,
+        ``restarts``, ``option``, ``primary``, ``division``, ``rows_from`` (``"mixed"`` if
+        segments differ; ``row_segments``: ``[lo, hi, rows_from, option]`` each), and the
+        counts of the passes after the grid (``flips``, ``collapsed``, ``paired``, ...).
 
     Raises
     ------
@@ -380,13 +380,12 @@ def pq_mesh(a, b, rows: int = 20, primary: int | str = "middle", option: int = 0
     >>> phi = np.linspace(0, np.pi, 12)
     >>> a = np.stack([np.cos(phi) - np.sin(phi), np.sin(phi) + np.cos(phi), -np.ones(12)], 1)
     >>> b = np.stack([np.cos(phi) + np.sin(phi), np.sin(phi) - np.cos(phi), np.ones(12)], 1)
-    >>> mesh = pq_mesh(a, b, rows=10)
-    >>> v = mesh.vertices
+    >>> v = pq_mesh(a, b, rows=10).vertices
     >>> bool(np.abs(v[:, 0]**2 + v[:, 1]**2 - v[:, 2]**2 - 1).max() < 1e-12)
     True
     """
     a, b, args = _checked(a, b, rows, primary, option, extend, trim, max_extend,
-                          planarity_tolerance, respace, tol, rows_from)
+                          planarity_tolerance, respace, tol, rows_from, division)
     rows, ptol, d = args.rows, args.ptol, b - a
     scale = _patch_scale(a, b, d, tol)
     warnings: list[str] = []
@@ -397,7 +396,8 @@ def pq_mesh(a, b, rows: int = 20, primary: int | str = "middle", option: int = 0
     plan = _Plan(a, d, tol, scale, warnings, args.ends[kept], args.option[kept], frozenset(cg.tolist()),
                  hop_maps(a, d), args.respace)
     primary = int(np.searchsorted(kept, args.primary, side="right") - 1)
-    parts = _build_all(plan, segs, primary, args.middle, Division(rows, 0, args.extend, args.max_extend), m)
+    parts = _build_all(plan, segs, primary, args.middle, Division(
+        rows, 0, args.extend, args.max_extend, graded=args.division == "graded"), m)
     restarts = max(len([r for r in parts if len(r.left)]) - len([s for s in segs if s.hi - s.lo >= 2]), 0)
     even = _even_ranges(parts, segs, warnings, exact=ptol <= tol.planarity, own=plan.own)
     meet, runs = np.r_[flat, False] | np.r_[False, flat], len(parts)    # meet: of a coplanar pair
@@ -408,7 +408,7 @@ def pq_mesh(a, b, rows: int = 20, primary: int | str = "middle", option: int = 0
     if kept.size < m_given:
         mesh = _renumbered(mesh, kept)
     return mesh.with_info(runs=runs, restarts=restarts, planarity_tolerance=ptol, extend=args.extend,
-                          respace=plan.respace, **_rows_from_info(plan.own, kept),
+                          respace=plan.respace, division=args.division, **_rows_from_info(plan.own, kept),
                           primary="middle" if args.middle else args.primary, **fattening)
 
 
@@ -521,6 +521,21 @@ class RowsFrom(str, Enum):
         return {"primary": None, "c1": 0, "c2": 1, "none": None}[self.value]
 
 
+class PrimaryDivision(str, Enum):
+    """How :func:`pq_mesh` divides the primary generator.
+
+    ``EVEN``: ``rows`` even steps over the primary's part on the patch, as in the paper,
+    continued beyond it where the rows reach the patch on other generators (and left out
+    where they would bunch, :mod:`.extension`).  ``GRADED``: steps graded so that the faces
+    are of about even shape on every generator the rows reach, the median generator
+    carrying ``rows`` steps (:mod:`.grading`); on a hyperboloid close to its asymptotic
+    cone the even division's far rows crowd into slivers.
+    """
+
+    EVEN = "even"
+    GRADED = "graded"
+
+
 @dataclass(frozen=True)
 class _Args:
     """The mesher's arguments, checked."""
@@ -535,10 +550,12 @@ class _Args:
     ptol: float
     respace: bool
     ends: np.ndarray        # (m,) RowsFrom.ends, or -1 for the primary's division
+    division: str = "even"  # the primary's division: "even" or "graded"
 
 
 def _checked(a, b, rows, primary, option, extend, trim, max_extend, planarity_tolerance, respace,
-             tol: Tolerances, rows_from: str | Sequence[str] = "primary") -> tuple[np.ndarray, np.ndarray, _Args]:
+             tol: Tolerances, rows_from: str | Sequence[str] = "primary",
+             division: str = "even") -> tuple[np.ndarray, np.ndarray, _Args]:
     """Validate the arguments of :func:`pq_mesh` (ParameterError naming the parameter)."""
     a = check_points(a, "a", min_count=3)
     b = check_points(b, "b", min_count=3)
@@ -565,7 +582,8 @@ def _checked(a, b, rows, primary, option, extend, trim, max_extend, planarity_to
         planarity_tolerance, "planarity_tolerance", lo=0.0, hi=0.1)
     _check_grid_budget(m, rows, extend)
     return a, b, _Args(rows, p, middle, option, extend, trim, max_extend, max(ptol, tol.planarity),
-                       check_bool(respace, "respace"), _per_generator(rows_from, m, "rows_from", _end_of))
+                       check_bool(respace, "respace"), _per_generator(rows_from, m, "rows_from", _end_of),
+                       check_choice(division, PrimaryDivision, "division").value)
 
 
 # The per-generator code of RowsFrom.NONE (-1 is the primary's division, 0 and 1 the curves).

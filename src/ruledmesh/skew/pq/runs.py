@@ -35,6 +35,7 @@ from ...tolerances import (
     Tolerances,
 )
 from .extension import LANDING_SLACK, thinned_rows
+from .grading import graded_rows
 from .maps import (
     ChainMaps,
     HopMaps,
@@ -64,6 +65,8 @@ class Division:
     generator), extended by their end spacings as far as the run needs.
     ``ends`` (0 or 1; a uniform division only) also puts a row through the end
     point ``t = ends`` of every generator the rows cross there (:func:`_through_ends`).
+    ``graded`` (not matched) spaces the rows for faces of about even shape on
+    every generator they reach instead of evenly on the primary (:func:`_graded_rows`).
     """
 
     rows: int
@@ -72,6 +75,7 @@ class Division:
     max_extend: float = 20.0
     matched: np.ndarray | None = None
     ends: int | None = None
+    graded: bool = False
 
 
 @dataclass
@@ -114,15 +118,7 @@ def _uniform_rows(M: np.ndarray, div: Division, primary_global: int, tol: Tolera
     """
     rows = div.rows
     if isinstance(div.extend, str):         # "auto" or "full": what covers the patch
-        lo, hi, bounded = patch_preimage(M, tol.degenerate)
-        if not np.all(bounded):
-            warnings.append(f"{int((~bounded).sum())} generators cannot be covered by a finite "
-                            f"division of the primary generator; extension capped at "
-                            f"{div.max_extend:g} generator lengths")
-        lo_v = lo[bounded].min() if bounded.any() else 0.0
-        hi_v = hi[bounded].max() if bounded.any() else 1.0
-        lo_v = max(min(lo_v, 0.0), -div.max_extend)
-        hi_v = min(max(hi_v, 1.0), 1.0 + div.max_extend)
+        lo_v, hi_v = _covering(M, div, tol, warnings)
         # Two rows of margin on each side: a face spans two row steps.
         j0 = math.floor(lo_v * rows) - 2
         j1 = math.ceil(hi_v * rows) + 2
@@ -137,6 +133,19 @@ def _uniform_rows(M: np.ndarray, div: Division, primary_global: int, tol: Tolera
     count += count % 2
     tau = (j0 + np.arange(count)) / rows
     return thinned_rows(M, tau, (0.0, 1.0), rows) if div.extend == "auto" else tau
+
+
+def _covering(M: np.ndarray, div: Division, tol: Tolerances, warnings: list[str]) -> tuple[float, float]:
+    """The range of the primary's parameter whose rows cover the patch on every generator
+    (with [0, 1]), capped at ``div.max_extend``; a warning where no finite range does."""
+    lo, hi, bounded = patch_preimage(M, tol.degenerate)
+    if not np.all(bounded):
+        warnings.append(f"{int((~bounded).sum())} generators cannot be covered by a finite "
+                        f"division of the primary generator; extension capped at "
+                        f"{div.max_extend:g} generator lengths")
+    lo_v = lo[bounded].min() if bounded.any() else 0.0
+    hi_v = hi[bounded].max() if bounded.any() else 1.0
+    return max(min(lo_v, 0.0), -div.max_extend), min(max(hi_v, 1.0), 1.0 + div.max_extend)
 
 
 def matched(div: Division, t: np.ndarray | None) -> Division:
@@ -330,6 +339,10 @@ def mesh_run(a: np.ndarray, d: np.ndarray, first: int, primary: int, div: Divisi
     M = compose(maps, m)
     if div.matched is not None and len(div.matched):
         tau = _matched_rows(M, div, tol)
+    elif div.graded and m >= 3:
+        lo, hi = _covering(M, div, tol, warnings) if isinstance(div.extend, str) else \
+            (-float(div.extend), 1.0 + float(div.extend))
+        tau = graded_rows(a, d, M, lo, hi, div.rows, bool((first + primary - div.option) % 2))
     else:
         tau = _uniform_rows(M, div, first + primary, tol, warnings)
     parity = (np.arange(m) - primary) % 2                     # 0: chain a, 1: chain b

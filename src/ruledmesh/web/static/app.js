@@ -1291,6 +1291,7 @@ function choiceList(path, name) {
   if (name === 'method' && path[0] === 'mesh') return ch.methods;
   if (name === 'type' && path[0] === 'curves') return ch.curve_types;
   if (name === 'rows_from' && path[0] === 'mesh') return ['auto', 'primary', 'c1', 'c2', 'none'];
+  if (name === 'division' && path[0] === 'mesh') return ['auto', 'even', 'graded'];
   return null;
 }
 
@@ -1382,7 +1383,7 @@ function buildControls() {
 // one has a control even while the design leaves it out.
 const METHOD_FIELDS = {
   pq: { rows: 20, primary: 'middle', option: 0, extend: 'auto', trim: true, max_extend: 20.0,
-        planarity_tolerance: 1e-12, refine: true, respace: 'auto', rows_from: 'auto' },
+        planarity_tolerance: 1e-12, refine: true, respace: 'auto', rows_from: 'auto', division: 'auto' },
   hybrid: { midpoints: 1, divisions: 8, flip: false, orient: true },
 };
 
