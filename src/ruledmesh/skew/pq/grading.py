@@ -27,6 +27,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from ..._arrays import median
 from ...analysis.asymptotic import crossing_angles
 from ...tolerances import TINY
 from .extension import LANDING_SLACK
@@ -113,7 +114,7 @@ def graded_rows(a: np.ndarray, d: np.ndarray, M: np.ndarray, lo: float, hi: floa
         _, inside = _density(M[k:k + chunk], steps[k:k + chunk], g)
         counts[k:k + chunk] = (inside * rho * width).sum(axis=1)
     counts = counts[reached > 0]
-    rho *= rows / max(float(np.median(counts)), TINY) if counts.size else 1.0
+    rho *= rows / max(float(median(counts)), TINY) if counts.size else 1.0
     F = np.concatenate([[0.0], np.cumsum(0.5 * (rho[1:] + rho[:-1]) * np.diff(g))])
     # Rows from end to end of the range (its ends are the margin: _covering's range holds
     # the patch of every generator it can), a whole even number of steps.  No rows beyond:
@@ -126,7 +127,7 @@ def graded_rows(a: np.ndarray, d: np.ndarray, M: np.ndarray, lo: float, hi: floa
     # The a-rows become b-rows and the other way round, one more row behind (a step no
     # longer than the median).
     gaps = np.diff(tau)
-    return np.append(tau[1:], tau[-1] + min(gaps[-1], float(np.median(gaps))))
+    return np.append(tau[1:], tau[-1] + min(gaps[-1], median(gaps)))
 
 
 def _density(M: np.ndarray, steps: np.ndarray, g: np.ndarray) -> tuple[np.ndarray, np.ndarray]:

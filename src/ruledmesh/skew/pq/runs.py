@@ -236,6 +236,8 @@ def _through_ends(M: np.ndarray, tau: np.ndarray, parity: np.ndarray, side: floa
     a_rows = tau[0::2]
     outside = a_rows[(a_rows < kept[0] - 0.5 * step) | (a_rows > kept[-1] + 0.5 * step)]
     a_rows = np.sort(np.concatenate([outside, kept]))
+    if a_rows.size < 2:     # one row through the ends and none beside it (a graded division
+        return tau          # that lies wholly within the end points' roots): as it was
     return _with_middles(a_rows, a_rows[-1] - a_rows[-2])
 
 
