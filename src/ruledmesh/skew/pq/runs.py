@@ -24,6 +24,7 @@ from ...budget import MAX_GRID_POINTS, PQ_BYTES_PER_GRID_POINT
 from ...errors import GeometryError
 from ...kernels import wanted
 from ...tolerances import (
+    EVEN_MAX_ADDED,
     EVEN_MAX_HALVINGS,
     EVEN_PINCH_SHARE,
     EVEN_PINCH_STEP_PER_WIDTH,
@@ -519,8 +520,10 @@ def graded_carrier(a: np.ndarray, d: np.ndarray, lo: int, hi: int, t: np.ndarray
     least distance to a neighbouring generator line over that step (a splinter's worth) is
     halved, and its halves again while longer than
     :data:`~ruledmesh.tolerances.EVEN_STEP_PER_WIDTH` times theirs, at most
-    :data:`~ruledmesh.tolerances.EVEN_MAX_HALVINGS` times: the steps shrink geometrically
-    towards the pinch.  Where no strip pinches, the division is ``t`` on every generator.
+    :data:`~ruledmesh.tolerances.EVEN_MAX_HALVINGS` times and while the vertices added stay
+    within :data:`~ruledmesh.tolerances.EVEN_MAX_ADDED` times the division's: the steps
+    shrink geometrically towards the pinch.  Where no strip pinches, the division is ``t``
+    on every generator.
 
     Parameters
     ----------
@@ -550,9 +553,11 @@ def graded_carrier(a: np.ndarray, d: np.ndarray, lo: int, hi: int, t: np.ndarray
     pinched = (_step_length(d, g, t0, t1) > EVEN_PINCH_STEP_PER_WIDTH * least) \
         & (least < EVEN_PINCH_SHARE * widest)
     g, t0, t1 = g[pinched], t0[pinched], t1[pinched]
+    budget, added = EVEN_MAX_ADDED * len(t) * len(gens), 0
     for _ in range(EVEN_MAX_HALVINGS):
         split = _step_length(d, g, t0, t1) > EVEN_STEP_PER_WIDTH * _widths(a, d, g, t0, t1, m)[0]
-        if not split.any():
+        added += int(split.sum())
+        if not split.any() or added > budget:
             break
         g, t0, t1 = g[split], t0[split], t1[split]
         mid = 0.5 * (t0 + t1)
