@@ -145,15 +145,12 @@ def test_designer_benchmark_times_every_stage(capsys):
 
 
 def test_twisted_arcs_sweep_writes_designs_that_build(tmp_path):
-    import importlib.util
+    import _shared  # a helper module of tests/ (see conftest.py)
 
     from ruledmesh import build
     from ruledmesh.analysis.faces import area_shares, planarity
 
-    spec = importlib.util.spec_from_file_location(
-        "twisted_arcs", Path(__file__).resolve().parents[1] / "benchmarks" / "twisted_arcs.py")
-    mod = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(mod)
+    mod = _shared.bench_module("twisted_arcs")
     assert mod.main([str(tmp_path)]) == 0
     files = sorted(tmp_path.glob("*.toml"))
     assert len(files) == 32

@@ -21,20 +21,13 @@ tolerance mode (``[mesh] planarity_tolerance``)
 
 from __future__ import annotations
 
-import importlib.util
 import math
-import sys
 from concurrent.futures import Future, ThreadPoolExecutor
-from pathlib import Path
 
 import pytest
+from _shared import bench_module
 
-_PATH = Path(__file__).resolve().parents[1] / "benchmarks" / "quality.py"
-_spec = importlib.util.spec_from_file_location("ruledmesh_bench_quality", _PATH)
-assert _spec is not None and _spec.loader is not None
-quality = importlib.util.module_from_spec(_spec)
-sys.modules[_spec.name] = quality          # dataclasses look their module up by name
-_spec.loader.exec_module(quality)
+quality = bench_module("quality")
 
 EXACT_PLANARITY = 1e-12
 MAX_TRIANGLE_SHARE = 0.25

@@ -25,11 +25,13 @@ from .._arrays import cross
 from ..hop import hop
 from ..tolerances import TINY
 
-__all__ = ["SLENDER_ELONGATION", "crossing_angles", "least_elongation", "slender_share"]
+__all__ = ["SLENDER_DEG", "SLENDER_ELONGATION", "crossing_angles", "least_elongation", "slender_share"]
 
 #: A face at least this many times as elongated as a square (``diameter**2 / (2 area)``)
-#: is slender: a 10:1 panel.  Its diagonals cross at less than asin(1/10) = 5.7 degrees.
+#: is slender: a 10:1 panel.  Its diagonals cross at less than asin(1/10) = 5.7 degrees ...
 SLENDER_ELONGATION = 10.0
+#: ... this angle, in degrees.
+SLENDER_DEG = float(np.degrees(np.arcsin(1.0 / SLENDER_ELONGATION)))
 
 
 def crossing_angles(a: np.ndarray, b: np.ndarray, t: np.ndarray | None = None
@@ -69,14 +71,13 @@ def crossing_angles(a: np.ndarray, b: np.ndarray, t: np.ndarray | None = None
     sin = np.linalg.norm(cross(e, g), axis=-1)
     cos = np.abs(np.einsum("...i,...i->...", e, g))
     angles = np.where(ok, np.degrees(np.arctan2(sin, cos)), 0.0)
-    # The patch around each point: half the way to both neighbours, across; its share of
-    # the generator, along (trapezoid weights of t).
-    across = np.linalg.norm(cross(
-        (a[2:, None, :] + t[None, :, None] * d[2:, None, :])
-        - (a[:-2, None, :] + t[None, :, None] * d[:-2, None, :]), g), axis=-1)
-    across /= 2.0 * np.maximum(np.linalg.norm(g, axis=-1), TINY)
+    # The patch around each point: half the way to both neighbours across (the parallelogram
+    # of that span and the generator), times its share of the generator along (trapezoid
+    # weights of t).
+    span = (a[2:, None, :] + t[None, :, None] * d[2:, None, :]) \
+        - (a[:-2, None, :] + t[None, :, None] * d[:-2, None, :])
     dt = np.gradient(t) if len(t) > 1 else np.ones(1)
-    weights = across * np.linalg.norm(g, axis=-1) * np.abs(dt)[None, :]
+    weights = 0.5 * np.linalg.norm(cross(span, g), axis=-1) * np.abs(dt)[None, :]
     return angles, weights
 
 

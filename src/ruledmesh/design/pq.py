@@ -5,7 +5,6 @@ from __future__ import annotations
 import contextlib
 import contextvars
 import hashlib
-import math
 from collections.abc import Iterator, Mapping
 from typing import Any
 
@@ -104,12 +103,11 @@ def _slender(rulings) -> dict[str, Any]:
     """The report's ``slender`` figures of the generators meshed: the share of the patch where
     every exact face is at least a 10:1 panel (:func:`~ruledmesh.analysis.asymptotic.slender_share`)
     and the crossing angle under which that is so."""
-    from ..analysis.asymptotic import SLENDER_ELONGATION, slender_share
+    from ..analysis.asymptotic import SLENDER_DEG, slender_share
 
     if len(rulings.a) < 3:
         return {}
-    return {"slender": {"share": slender_share(rulings.a, rulings.b),
-                        "rows_cross_below_deg": math.degrees(math.asin(1.0 / SLENDER_ELONGATION))}}
+    return {"slender": {"share": slender_share(rulings.a, rulings.b), "rows_cross_below_deg": SLENDER_DEG}}
 
 
 # The build's progress task and how many meshes it has made, while build_pq runs: the
@@ -450,13 +448,13 @@ def _other_rows(kept: tuple, options: dict, free: tuple[bool, bool, bool, bool])
     return best, said
 
 
-def _checkerboards(rulings, options: dict, free: tuple[bool, ...]) -> list[dict]:
+def _checkerboards(rulings, options: dict, free: tuple[bool, bool, bool, bool]) -> list[dict]:
     """The options of the other checkerboards and primaries that ``free`` leaves open, and the
     graded division with the first's (where ``free[3]``: the division is the design's choice)."""
     m = len(rulings.a)
     first = (options["option"], options["primary"])
     graded = [{**options, "division": PrimaryDivision.GRADED.value}] \
-        if len(free) > 3 and free[3] and options["division"] == PrimaryDivision.EVEN.value else []
+        if free[3] and options["division"] == PrimaryDivision.EVEN.value else []
     return [{**options, "option": o, "primary": p}
             for o in ((0, 1) if free[0] else (options["option"],))
             for p in (("middle", *(int(f * m) for f in _OTHER_PRIMARIES)) if free[1]

@@ -2,7 +2,6 @@
 
 from __future__ import annotations
 
-import math
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field, replace
 from enum import Enum
@@ -11,7 +10,7 @@ import numpy as np
 
 from ..._arrays import unique
 from ..._validation import check_bool, check_choice, check_float, check_int, check_points, describe
-from ...analysis.asymptotic import SLENDER_ELONGATION, slender_share
+from ...analysis.asymptotic import SLENDER_DEG, SLENDER_ELONGATION, slender_share
 from ...errors import GeometryError, ParameterError
 from ...hop import coplanarity, sense_changes
 from ...mesh import Mesh
@@ -57,7 +56,6 @@ _NO_ROWS_SHARE = 0.5
 _WARN_SHARE = 0.3
 # ... and names slender regions as a cause from this share of the area on.
 _SAY_SLENDER = 0.05
-_SLENDER_DEG = math.degrees(math.asin(1.0 / SLENDER_ELONGATION))
 # Tolerance mode pairs triangles into quads planar within this share of the stated tolerance.
 _PAIRING_MARGIN = 0.9
 
@@ -735,7 +733,7 @@ def _warn_share(mesh: Mesh, warnings: list[str], torsal: int, even: list[str], r
     slender = slender_share(a, a + d) if a is not None and len(a) >= 3 else 0.0
     if slender >= _SAY_SLENDER:
         causes.append(f"{slender:.0%} of the area slender (the rows would cross the generators at "
-                      f"under {_SLENDER_DEG:.1f} degrees there: exact quads at least "
+                      f"under {SLENDER_DEG:.1f} degrees there: exact quads at least "
                       f"{SLENDER_ELONGATION:g}:1)")
     if restarts:
         causes.append(f"the two chains drifted apart ({restarts} restarts)")
