@@ -518,7 +518,11 @@ def surface_generator_distance(p: np.ndarray, ref: Reference, iters: int = 100, 
     and that distance has a local minimum on each side of it: a point the first descent
     leaves off the surface is searched again from the next ``starts`` nearest patch
     points, and the nearest generator found is kept; with ``polish``, what is still off
-    is searched once more by golden section on ``u`` around it.
+    is searched once more by golden section on ``u`` around it.  A point counts as on
+    a generator within ``1e-12`` of the diagonal or within the rounding of the
+    coordinates, whichever is larger: far from the origin (a building in projected
+    coordinates, 2.6e6 m) every vertex is "off" by its coordinates' last bits, and the
+    searches for all of them took a minute without finding anything nearer.
 
     Returns
     -------
@@ -533,13 +537,14 @@ def surface_generator_distance(p: np.ndarray, ref: Reference, iters: int = 100, 
     _, idx = tree.query(p)
     u = _generator_descent(p, ref.grid_u[idx // T].astype(float), ref, iters)
     dist, t, length = _foot(p, u, ref)
-    off = np.nonzero(dist > 1e-12 * ref.diagonal)[0]
+    settled = max(1e-12 * ref.diagonal, ROUNDING * float(np.abs(p).max(initial=0.0)))
+    off = np.nonzero(dist > settled)[0]
     if len(off) and starts > 1:
         _, near = tree.query(p[off], k=starts + 1)
         for k in range(1, starts + 1):
             u_k = _generator_descent(p[off], ref.grid_u[near[:, k] // T].astype(float), ref, iters)
             _keep_nearer(p, off, u_k, ref, (u, dist, t, length))
-    off = np.nonzero(dist > 1e-12 * ref.diagonal)[0]
+    off = np.nonzero(dist > settled)[0]
     if len(off) and polish:
         # Where the foot moves fast along the generator as u changes (the waist of a
         # surface close to a cone), Gauss-Newton with t held crawls: a golden-section
@@ -550,14 +555,14 @@ def surface_generator_distance(p: np.ndarray, ref: Reference, iters: int = 100, 
         # last generator whose distance falls towards the end of the patch is measured there
         # too (a linear-directrix surface whose last generator carries vertices at 2.4e-4 of
         # the diagonal by the search, 9e-17 on it).
-        off = np.nonzero(dist > 1e-12 * ref.diagonal)[0]
+        off = np.nonzero(dist > settled)[0]
         for end in (ref.grid_u[0], ref.grid_u[-1]):
             _keep_nearer(p, off, np.full(len(off), float(end)), ref, (u, dist, t, length))
         # The few points still off: every dense generator tried, then a golden section
         # around the nearest (where the surface folds towards itself, the nearest patch
         # points can all lie on another sheet: 2.1e-4 of the diagonal by the search, 6e-17
         # from the generator the vertex is on).
-        off = np.nonzero(dist > 1e-12 * ref.diagonal)[0][:_SCANNED]
+        off = np.nonzero(dist > settled)[0][:_SCANNED]
         for k in off:
             row = np.broadcast_to(p[k], (len(ref.grid_u), 3))
             best = float(ref.grid_u[int(np.argmin(_foot(row, ref.grid_u.astype(float), ref)[0]))])
