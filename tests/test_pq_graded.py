@@ -42,6 +42,19 @@ def _off_hyperboloid(v: np.ndarray, turn_deg: float) -> np.ndarray:
     return np.abs(v[:, 0] ** 2 + v[:, 1] ** 2 - r0 ** 2 - (RADIUS ** 2 - r0 ** 2) * z ** 2) / RADIUS ** 2
 
 
+def test_the_warning_names_the_cone_as_the_cause():
+    # 170 degrees: most generators take rows only from beyond the primary's point at
+    # infinity; the share warning says so (not "few generators"), a hyperboloid far from its
+    # cone does not.
+    near = pq_mesh(*_arcs(170.0, 45), rows=30, division="graded")
+    said = [w for w in near.info["warnings"] if "not in quads" in w]
+    assert said and "close to a cone" in said[0] and "few generators" not in said[0]
+    count = int(said[0].split("the rows reach ")[1].split()[0])
+    assert 3 <= count <= 45
+    far = pq_mesh(*_arcs(60.0, 45), rows=30, division="graded")
+    assert not any("close to a cone" in w for w in far.info["warnings"])
+
+
 @pytest.mark.parametrize("turn", [160.0, 165.0, 170.0])
 def test_graded_rows_keep_the_faces_fat_near_the_cone(turn):
     a, b = _arcs(turn, 45)

@@ -399,9 +399,11 @@ def pq_mesh(a, b, rows: int = 20, primary: int | str = "middle", option: int = 0
     restarts = max(len([r for r in parts if len(r.left)]) - len([s for s in segs if s.hi - s.lo >= 2]), 0)
     even = _even_ranges(parts, segs, warnings, exact=ptol <= tol.planarity, own=plan.own)
     meet, runs = np.r_[flat, False] | np.r_[False, flat], len(parts)    # meet: of a coplanar pair
+    # Read before assembling: the assembly empties the list of runs (to free their arrays).
+    known = _Causes(torsal.size, even, restarts, max((r.uncovered for r in parts), default=0))
     mesh, fattening, measured = _fattened(assemble(parts, a, d, args.trim, tol, ptol, warnings, scale, meet,
                                                    rows=rows), ptol, tol)
-    _warn_share(mesh, warnings, torsal.size, even, restarts, m, rows, (a, d, ptol), measured)
+    _warn_share(mesh, warnings, known, m, rows, (a, d, ptol), measured)
     _warn_splinters(mesh, warnings, torsal, measured)
     if kept.size < m_given:
         mesh = _renumbered(mesh, kept)
@@ -697,9 +699,18 @@ def _even_ranges(parts: list[Run], segs: list[_Segment], warnings: list[str],
     return out
 
 
-def _warn_share(mesh: Mesh, warnings: list[str], torsal: int, even: list[str], restarts: int,
-                m: int, rows: int, generators: tuple | None = None,
-                measured: tuple | None = None) -> None:
+@dataclass(frozen=True)
+class _Causes:
+    """What the build knows of why area is not in quads (:func:`_warn_share`)."""
+
+    torsal: int             # torsal generators
+    even: list[str]         # generator ranges without rows
+    restarts: int           # runs restarted where the chains drifted apart
+    uncovered: int = 0      # generators the rows reach only through the primary's infinity
+
+
+def _warn_share(mesh: Mesh, warnings: list[str], known: _Causes, m: int, rows: int,
+                generators: tuple | None = None, measured: tuple | None = None) -> None:
     """Say so when much of the area is not in quads: how much, where, why, and what to change.
 
     ``generators`` is ``(a, d, ptol)``: the generators, to count the strips that
@@ -720,10 +731,17 @@ def _warn_share(mesh: Mesh, warnings: list[str], torsal: int, even: list[str], r
     if share <= _WARN_SHARE:
         return
     causes = []
-    if torsal:
-        causes.append(f"{torsal} torsal generator{'s' * (torsal > 1)}")
-    if even:
-        causes.append(f"no rows on generators {', '.join(even[:4])}")
+    if known.torsal:
+        causes.append(f"{known.torsal} torsal generator{'s' * (known.torsal > 1)}")
+    if known.even:
+        causes.append(f"no rows on generators {', '.join(known.even[:4])}")
+    near_cone = known.uncovered >= max(3, m // 4)
+    if near_cone:
+        # A hyperboloid close to its asymptotic cone: the rows that far out crowd onto the
+        # row through the primary's point at infinity, and beyond it no row lands.
+        causes.append(f"a surface close to a cone: the rows reach {known.uncovered} generators only "
+                      f"through the primary generator's point at infinity, so part of their patch "
+                      f"has no rows")
     a, d, ptol = generators if generators is not None else (None, None, DEFAULT.planarity)
     exact = ptol <= DEFAULT.planarity
     flat = int(_nearly_flat(a, d, rows, NEARLY_DEVELOPABLE).sum()) \
@@ -735,9 +753,9 @@ def _warn_share(mesh: Mesh, warnings: list[str], torsal: int, even: list[str], r
         causes.append(f"{slender:.0%} of the area slender (the rows would cross the generators at "
                       f"under {SLENDER_DEG:.1f} degrees there: exact quads at least "
                       f"{SLENDER_ELONGATION:g}:1)")
-    if restarts:
-        causes.append(f"the two chains drifted apart ({restarts} restarts)")
-    if m < 2 * rows:
+    if known.restarts:
+        causes.append(f"the two chains drifted apart ({known.restarts} restarts)")
+    if m < 2 * rows and not near_cone:
         causes.append(f"few generators for {rows} rows")
     warnings.append(f"{share:.0%} of the area is not in quads ({'; '.join(causes) or 'border'}; "
                     f"{_where_not_quads(mesh, area, off, total)}): more generators (rulings.count), "

@@ -100,6 +100,9 @@ class Run:
     centre_gen: np.ndarray    # (F,) generator index of each centre (global)
     failing: np.ndarray       # (m,) faces on the patch not convex or too thin, per generator
     on_patch: np.ndarray      # (m,) faces on the patch, per generator
+    # Generators whose patch the rows reach only through the primary's point at infinity
+    # (no finite division covers it: patch_preimage), for the build's warning.
+    uncovered: int = 0
 
     def inside_t(self, g: int) -> np.ndarray:
         """Increasing parameters of this run's vertices on global generator ``g`` in [0, 1]."""
@@ -361,7 +364,9 @@ def mesh_run(a: np.ndarray, d: np.ndarray, first: int, primary: int, div: Divisi
     tau = _root_b_rows(M, N, tau, primary, parity)
     if side is not None:
         tau = _b_through_ends(M, tau, parity, side)
-    return _grid(a, d, first, maps, tau, parity, tol, scale, hops.crossing)
+    run = _grid(a, d, first, maps, tau, parity, tol, scale, hops.crossing)
+    run.uncovered = int(np.count_nonzero(~patch_preimage(M, tol.degenerate)[2]))
+    return run
 
 
 def _grid(a: np.ndarray, d: np.ndarray, first: int, maps: ChainMaps, tau: np.ndarray,
