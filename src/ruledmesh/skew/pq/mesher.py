@@ -396,18 +396,16 @@ def pq_mesh(a, b, rows: int = 20, primary: int | str = "middle", option: int = 0
     primary = int(np.searchsorted(kept, args.primary, side="right") - 1)
     parts = _build_all(plan, segs, primary, args.middle, Division(
         rows, 0, args.extend, args.max_extend, graded=args.division == "graded"), m)
-    restarts = max(len([r for r in parts if len(r.left)]) - len([s for s in segs if s.hi - s.lo >= 2]), 0)
     even = _even_ranges(parts, segs, warnings, exact=ptol <= tol.planarity, own=plan.own)
+    known = _Causes.of(parts, segs, torsal.size, even)    # before assemble() empties parts
     meet, runs = np.r_[flat, False] | np.r_[False, flat], len(parts)    # meet: of a coplanar pair
-    # Read before assembling: the assembly empties the list of runs (to free their arrays).
-    known = _Causes(torsal.size, even, restarts, max((r.uncovered for r in parts), default=0))
     mesh, fattening, measured = _fattened(assemble(parts, a, d, args.trim, tol, ptol, warnings, scale, meet,
                                                    rows=rows), ptol, tol)
     _warn_share(mesh, warnings, known, m, rows, (a, d, ptol), measured)
     _warn_splinters(mesh, warnings, torsal, measured)
     if kept.size < m_given:
         mesh = _renumbered(mesh, kept)
-    return mesh.with_info(runs=runs, restarts=restarts, planarity_tolerance=ptol, extend=args.extend,
+    return mesh.with_info(runs=runs, restarts=known.restarts, planarity_tolerance=ptol, extend=args.extend,
                           respace=plan.respace, division=args.division, **_rows_from_info(plan.own, kept),
                           primary="middle" if args.middle else args.primary, **fattening)
 
@@ -707,6 +705,13 @@ class _Causes:
     even: list[str]         # generator ranges without rows
     restarts: int           # runs restarted where the chains drifted apart
     uncovered: int = 0      # generators the rows reach only through the primary's infinity
+
+    @classmethod
+    def of(cls, parts: list[Run], segs: list[_Segment], torsal: int, even: list[str]) -> _Causes:
+        """The causes known from the runs ``parts`` of the segments ``segs`` (a run beyond one
+        per segment of three generators or more is a restart), and the counts given."""
+        restarts = max(len([r for r in parts if len(r.left)]) - len([s for s in segs if s.hi - s.lo >= 2]), 0)
+        return cls(torsal, even, restarts, max((r.uncovered for r in parts), default=0))
 
 
 def _warn_share(mesh: Mesh, warnings: list[str], known: _Causes, m: int, rows: int,
