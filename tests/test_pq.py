@@ -469,6 +469,36 @@ def test_rows_through_the_end_points_leave_no_teeth_on_that_curve():
         pq_mesh(A, B, rows_from="c3")
 
 
+def test_rows_through_the_end_points_on_both_curves_fill_where_one_family_turns_back():
+    """On the closed Moebius band of moebius-lines (73 lines, half-width 1 about a circle of
+    radius 4) the rows through one edge's end points turn back over a stretch before they reach
+    the other edge; the rows through both edges' end points are one division in which the other
+    family fills that stretch: less of the area in triangles than from either edge alone
+    (13.3 % against 15.4-15.6 %), every face still exact, convex and on the generators."""
+    phi = np.linspace(0.0, 2 * np.pi, 73)
+    e_r = np.stack([np.cos(phi), np.sin(phi), 0 * phi], 1)
+    e = np.cos(phi / 2)[:, None] * e_r + np.sin(phi / 2)[:, None] * np.array([0.0, 0.0, 1.0])
+    A, B = 4 * e_r - e, 4 * e_r + e
+
+    def triangles(mesh):
+        area = face_areas(mesh)
+        return area[mesh.valences == 3].sum() / area.sum()
+
+    one = [pq_mesh(A, B, rows=16, rows_from=side) for side in ("c1", "c2")]
+    both = pq_mesh(A, B, rows=16, rows_from="both")
+    assert both.info["rows_from"] == "both"
+    # The band is closed (its last line is its first, reversed): not a disc, so no Euler check.
+    assert planarity(both).max() <= DEFAULT.planarity and convexity(both).all()
+    assert face_areas(both).min() > 0
+    g, t = both.vertex_data["generator"], both.vertex_data["t"]
+    assert np.abs(both.vertices - (A[g] + t[:, None] * (B - A)[g])).max() <= 1e-12 * 5
+    assert ((t >= -1e-12) & (t <= 1 + 1e-12)).all()
+    assert triangles(both) < min(triangles(m) for m in one) - 0.015
+    # Rows pass through end points of both edges.
+    for side in (0.0, 1.0):
+        assert _quad_share_of_border_edges(both, side)[1] >= 20
+
+
 def _same_mesh(m1, m2) -> bool:
     return all(np.array_equal(getattr(m1, k), getattr(m2, k)) for k in (
         "vertices", "face_offsets", "face_indices", "face_kind", "members", "member_id"))
@@ -517,7 +547,7 @@ def test_rows_from_per_generator_give_each_segment_its_own():
 
 
 @settings(max_examples=30, deadline=None, suppress_health_check=[HealthCheck.too_slow])
-@given(seed=st.integers(0, 2**32 - 1), rows_from=st.sampled_from(["c1", "c2", "none", "mixed"]),
+@given(seed=st.integers(0, 2**32 - 1), rows_from=st.sampled_from(["c1", "c2", "both", "none", "mixed"]),
        m=st.integers(12, 61),
        rows=st.integers(4, 40), option=st.integers(0, 1))
 def test_rows_through_the_end_points_keep_the_invariants(seed, rows_from, m, rows, option):
@@ -530,7 +560,7 @@ def test_rows_through_the_end_points_keep_the_invariants(seed, rows_from, m, row
     c1 = np.c_[10 * s, np.zeros_like(s), np.zeros_like(s)] + np.sin(3 * s) * k1[0] + s ** 2 * k1[1]
     c2 = np.c_[10 * s, 2 + 0 * s, 4 + 0 * s] + np.cos(2 * s) * k2[0] + s ** 3 * k2[1]
     if rows_from == "mixed":     # per generator, at random, and the checkerboard too
-        rows_from = rng.choice(["primary", "c1", "c2", "none"], size=m).tolist()
+        rows_from = rng.choice(["primary", "c1", "c2", "both", "none"], size=m).tolist()
         option = rng.integers(0, 2, size=m).tolist()
     mesh = pq_mesh(c1, c2, rows=rows, rows_from=rows_from, option=option)
     check_mesh(mesh)

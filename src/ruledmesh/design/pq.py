@@ -299,7 +299,7 @@ def _refined(rulings, mesh, options: dict, respace_auto: bool = False, rows_from
         # as much build time again on the quality surfaces (80 -> 117 s).
         # They never bring in a splinter (linear-directrix: 29.0 -> 25.0 % with a face at
         # 2.86 degrees, a smaller miss by _fabricable, but a new kind of panel to cut).
-        tries = [{**options, "rows_from": side.value} for side in (RowsFrom.C1, RowsFrom.C2)]
+        tries = [{**options, "rows_from": side.value} for side in _THROUGH_ENDS]
         firsts = [(o, _mesh(rulings, o)) for o in tries]
         shares = [_measured(m)[0] for _, m in firsts]
         rooted, first = firsts[int(np.argmax(shares))]
@@ -497,13 +497,14 @@ def _rows_from_note(info: Mapping[str, Any]) -> str:
                 "the strips pinch, closed by strip quads and triangles): the meshes with rows had "
                 "splinters or more of their area in triangles; [mesh] rows_from chooses it")
     if "mixed" not in (side, info["option"]):
-        return (f"rows through the generators' end points on director curve {side} (no teeth of "
-                f"triangles along it): that mesh had more of its area in quads or fewer splinters; "
-                f"[mesh] rows_from chooses it")
+        on = ("both director curves (no teeth of triangles along them" if side == RowsFrom.BOTH.value
+              else f"director curve {side} (no teeth of triangles along it")
+        return (f"rows through the generators' end points on {on}): that mesh had more of its area "
+                f"in quads or fewer splinters; [mesh] rows_from chooses it")
     ranges: dict[tuple, list[str]] = {}
     for lo, hi, where, option in sorted(info["row_segments"]):
         ranges.setdefault((where, option), []).append(f"{lo}-{hi}")
-    start = {RowsFrom.PRIMARY.value: "from the primary"}
+    start = {RowsFrom.PRIMARY.value: "from the primary", RowsFrom.BOTH.value: "through the end points on both curves"}
     said = "; ".join(f"{start.get(where, 'through the end points on ' + where)}, option {option}, "
                      f"for generators {', '.join(r)}" for (where, option), r in ranges.items())
     return (f"rows {said} (each stretch between torsal generators where its faces had the fewest "
@@ -521,6 +522,11 @@ def _with_room(round_: tuple, goal: float) -> bool:
     """Whether a round's mesh meets the goals with room: no splinter and at most :data:`_ROOM`
     of the goal's share of its area in triangles."""
     return round_[1] == 0 and 1.0 - round_[0] <= _ROOM * goal
+
+
+# Where the rows may start instead of the primary's division: through the end points on
+# either director curve, or on both (MEASURED below).
+_THROUGH_ENDS = (RowsFrom.C1, RowsFrom.C2, RowsFrom.BOTH)
 
 
 def _from_either_curve(kept: tuple, rulings, options: dict, goal: float, colours: bool = True) -> tuple:
@@ -543,7 +549,7 @@ def _from_either_curve(kept: tuple, rulings, options: dict, goal: float, colours
         return kept
     mesh = kept[4]
     base = {**options, "option": mesh.info["option"], "primary": mesh.info["primary"]}
-    tries = [{**base, "rows_from": side.value} for side in (RowsFrom.C1, RowsFrom.C2)]
+    tries = [{**base, "rows_from": side.value} for side in _THROUGH_ENDS]
     mixed = _per_segment(rulings, mesh, base, colours)
     return _more_fabricable(kept, rulings, goal, tries + ([{**base, **mixed}] if mixed else []), priced=True)
 

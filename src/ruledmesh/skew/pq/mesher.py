@@ -24,6 +24,7 @@ from .pairing import pair_triangles
 from .panels import split_strip_quads
 from .respacing import evened, spread_generators
 from .runs import (
+    BOTH_ENDS,
     BYTES_PER_GRID_POINT,
     MAX_GRID_POINTS,
     Division,
@@ -344,7 +345,7 @@ def pq_mesh(a, b, rows: int = 20, primary: int | str = "middle", option: int = 0
         ``tol.planarity`` (exact to rounding).
     respace : bool
         Also restart the rows where they spread, evened there (:mod:`.respacing`).
-    rows_from : {"primary", "c1", "c2", "none"} or (m,) sequence of them
+    rows_from : {"primary", "c1", "c2", "both", "none"} or (m,) sequence of them
         Where the rows start (:class:`RowsFrom`; ``"none"``: no rows); per generator, a segment
         with a division of its own (between torsal generators) takes the value where its rows start.
     division : {"even", "graded"}
@@ -502,7 +503,9 @@ class RowsFrom(str, Enum):
     the director curve at ``t = 0`` (``t = 1``) cuts passes through a generator's end point
     there, so the border along that curve is edges of quads instead of a band of teeth; the
     rows are then as far apart as the end points' rows, and restarted runs keep their
-    matched divisions (:func:`.runs._through_ends`).  ``NONE``: no §4.3 rows; the generators
+    matched divisions (:func:`.runs._through_ends`).  ``BOTH``: rows through the end points
+    on both curves (on a Moebius band, where the rows from one edge turn back before they
+    reach the other over a stretch, those from the other edge fill it).  ``NONE``: no §4.3 rows; the generators
     carry an even division, graded where the strips pinch (:func:`.runs.graded_carrier`), and
     the strips are closed by strip quads (where planar within the tolerance) and triangles:
     the mesh of a nearly developable surface, or of one whose rows leave splinters.
@@ -511,12 +514,14 @@ class RowsFrom(str, Enum):
     PRIMARY = "primary"
     C1 = "c1"
     C2 = "c2"
+    BOTH = "both"
     NONE = "none"
 
     @property
     def ends(self) -> int | None:
-        """The end parameter the rows pass through (None: the primary's division, or no rows)."""
-        return {"primary": None, "c1": 0, "c2": 1, "none": None}[self.value]
+        """The end parameter the rows pass through (:data:`.runs.BOTH_ENDS`: both; None: the
+        primary's division, or no rows)."""
+        return {"primary": None, "c1": 0, "c2": 1, "both": BOTH_ENDS, "none": None}[self.value]
 
 
 class PrimaryDivision(str, Enum):
@@ -605,7 +610,7 @@ def _per_generator(value, m: int, name: str, check) -> np.ndarray:
 
 
 _FROM_ENDS = {_NO_ROWS: RowsFrom.NONE.value, -1: RowsFrom.PRIMARY.value, 0: RowsFrom.C1.value,
-              1: RowsFrom.C2.value}
+              1: RowsFrom.C2.value, BOTH_ENDS: RowsFrom.BOTH.value}
 
 
 def _rows_from_info(own: list, kept: np.ndarray) -> dict:

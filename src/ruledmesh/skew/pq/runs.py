@@ -50,7 +50,7 @@ from .maps import (
     propagate,
 )
 
-__all__ = ["MAX_GRID_POINTS", "Division", "Run", "carrier", "graded_carrier", "matched", "mesh_run"]
+__all__ = ["BOTH_ENDS", "MAX_GRID_POINTS", "Division", "Run", "carrier", "graded_carrier", "matched", "mesh_run"]
 
 # The grid-point limit and the memory per point: ruledmesh.budget.
 BYTES_PER_GRID_POINT = PQ_BYTES_PER_GRID_POINT
@@ -65,7 +65,8 @@ class Division:
     parameters ``matched`` (increasing, the vertices another run left on this
     generator), extended by their end spacings as far as the run needs.
     ``ends`` (0 or 1; a uniform division only) also puts a row through the end
-    point ``t = ends`` of every generator the rows cross there (:func:`_through_ends`).
+    point ``t = ends`` of every generator the rows cross there (:func:`_through_ends`);
+    :data:`BOTH_ENDS` through the end points at both ends.
     ``graded`` (not matched) spaces the rows for faces of about even shape on
     every generator they reach instead of evenly on the primary (:func:`_graded_rows`).
     """
@@ -200,6 +201,22 @@ def _matched_rows(M: np.ndarray, div: Division, tol: Tolerances) -> np.ndarray:
     return thinned_rows(M, out, (float(given[0]), float(given[-1])), div.rows)
 
 
+# Division.ends for rows through the end points on both director curves.
+BOTH_ENDS = 2
+
+
+def _sides(ends: int) -> tuple[float, ...]:
+    """The end parameters ``t`` the rows of :attr:`Division.ends` pass through."""
+    return (0.0, 1.0) if ends == BOTH_ENDS else (float(ends),)
+
+
+def _roots_through(M: np.ndarray, sides: tuple[float, ...], lo: float, hi: float, mine: np.ndarray) -> np.ndarray:
+    """Increasing root parameters in ``(lo, hi)`` of the rows through the end points ``t`` in
+    ``sides`` of the generators ``mine`` (m,) bool."""
+    roots = np.concatenate([_end_roots(M, side, lo, hi)[mine] for side in sides])
+    return np.sort(roots[np.isfinite(roots)])
+
+
 # Rows through the end points: of two roots closer than this share of an a-row step
 # (2 / rows), the second is left out (a row that meets the curve twice, on either side of
 # a turn, would otherwise be there twice) ...
@@ -216,10 +233,10 @@ def _end_roots(M: np.ndarray, side: float, lo: float, hi: float) -> np.ndarray:
     return np.where(np.isfinite(r) & (r > lo) & (r < hi), r, np.nan)
 
 
-def _through_ends(M: np.ndarray, tau: np.ndarray, parity: np.ndarray, side: float,
+def _through_ends(M: np.ndarray, tau: np.ndarray, parity: np.ndarray, sides: tuple[float, ...],
                   rows: int) -> np.ndarray:
     """Chain *a*'s roots moved so that a row passes through the end point ``t = side`` of
-    every a-generator (b-rows at the middles, rooted afterwards).
+    every a-generator, for each of ``sides`` (b-rows at the middles, rooted afterwards).
 
     Where every row the border cuts passes through a generator's end point, the
     border edges are edges of quads (the hop from one end point lands on the
@@ -228,8 +245,7 @@ def _through_ends(M: np.ndarray, tau: np.ndarray, parity: np.ndarray, side: floa
     range of these roots the uniform rows stay (rows that never reach the curve).
     """
     step = 2.0 / rows
-    ends = _end_roots(M, side, tau[0], tau[-1])
-    ends = np.sort(ends[(parity == 0) & np.isfinite(ends)])
+    ends = _roots_through(M, sides, tau[0], tau[-1], parity == 0)
     if ends.size < 2:
         return tau
     # A row close to one kept before is left out (a run of close roots keeps its first).
@@ -245,11 +261,11 @@ def _through_ends(M: np.ndarray, tau: np.ndarray, parity: np.ndarray, side: floa
     return _with_middles(a_rows, a_rows[-1] - a_rows[-2])
 
 
-def _b_through_ends(M: np.ndarray, tau: np.ndarray, parity: np.ndarray, side: float) -> np.ndarray:
-    """Chain *b*'s roots moved onto the end points ``t = side`` of the b-generators: in each
-    bracket of a-rows the end point's root nearest its middle, where one lies inside."""
-    ends = _end_roots(M, side, tau[0], tau[-1])
-    ends = np.sort(ends[(parity == 1) & np.isfinite(ends)])
+def _b_through_ends(M: np.ndarray, tau: np.ndarray, parity: np.ndarray,
+                    sides: tuple[float, ...]) -> np.ndarray:
+    """Chain *b*'s roots moved onto the end points ``t`` in ``sides`` of the b-generators: in
+    each bracket of a-rows the end point's root nearest its middle, where one lies inside."""
+    ends = _roots_through(M, sides, tau[0], tau[-1], parity == 1)
     if ends.size == 0:
         return tau
     lo, hi = tau[0:-2:2], tau[2::2]
@@ -352,9 +368,9 @@ def mesh_run(a: np.ndarray, d: np.ndarray, first: int, primary: int, div: Divisi
     else:
         tau = _uniform_rows(M, div, first + primary, tol, warnings)
     parity = (np.arange(m) - primary) % 2                     # 0: chain a, 1: chain b
-    side = None if div.ends is None or div.matched is not None else float(div.ends)
-    if side is not None:
-        tau = _through_ends(M, tau, parity, side, div.rows)
+    sides = None if div.ends is None or div.matched is not None else _sides(div.ends)
+    if sides is not None:
+        tau = _through_ends(M, tau, parity, sides, div.rows)
     H = len(tau) // 2
     if m * 2 * H > MAX_GRID_POINTS:
         need = m * 2 * H * BYTES_PER_GRID_POINT / 2**30
@@ -362,8 +378,8 @@ def mesh_run(a: np.ndarray, d: np.ndarray, first: int, primary: int, div: Divisi
                             f"reduce the generator count, the rows or the extension")
     N = drift_maps(a, d, M, hops.crossing)
     tau = _root_b_rows(M, N, tau, primary, parity)
-    if side is not None:
-        tau = _b_through_ends(M, tau, parity, side)
+    if sides is not None:
+        tau = _b_through_ends(M, tau, parity, sides)
     run = _grid(a, d, first, maps, tau, parity, tol, scale, hops.crossing)
     run.uncovered = int(np.count_nonzero(~patch_preimage(M, tol.degenerate)[2]))
     return run

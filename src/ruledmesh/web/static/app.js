@@ -1290,7 +1290,7 @@ function choiceList(path, name) {
   if (name === 'distribution') return ch.distributions;
   if (name === 'method' && path[0] === 'mesh') return ch.methods;
   if (name === 'type' && path[0] === 'curves') return ch.curve_types;
-  if (name === 'rows_from' && path[0] === 'mesh') return ['auto', 'primary', 'c1', 'c2', 'none'];
+  if (name === 'rows_from' && path[0] === 'mesh') return ['auto', 'primary', 'c1', 'c2', 'both', 'none'];
   if (name === 'division' && path[0] === 'mesh') return ['auto', 'even', 'graded'];
   return null;
 }
