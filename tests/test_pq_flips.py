@@ -166,13 +166,18 @@ def test_a_doubled_generator_is_left_out():
 
 
 def test_a_sign_change_of_the_twist_leaves_no_doubled_vertices():
-    """The cusp surface: the segments on either side of the torsal strip do not share a
-    generator with two divisions on it (they left slivers 1e-4 of a generator long)."""
+    """The cusp surface: the segments on either side of the torsal strip do not leave a
+    doubled division on a generator (two divisions 1e-4 of a generator apart made slivers).
+    Where two segments meet in a zipper on the torsal generator, each with a division of its
+    own, their vertices can come close by chance (7e-4 of the generator with the rows through
+    both curves' end points that the build keeps, 1.3e-3 from the primary), never doubled,
+    and the faces there keep their angles."""
     mesh = build_file(ROOT / "benchmarks" / "quality" / "cusp.toml").mesh
     g, t = mesh.vertex_data["generator"], mesh.vertex_data["t"]
     order = np.lexsort((t, g))
     same = g[order][1:] == g[order][:-1]
-    assert np.diff(t[order])[same].min() >= 1e-3
+    assert np.diff(t[order])[same].min() >= 5e-4
+    assert face_min_angles(mesh).min() >= 3.0
 
 
 def test_flip_count_is_reported():
