@@ -80,11 +80,11 @@ SMALL_DESIGN = _shared.SMALL_DESIGN
 LONGEST_FIRST = ("test_quality.py",            # 230 s
                  "test_fuzz.py",               # 170 s
                  "test_designer_browser.py",   # 110 s
-                 "test_pq_splinters.py",       # 90 s
                  "test_designer.py",           # 80 s
                  "test_pq_quality.py",         # 60 s
                  "test_pq_choice.py",          # 55 s
-                 "test_fuzz_cli.py")           # 55 s
+                 "test_fuzz_cli.py",           # 55 s
+                 "test_pq_splinters.py")       # 45 s
 
 
 def pytest_collection_modifyitems(config, items):
