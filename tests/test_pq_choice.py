@@ -4,6 +4,7 @@ from pathlib import Path
 from types import SimpleNamespace
 
 import numpy as np
+import pytest
 
 from ruledmesh.analysis.faces import area_shares, convexity, degenerate_faces, face_min_angles, planarity
 from ruledmesh.design import build_design, parse_design
@@ -14,6 +15,7 @@ from ruledmesh.design.pq import (
     _fabricable,
     _worth_its_panels,
 )
+from ruledmesh.errors import DesignError
 from ruledmesh.pq import pq_mesh
 
 QUALITY = Path(__file__).resolve().parents[1] / "benchmarks" / "quality"
@@ -248,6 +250,10 @@ def test_rows_through_the_end_points_where_the_mesh_keeps_teeth():
     assert fixed.info["rows_from"] == "primary"
     assert not any("rows_from" in w for w in fixed.info["warnings"])
     assert 1.0 - area_shares(fixed)["quads"] > 0.24
+    both = build_design(parse_design(text.replace("[mesh]", '[mesh]\nrows_from = "both"'))).mesh
+    assert both.info["rows_from"] == "both" and not any("rows_from" in w for w in both.info["warnings"])
+    with pytest.raises(DesignError, match=r"mesh\.rows_from"):
+        build_design(parse_design(text.replace("[mesh]", '[mesh]\nrows_from = "c3"')))
 
 
 def test_the_refinement_rounds_start_from_the_end_points_too():
