@@ -114,16 +114,17 @@ class Run:
         return np.sort(self.t[sel])
 
 
-def _uniform_rows(M: np.ndarray, div: Division, primary_global: int, tol: Tolerances,
+def _uniform_rows(M: np.ndarray, div: Division, primary_global: int, preimage: tuple,
                   warnings: list[str]) -> np.ndarray:
-    """Root parameters of all rows, uniform in ``1 / rows``; even entries on the primary.
+    """Root parameters of all rows, uniform in ``1 / rows``; even entries on the primary
+    (``preimage``: :func:`~.maps.patch_preimage` of ``M``).
 
     Beyond the primary's part the rows that would bunch on every generator are
     left out (:func:`~ruledmesh.skew.pq.extension.thinned_rows`).
     """
     rows = div.rows
     if isinstance(div.extend, str):         # "auto" or "full": what covers the patch
-        lo_v, hi_v = _covering(M, div, tol, warnings)
+        lo_v, hi_v = _covering(preimage, div, warnings)
         # Two rows of margin on each side: a face spans two row steps.
         j0 = math.floor(lo_v * rows) - 2
         j1 = math.ceil(hi_v * rows) + 2
@@ -140,10 +141,11 @@ def _uniform_rows(M: np.ndarray, div: Division, primary_global: int, tol: Tolera
     return thinned_rows(M, tau, (0.0, 1.0), rows) if div.extend == "auto" else tau
 
 
-def _covering(M: np.ndarray, div: Division, tol: Tolerances, warnings: list[str]) -> tuple[float, float]:
+def _covering(preimage: tuple, div: Division, warnings: list[str]) -> tuple[float, float]:
     """The range of the primary's parameter whose rows cover the patch on every generator
-    (with [0, 1]), capped at ``div.max_extend``; a warning where no finite range does."""
-    lo, hi, bounded = patch_preimage(M, tol.degenerate)
+    (with [0, 1]), capped at ``div.max_extend``; a warning where no finite range does.
+    ``preimage``: the row maps' :func:`~.maps.patch_preimage`."""
+    lo, hi, bounded = preimage
     if not np.all(bounded):
         warnings.append(f"{int((~bounded).sum())} generators cannot be covered by a finite "
                         f"division of the primary generator; extension capped at "
@@ -173,14 +175,15 @@ def _with_middles(a_rows: np.ndarray, last_step: float) -> np.ndarray:
     return out
 
 
-def _matched_rows(M: np.ndarray, div: Division, tol: Tolerances) -> np.ndarray:
-    """Root parameters from a matched division, extended by the end spacings.
+def _matched_rows(M: np.ndarray, div: Division, preimage: tuple) -> np.ndarray:
+    """Root parameters from a matched division, extended by the end spacings
+    (``preimage``: :func:`~.maps.patch_preimage` of ``M``).
 
     Beyond the given rows those that would bunch on every generator are left out
     (unless ``div.extend`` is ``"full"``).
     """
     given = np.asarray(div.matched, dtype=np.float64)
-    lo, hi, bounded = patch_preimage(M, tol.degenerate)
+    lo, hi, bounded = preimage
     lo_v = max(lo[bounded].min() if bounded.any() else 0.0, -div.max_extend)
     hi_v = min(hi[bounded].max() if bounded.any() else 1.0, 1.0 + div.max_extend)
     if given.size == 1:
@@ -359,14 +362,15 @@ def mesh_run(a: np.ndarray, d: np.ndarray, first: int, primary: int, div: Divisi
     maps = chain_maps(a, d, primary, hops)
     primary = maps.primary
     M = compose(maps, m)
+    preimage = patch_preimage(M, tol.degenerate)
     if div.matched is not None and len(div.matched):
-        tau = _matched_rows(M, div, tol)
+        tau = _matched_rows(M, div, preimage)
     elif div.graded and m >= 3:
-        lo, hi = _covering(M, div, tol, warnings) if isinstance(div.extend, str) else \
+        lo, hi = _covering(preimage, div, warnings) if isinstance(div.extend, str) else \
             (-float(div.extend), 1.0 + float(div.extend))
         tau = graded_rows(a, d, M, lo, hi, div.rows, bool((first + primary - div.option) % 2))
     else:
-        tau = _uniform_rows(M, div, first + primary, tol, warnings)
+        tau = _uniform_rows(M, div, first + primary, preimage, warnings)
     parity = (np.arange(m) - primary) % 2                     # 0: chain a, 1: chain b
     sides = None if div.ends is None or div.matched is not None else _sides(div.ends)
     if sides is not None:
@@ -381,7 +385,7 @@ def mesh_run(a: np.ndarray, d: np.ndarray, first: int, primary: int, div: Divisi
     if sides is not None:
         tau = _b_through_ends(M, tau, parity, sides)
     run = _grid(a, d, first, maps, tau, parity, tol, scale, hops.crossing)
-    run.uncovered = int(np.count_nonzero(~patch_preimage(M, tol.degenerate)[2]))
+    run.uncovered = int(np.count_nonzero(~preimage[2]))
     return run
 
 
