@@ -34,8 +34,8 @@ def caught(monkeypatch):
     calls: list[tuple] = []
     real = collapses.collapse_splinters
 
-    def spy(mesh, *args):
-        out, n = real(mesh, *args)
+    def spy(mesh, *args, **kwargs):
+        out, n = real(mesh, *args, **kwargs)
         scale = args[1] if len(args) > 1 and args[1] is not None else \
             float(np.linalg.norm(mesh.vertices.max(0) - mesh.vertices.min(0)))
         calls.append((mesh, out, n, scale))

@@ -32,8 +32,8 @@ def caught(monkeypatch):
     for name in ("snap_to_border", "trim_border_needles", "open_walled_splinters"):
         real = getattr(splinters, name)
 
-        def spy(mesh, *args, _real=real, _name=name):
-            out, n = _real(mesh, *args)
+        def spy(mesh, *args, _real=real, _name=name, **kwargs):
+            out, n = _real(mesh, *args, **kwargs)
             calls.append((_name, mesh, out, n))
             return out, n
 

@@ -11,7 +11,7 @@ become beams or cables, paper §6).
 
 from __future__ import annotations
 
-from collections.abc import Iterable, Mapping
+from collections.abc import Callable, Iterable, Mapping
 from dataclasses import dataclass, field, replace
 from enum import IntEnum
 from typing import Any
@@ -220,12 +220,36 @@ class Mesh:
         """Number of faces."""
         return int(self.face_offsets.shape[0] - 1)
 
+    def _derived(self, name: str, make: Callable[[], np.ndarray]) -> np.ndarray:
+        """``make()``, computed once per mesh and kept read-only.
+
+        The mesh is immutable, so arrays derived from its faces hold for its life;
+        a build's passes ask for the same ones many times (at 1000 x 1000 each
+        costs several milliseconds).  Read-only, so that a caller changing one
+        in place fails at once instead of corrupting the next caller's.
+        """
+        cache = self.__dict__.get("_cache")
+        if cache is None:
+            cache = {}
+            object.__setattr__(self, "_cache", cache)
+        out = cache.get(name)
+        if out is None:
+            out = make()
+            out.setflags(write=False)
+            cache[name] = out
+        return out
+
     @property
     def valences(self) -> np.ndarray:
-        """(F,) int64: number of vertices of each face."""
+        """(F,) int64: number of vertices of each face (read-only)."""
         # np.diff's result, without its argument handling (a build asks this hundreds of times).
         off = self.face_offsets
-        return np.subtract(off[1:], off[:-1])
+        return self._derived("valences", lambda: np.subtract(off[1:], off[:-1]))
+
+    @property
+    def face_of(self) -> np.ndarray:
+        """(N,) int64: for each entry of ``face_indices``, the face it belongs to (read-only)."""
+        return self._derived("face_of", lambda: np.repeat(np.arange(self.n_faces), self.valences))
 
     @property
     def kinds(self) -> np.ndarray:
@@ -267,10 +291,13 @@ class Mesh:
         return self.face_indices[self.face_offsets[f]:self.face_offsets[f + 1]]
 
     def next_corners(self) -> np.ndarray:
-        """(N,) int64: for each entry of ``face_indices``, the position of the next corner of its face."""
-        nxt = np.arange(self.face_indices.size) + 1
-        nxt[self.face_offsets[1:] - 1] = self.face_offsets[:-1]
-        return nxt
+        """(N,) int64: for each entry of ``face_indices``, the position of the next corner of its
+        face (read-only)."""
+        def make() -> np.ndarray:
+            nxt = np.arange(self.face_indices.size) + 1
+            nxt[self.face_offsets[1:] - 1] = self.face_offsets[:-1]
+            return nxt
+        return self._derived("next_corners", make)
 
     def edge_uses(self) -> tuple[np.ndarray, np.ndarray]:
         """Sorted undirected edge keys ``low * n_vertices + high`` and how many faces use each.
@@ -365,15 +392,25 @@ class Mesh:
 
     def compact(self) -> Mesh:
         """Drop vertices used by no face and no member, renumbering the rest."""
+        return self._compacted()[0]
+
+    def compact_index(self) -> tuple[Mesh, np.ndarray]:
+        """:meth:`compact`, and (V,) int64 the new index of each vertex (-1: dropped)."""
+        out, used = self._compacted()
+        if used is None:
+            return out, np.arange(self.n_vertices)
+        return out, np.where(used, np.cumsum(used) - 1, -1)
+
+    def _compacted(self) -> tuple[Mesh, np.ndarray | None]:
         used = np.zeros(self.n_vertices, dtype=bool)
         used[self.face_indices] = True
         used[self.members.reshape(-1)] = True
         if used.all():
-            return self
+            return self, None
         new = np.cumsum(used) - 1
         vdata = {k: v[used] for k, v in self.vertex_data.items()}
         return replace(self, vertices=self.vertices[used], face_indices=new[self.face_indices],
-                       members=new[self.members], vertex_data=vdata)
+                       members=new[self.members], vertex_data=vdata), used
 
     def merge_vertices(self, tol: float = ROUNDING) -> Mesh:
         """Merge vertices closer than ``tol`` times the diagonal (exact grid snap).
@@ -409,7 +446,7 @@ class Mesh:
         keep = idx != idx[self.next_corners()]
         if keep.all() and np.all(self.members[:, 0] != self.members[:, 1]):
             return self
-        face_of = np.repeat(np.arange(self.n_faces), self.valences)
+        face_of = self.face_of
         val = np.bincount(face_of[keep], minlength=self.n_faces)
         ok_face = val >= 3
         keep &= ok_face[face_of]

@@ -167,7 +167,7 @@ def dumpb(mesh: Mesh, shading: str = "flat", quads: str = "shorter") -> bytes:
     centre = mesh.bounding_box().mean(axis=0)
     # Newell sums lose digits far from the origin: take normals of the centred mesh.
     normals, areas = face_normals(mesh.with_vertices(mesh.vertices - centre))
-    corner_face = np.repeat(np.arange(mesh.n_faces), mesh.valences)
+    corner_face = mesh.face_of
     if shading == "flat":
         corner_normal = normals[corner_face]
     else:

@@ -428,7 +428,7 @@ def thick_panels(structure: SupportStructure, thickness: float, *, side: str = "
     full = structure.mesh
     normals, area = face_normals(full)
     sign = -1.0 if side == "outer" else 1.0
-    face_of = np.repeat(np.arange(full.n_faces), full.valences)
+    face_of = full.face_of
     cos = np.einsum("ij,ij->i", sign * structure.axes[full.face_indices], normals[face_of])
     first = np.repeat(full.face_offsets[:-1], full.valences)
     # A panel needs every corner's axis well out of its plane, all on one side.
@@ -439,7 +439,7 @@ def thick_panels(structure: SupportStructure, thickness: float, *, side: str = "
     cos, face_ids = cos[keep_corner], np.flatnonzero(good)
     _, _, nxt = face_edges(mesh)
     idx = mesh.face_indices
-    local_face = np.repeat(np.arange(mesh.n_faces), mesh.valences)
+    local_face = mesh.face_of
     top = mesh.vertices[idx]
     bottom = top + (thickness / np.abs(cos))[:, None] * (sign * structure.axes[idx])
     verts = np.concatenate([top, bottom])

@@ -98,7 +98,7 @@ def edge_parallelism(vertices: np.ndarray, offset: np.ndarray, edges: np.ndarray
 def face_parallelism(mesh: Mesh, offset: np.ndarray) -> np.ndarray:
     """(F,) float64: offset corners' distance from the plane parallel to their face / diagonal."""
     n0, _ = face_normals(mesh)
-    face_of = np.repeat(np.arange(mesh.n_faces), mesh.valences)
+    face_of = mesh.face_of
     first = offset[mesh.face_indices[np.repeat(mesh.face_offsets[:-1], mesh.valences)]]
     gap = np.abs(np.einsum("ij,ij->i", offset[mesh.face_indices] - first, n0[face_of]))
     out = np.zeros(mesh.n_faces)

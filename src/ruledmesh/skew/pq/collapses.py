@@ -121,7 +121,7 @@ def _directed(tri: np.ndarray, free: np.ndarray) -> tuple[np.ndarray, np.ndarray
 
 def _touching(mesh: Mesh, mark: np.ndarray) -> np.ndarray:
     """(F,) bool: the faces with a corner where ``mark`` (V,) is true."""
-    face_of = np.repeat(np.arange(mesh.n_faces), mesh.valences)
+    face_of = mesh.face_of
     return np.bincount(face_of[mark[mesh.face_indices]], minlength=mesh.n_faces) > 0
 
 
@@ -289,7 +289,7 @@ def _apply(mesh: Mesh, v: np.ndarray, u: np.ndarray) -> tuple[Mesh, np.ndarray]:
     remap[v] = u
     removed = np.zeros(n, bool)
     removed[v] = True
-    face_of = np.repeat(np.arange(mesh.n_faces), mesh.valences)
+    face_of = mesh.face_of
     kind = mesh.face_kind.copy()
     kind[face_of[removed[mesh.face_indices]]] = FaceKind.FILL
     members, member_id = _rejoined(mesh.members, mesh.member_id, removed, n)
@@ -305,7 +305,7 @@ def _apply(mesh: Mesh, v: np.ndarray, u: np.ndarray) -> tuple[Mesh, np.ndarray]:
 
 
 def collapse_splinters(mesh: Mesh, removable: np.ndarray | None = None,
-                       scale: float | None = None) -> tuple[Mesh, int]:
+                       scale: float | None = None, *, report: dict | None = None) -> tuple[Mesh, int]:
     """Remove triangle-only vertices of splinters where that fattens the faces around them.
 
     Parameters
@@ -318,6 +318,8 @@ def collapse_splinters(mesh: Mesh, removable: np.ndarray | None = None,
     scale : float, optional
         Length the sag bound is relative to (default: the mesh's bounding-box
         diagonal; a part of a mesh passes the whole one's).
+    report : dict, optional
+        Filled with ``"touched"``: (V_out,) bool, the vertices the removed ones went into.
 
     Returns
     -------
@@ -336,6 +338,7 @@ def collapse_splinters(mesh: Mesh, removable: np.ndarray | None = None,
     # neighbours, edges and border are unchanged, so its verdict is too).
     watch = None
     ghosts, anchors = np.zeros((0, 3)), np.zeros(0, np.int64)
+    into_kept = np.zeros(0, np.int64)           # the vertices collapsed into, numbered now
     for _ in range(_ROUNDS):
         val = mesh.valences
         if not (val == 3).any():
@@ -387,21 +390,35 @@ def collapse_splinters(mesh: Mesh, removable: np.ndarray | None = None,
         ghosts = np.concatenate([ghosts, V[v[take]]])
         anchors = into[np.concatenate([anchors, v[take]])]
         mesh, new_index = _apply(mesh, v[take], u[take])
+        into_kept = _renumbered(new_index, np.concatenate([into_kept, u[take]]))
         anchors = new_index[anchors]
         ghosts, anchors = ghosts[anchors >= 0], anchors[anchors >= 0]
         if removable is not None:
-            gone = np.zeros(n, bool)
-            gone[v[take]] = True
-            removable = removable[~gone]
-            if removable.size != mesh.n_vertices:     # compaction dropped others: stop here
-                removable = np.zeros(mesh.n_vertices, bool)
+            removable = _still_removable(removable, v[take], mesh.n_vertices)
         total += int(take.size)
         watch = _rings(mesh, new_index[u[take]], 2)
         waiting = np.ones(v.size, bool)
         waiting[take] = False
         waiting &= ~member(v, v[take])
         watch[new_index[v[waiting]]] = True
+    if report is not None:
+        report["touched"] = np.bincount(into_kept, minlength=mesh.n_vertices) > 0
     return mesh, total
+
+
+def _renumbered(new_index: np.ndarray, idx: np.ndarray) -> np.ndarray:
+    """The vertices ``idx`` in the new numbers, those removed left out."""
+    out = new_index[idx]
+    return out[out >= 0]
+
+
+def _still_removable(removable: np.ndarray, gone: np.ndarray, n_new: int) -> np.ndarray:
+    """``removable`` (V,) bool without the vertices ``gone``, for the ``n_new`` vertices left;
+    none where the compaction dropped others too (the marks no longer line up)."""
+    keep = np.ones(removable.size, bool)
+    keep[gone] = False
+    removable = removable[keep]
+    return removable if removable.size == n_new else np.zeros(n_new, bool)
 
 
 def _rings(mesh: Mesh, seeds: np.ndarray, k: int) -> np.ndarray:

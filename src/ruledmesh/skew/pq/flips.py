@@ -30,11 +30,14 @@ from ...tolerances import (
     SPLINTER_FLIP_MAX_SAG,
     TINY,
 )
-from .pairing import _adjacent
+from .pairing import _adjacent, _around, _corners
 
 __all__ = ["flip_splinters", "flip_triangles"]
 
 _ROUNDS = 40
+# A run ``near`` a change weighs the triangles this many corner-sharing steps from it: a
+# flip there may make its neighbours' flips worth taking, two or three steps on.
+NEAR_RINGS = 4
 
 
 def _angles(P: np.ndarray) -> np.ndarray:
@@ -67,31 +70,12 @@ def _edge_keys(mesh_faces: list[np.ndarray], n: int, among: np.ndarray) -> np.nd
     return unique(np.concatenate(keys)) if keys else np.zeros(0, np.int64)
 
 
-def _corners(tri: np.ndarray, n: int) -> np.ndarray:
-    """(n,) bool: the vertices that are corners of the triangles ``tri`` (T, 3)."""
-    out = np.zeros(n, bool)
-    out[tri.reshape(-1)] = True
-    return out
-
-
 def _ring(t1: np.ndarray, t2: np.ndarray, mark: np.ndarray) -> np.ndarray:
     """``mark`` (T,) bool and the triangles sharing an edge with a marked one."""
     out = mark.copy()
     out[t2[mark[t1]]] = True
     out[t1[mark[t2]]] = True
     return out
-
-
-def _around(tri: np.ndarray, n: int, mark: np.ndarray, times: int) -> np.ndarray:
-    """(T,) bool: ``mark`` and the triangles ``times`` corner-sharing steps from a marked one.
-
-    A triangle sharing an edge with another shares a corner with it, so this
-    holds every triangle ``times`` edge-sharing steps away (and some more).
-    """
-    for _ in range(times):
-        hit = _corners(tri[mark], n)
-        mark = hit[tri[:, 0]] | hit[tri[:, 1]] | hit[tri[:, 2]]
-    return mark
 
 
 def _pair_measures(V: np.ndarray, a: np.ndarray, b: np.ndarray, c: np.ndarray, d: np.ndarray,
@@ -250,7 +234,8 @@ def _retriangulated(mesh: Mesh, ids: np.ndarray, tri: np.ndarray, before: np.nda
 
 
 def flip_triangles(mesh: Mesh, changeable: np.ndarray | None = None,
-                   scale: float | None = None) -> tuple[Mesh, int]:
+                   scale: float | None = None, *, near: np.ndarray | None = None,
+                   report: dict | None = None) -> tuple[Mesh, int]:
     """Re-cut pairs of adjacent triangles for a larger smallest angle.
 
     Parameters
@@ -262,6 +247,16 @@ def flip_triangles(mesh: Mesh, changeable: np.ndarray | None = None,
     scale : float, optional
         Length the sag bound is relative to (default: the mesh's bounding-box
         diagonal; a part of a mesh passes the whole one's).
+    near : (V,) bool, optional
+        Only the triangles within :data:`NEAR_RINGS` corner-sharing steps of a
+        face at these vertices take part: a run after a local change to a mesh
+        whose flips had settled, which finds the flips a run over the whole
+        mesh would (no flip was left elsewhere), at the cost of the region.
+    report : dict, optional
+        Filled with ``"settled"`` (bool: the last round made no flip, so a later
+        run may take ``near``), ``"touched"`` ((V,) bool: the corners of the
+        flipped triangles) and ``"again"`` ((V,) bool: the corners of the
+        triangles a later run weighs that this one did not, see :func:`_report`).
 
     Returns
     -------
@@ -271,30 +266,33 @@ def flip_triangles(mesh: Mesh, changeable: np.ndarray | None = None,
     int
         Number of flips made.
     """
+    if report is not None:
+        report.update(settled=True, touched=np.zeros(mesh.n_vertices, bool),
+                      again=np.zeros(mesh.n_vertices, bool))
     val = mesh.valences
     is_tri = val == 3
     if is_tri.sum() < 2:
         return mesh, 0
     V = mesh.vertices
-    n = len(V)
     scale = scale or diagonal(V) or 1.0
     ids = np.flatnonzero(is_tri)
     tri_all = mesh.face_indices[mesh.face_offsets[ids][:, None] + np.arange(3)].astype(np.int64)
-    live, ang, adjacency = _active(V, tri_all)
+    if near is not None:
+        live, ang = _active_near(V, tri_all, near)
+        adjacency = None
+    else:
+        live, ang, adjacency = _active(V, tri_all)
     if changeable is not None and not changeable[ids].all():
         live &= changeable[ids]
         adjacency = None        # the rounds find the pairs among the triangles left
     if not live.any():
         return mesh, 0
-    others = [tri_all[~live]]
-    for k in unique(val[~is_tri]).tolist():
-        f = np.flatnonzero(val == k)
-        others.append(mesh.face_indices[mesh.face_offsets[f][:, None] + np.arange(k)])
     tri = tri_all[live]
-    fixed = _edge_keys(others, n, _corners(tri, n))
+    fixed = _fixed_edges(mesh, ids, live, tri)
     tmin = ang[live]
     before = tri.copy()
     flips = 0
+    made = 0
     changed = None
     for _ in range(_ROUNDS):
         changed = _round(V, tri, tmin, fixed, scale, changed, adjacency)
@@ -302,9 +300,72 @@ def flip_triangles(mesh: Mesh, changeable: np.ndarray | None = None,
         flips += made
         if made == 0:
             break
+    if report is not None:
+        report["settled"] = made == 0
     if flips == 0:
         return mesh, 0
+    if report is not None:
+        _report(report, tri_all, live, tri, before, tmin)
     return _retriangulated(mesh, ids[live], tri, before), flips
+
+
+def _report(report: dict, tri_all: np.ndarray, live: np.ndarray, tri: np.ndarray, before: np.ndarray,
+            tmin: np.ndarray) -> None:
+    """Mark in ``report`` the corners of the flipped triangles (``"touched"``) and of the
+    triangles a later run over the whole mesh would weigh that this run did not (``"again"``).
+
+    A run weighs the triangles near the thin ones it starts with.  A flip that leaves a
+    triangle thin brings its neighbours into a later run's reach: those that were not
+    ``live`` (T,) here may have flips to offer; every other pair was weighed and
+    settled.  ``tri`` are the live triangles now (``before`` as they were, ``tmin``
+    their smallest angles now).
+    """
+    flipped = (tri != before).any(axis=1)
+    report["touched"][tri[flipped]] = True
+    thin = np.zeros(len(tri_all), bool)
+    thin[np.flatnonzero(live)[flipped & (tmin < FLIP_ACTIVE_DEG)]] = True
+    if thin.any():
+        now = tri_all.copy()
+        now[live] = tri
+        report["again"][now[_around(now, len(report["again"]), thin, 2) & ~live]] = True
+
+
+def _active_near(V: np.ndarray, tri: np.ndarray, near: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """:func:`_active`'s marks and angles for the triangles within :data:`NEAR_RINGS` steps
+    of a triangle with a corner in ``near`` (V,) bool; the others unmarked (angles 0).
+
+    The marks of those need the thin triangles two steps further: only that region is
+    measured.
+    """
+    n = len(V)
+    core = _around(tri, n, near[tri[:, 0]] | near[tri[:, 1]] | near[tri[:, 2]], NEAR_RINGS)
+    rows = np.flatnonzero(_around(tri, n, core, 2))
+    live = np.zeros(len(tri), bool)
+    ang = np.zeros(len(tri))
+    if rows.size:
+        live_r, ang[rows], _ = _active(V, tri[rows])
+        live[rows] = live_r & core[rows]
+    return live, ang
+
+
+def _fixed_edges(mesh: Mesh, ids: np.ndarray, live: np.ndarray, tri: np.ndarray) -> np.ndarray:
+    """Sorted edge keys of the faces other than the ``live`` triangles (``tri``; ``ids`` (T,)
+    the faces of all triangles) that join two of their corners: the edges no flip may make
+    again.
+
+    Only faces with a corner among the live triangles' can have such an edge: the
+    others (most of a large mesh) are not read.
+    """
+    n = len(mesh.vertices)
+    corners = _corners(tri, n)
+    faces = unique(mesh.face_of[np.flatnonzero(corners[mesh.face_indices])])
+    is_live = np.zeros(mesh.n_faces, bool)
+    is_live[ids[live]] = True
+    faces = faces[~is_live[faces]]
+    val = mesh.valences[faces]
+    others = [mesh.face_indices[mesh.face_offsets[f][:, None] + np.arange(k)]
+              for k in unique(val).tolist() for f in [faces[val == k]]]
+    return _edge_keys(others, n, corners)
 
 
 def _splinter_pairs(V: np.ndarray, tri: np.ndarray, tmin: np.ndarray, on_generator: np.ndarray,

@@ -436,34 +436,50 @@ def _cut(a, d, rows, ptol, scale, tol, creases, crease_generators, warnings):
 def _fattened(mesh: Mesh, ptol: float, tol: Tolerances) -> tuple[Mesh, dict[str, int], tuple | None]:
     """Flip the triangles for their angles, collapse what flips cannot fatten, pair the
     triangles in tolerance mode, flip what is left; then the splinters left: corners a
-    sliver from the border snapped onto it, quads walling a splinter in opened; last, strip
+    sliver from the border snapped onto it, quads walling a splinter opened; last, strip
     quads much larger than the other panels cut.
 
     The third result: the (F,) smallest angles and areas of the faces of the mesh
     returned, where the opening measured them and left the mesh as it was (else None).
     The caller does not keep ``mesh``, so each pass frees the mesh it replaces (a
     1000 x 1000 build's is 50 MB).
+
+    A flip or pairing run after the first weighs only the faces near what the passes
+    since changed (:class:`_Changes`): elsewhere it would find nothing new, and on a large
+    mesh a whole run costs a tenth of a second or more for a collapse or two.
     """
     mesh, snapped = snap_to_border(mesh)
-    mesh, flips = flip_triangles(mesh)
-    mesh, trimmed = trim_border_needles(mesh)
-    mesh, collapsed = collapse_splinters(mesh)
+    mesh = replace(mesh, vertex_data={**mesh.vertex_data, _FID: np.arange(mesh.n_vertices)})
+    unflipped, unpaired = _Changes(), _Changes()
+    report: dict = {}
+    mesh, flips = flip_triangles(mesh, report=report)
+    unflipped.settle(mesh, report)
+    mesh, trimmed = trim_border_needles(mesh, report=report)
+    unflipped.add(mesh, report)
+    mesh, collapsed = collapse_splinters(mesh, report=report)
+    unflipped.add(mesh, report)
     if collapsed:
-        mesh, more = flip_triangles(mesh)
+        mesh, more = flip_triangles(mesh, near=unflipped.near(mesh), report=report)
+        unflipped.settle(mesh, report)
         flips += more
-    mesh, paired = _paired(mesh, ptol, tol)
+    mesh, paired = pair_triangles(mesh, _pairing_tolerance(ptol, tol), report=report)
+    unpaired.settle(mesh, report)
+    unflipped.add(mesh, report)
     if paired:
-        mesh, more = flip_triangles(mesh)
+        mesh, more = flip_triangles(mesh, near=unflipped.near(mesh), report=report)
+        unpaired.add(mesh, report)
         flips += more
     from ...analysis.faces import face_min_angles, face_normals
 
     measured = (face_min_angles(mesh), face_normals(mesh)[1]) if mesh.n_faces else None
     # Whether the mesh measured is the one returned (each pass returns its input where it
     # changes nothing), told without holding on to it: a large mesh is 50 MB.
-    mesh, opened, same = _pass(open_walled_splinters, mesh, _reflipped, measured)
+    mesh, opened, same = _pass(open_walled_splinters, mesh, _reflipped, measured, report=report)
     if opened:
-        mesh, more = _paired(mesh, ptol, tol)
+        unpaired.add(mesh, report)
+        mesh, more = pair_triangles(mesh, _pairing_tolerance(ptol, tol), near=unpaired.near(mesh))
         paired += more
+    mesh = replace(mesh, vertex_data={k: v for k, v in mesh.vertex_data.items() if k != _FID})
     mesh, more, kept = _pass(flip_splinters, mesh)
     flips += more
     mesh, cut, kept_too = _pass(split_strip_quads, mesh)
@@ -472,9 +488,47 @@ def _fattened(mesh: Mesh, ptol: float, tol: Tolerances) -> tuple[Mesh, dict[str,
                   "trimmed": trimmed, "opened": opened, "cut": cut}, (measured if same else None)
 
 
-def _pass(step: Callable[..., tuple[Mesh, int]], mesh: Mesh, *args) -> tuple[Mesh, int, bool]:
-    """``step(mesh, *args)``'s mesh and count, and whether that mesh is ``mesh`` itself."""
-    out, n = step(mesh, *args)
+# The persistent vertex id of :class:`_Changes`, dropped before the mesh leaves :func:`_fattened`.
+_FID = "_fid"
+
+
+class _Changes:
+    """The vertices near which the mesh changed since a pass (the flips, the pairing) last
+    settled, or None: anywhere (its last run ran out of rounds, so a later one must weigh
+    the whole mesh).
+
+    Vertices are named by ``vertex_data["_fid"]``: the passes between drop vertices and
+    renumber the rest in order, and the vertex data goes with them.
+    """
+
+    def __init__(self) -> None:
+        self.ids: np.ndarray | None = np.zeros(0, np.int64)
+
+    def add(self, mesh: Mesh, report: dict) -> None:
+        """Add the vertices ``report["touched"]`` (V,) bool of ``mesh`` marks."""
+        if self.ids is not None:
+            self.ids = unique(np.concatenate([self.ids, np.asarray(mesh.vertex_data[_FID])[report["touched"]]]))
+
+    def settle(self, mesh: Mesh, report: dict) -> None:
+        """The pass ran on ``mesh`` (its output); it settled everywhere if ``report["settled"]``,
+        but near ``report["again"]`` (V,) bool, where its own changes make more worth weighing
+        (a flip can leave a thin triangle, and a run over the whole mesh would weigh the
+        triangles around it)."""
+        self.ids = np.zeros(0, np.int64) if report["settled"] else None
+        self.add(mesh, {"touched": report["again"]})
+
+    def near(self, mesh: Mesh) -> np.ndarray | None:
+        """(V,) bool of ``mesh``: the vertices changed; None: everywhere."""
+        if self.ids is None:
+            return None
+        fid = np.asarray(mesh.vertex_data[_FID])
+        pos = np.minimum(np.searchsorted(self.ids, fid), max(self.ids.size - 1, 0))
+        return self.ids[pos] == fid if self.ids.size else np.zeros(len(fid), bool)
+
+
+def _pass(step: Callable[..., tuple[Mesh, int]], mesh: Mesh, *args, **kwargs) -> tuple[Mesh, int, bool]:
+    """``step(mesh, *args, **kwargs)``'s mesh and count, and whether that mesh is ``mesh`` itself."""
+    out, n = step(mesh, *args, **kwargs)
     return out, n, out is mesh
 
 
@@ -487,7 +541,7 @@ def _reflipped(mesh: Mesh, frozen: np.ndarray, scale: float) -> Mesh:
     """
     def changeable(m: Mesh) -> np.ndarray:
         at = frozen[np.asarray(m.vertex_data["_id"])][m.face_indices]
-        return np.bincount(np.repeat(np.arange(m.n_faces), m.valences)[at], minlength=m.n_faces) == 0
+        return np.bincount(m.face_of[at], minlength=m.n_faces) == 0
 
     mesh, _ = flip_triangles(mesh, changeable(mesh), scale)
     mesh, collapsed = collapse_splinters(mesh, ~frozen[np.asarray(mesh.vertex_data["_id"])], scale)
@@ -797,8 +851,8 @@ def _where_not_quads(mesh: Mesh, area: np.ndarray, off: np.ndarray, total: float
     return ", ".join(said)
 
 
-def _paired(mesh: Mesh, ptol: float, tol: Tolerances) -> tuple[Mesh, int]:
-    """Triangle pairs planar within the tolerance become quads.
+def _pairing_tolerance(ptol: float, tol: Tolerances) -> float:
+    """The tolerance triangle pairs are made quads within (:func:`.pairing.pair_triangles`).
 
     In exact mode that is within the exact bar: two halves of one planar quad
     that the cuts kept apart, or a notch half and a border triangle that happen
@@ -806,7 +860,7 @@ def _paired(mesh: Mesh, ptol: float, tol: Tolerances) -> tuple[Mesh, int]:
     """
     # A margin below the stated tolerance, so that rounding in another reader's
     # measure cannot push a paired quad over it.
-    return pair_triangles(mesh, _PAIRING_MARGIN * max(ptol, tol.planarity))
+    return _PAIRING_MARGIN * max(ptol, tol.planarity)
 
 
 def _warn_splinters(mesh: Mesh, warnings: list[str], torsal: np.ndarray,

@@ -66,7 +66,27 @@ def _adjacent(tri: np.ndarray, n: int):
             tri[t2, (j2 + 2) % 3], ks)
 
 
-def pair_triangles(mesh: Mesh, ptol: float, kinds: tuple[int, ...] | None = None) -> tuple[Mesh, int]:
+def _corners(tri: np.ndarray, n: int) -> np.ndarray:
+    """(n,) bool: the vertices that are corners of the triangles ``tri`` (T, 3)."""
+    out = np.zeros(n, bool)
+    out[tri.reshape(-1)] = True
+    return out
+
+
+def _around(tri: np.ndarray, n: int, mark: np.ndarray, times: int) -> np.ndarray:
+    """(T,) bool: ``mark`` and the triangles ``times`` corner-sharing steps from a marked one.
+
+    A triangle sharing an edge with another shares a corner with it, so this
+    holds every triangle ``times`` edge-sharing steps away (and some more).
+    """
+    for _ in range(times):
+        hit = _corners(tri[mark], n)
+        mark = hit[tri[:, 0]] | hit[tri[:, 1]] | hit[tri[:, 2]]
+    return mark
+
+
+def pair_triangles(mesh: Mesh, ptol: float, kinds: tuple[int, ...] | None = None, *,
+                   near: np.ndarray | None = None, report: dict | None = None) -> tuple[Mesh, int]:
     """Merge pairs of triangles into quads planar within ``ptol``.
 
     Parameters
@@ -78,6 +98,16 @@ def pair_triangles(mesh: Mesh, ptol: float, kinds: tuple[int, ...] | None = None
     kinds : tuple of int, optional
         Face kinds whose triangles may be paired (default: fill, border and
         split halves).
+    near : (V,) bool, optional
+        Only the triangles two corner-sharing steps or fewer from a triangle with a
+        corner here take part: a run after a local change to a mesh whose pairing had
+        settled (no pair was left that both triangles could take), which finds the
+        pairs a run over the whole mesh would.
+    report : dict, optional
+        Filled with ``"settled"`` (bool: every pair that passes was taken or lost a
+        triangle to another, rather than the rounds running out), ``"touched"``
+        ((V,) bool: the corners of the quads made) and ``"again"`` (none: a pair
+        made leaves the other triangles as they were).
 
     Returns
     -------
@@ -90,6 +120,9 @@ def pair_triangles(mesh: Mesh, ptol: float, kinds: tuple[int, ...] | None = None
     """
     from ...analysis.faces import SPLINTER_DEG, min_corner_angles, quad_diagonal_crossing, quad_planarity
 
+    if report is not None:
+        report.update(settled=True, touched=np.zeros(mesh.n_vertices, bool),
+                      again=np.zeros(mesh.n_vertices, bool))
     if kinds is None:
         kinds = (FaceKind.FILL, FaceKind.BORDER, FaceKind.SPLIT)
     val = mesh.valences
@@ -98,6 +131,10 @@ def pair_triangles(mesh: Mesh, ptol: float, kinds: tuple[int, ...] | None = None
         return mesh, 0
     V = mesh.vertices
     tri = mesh.face_indices[mesh.face_offsets[ids][:, None] + np.arange(3)]
+    if near is not None:
+        # Rows in order: the pairs come in the same order and with the same sides.
+        rows = np.flatnonzero(_around(tri, len(V), near[tri[:, 0]] | near[tri[:, 1]] | near[tri[:, 2]], 2))
+        ids, tri = ids[rows], tri[rows]
     t1, t2, a, b, c, d = adjacent_triangles(tri, len(V))
     quad = np.stack([a, b, d, c], axis=1)
     if t1.size == 0:
@@ -109,24 +146,44 @@ def pair_triangles(mesh: Mesh, ptol: float, kinds: tuple[int, ...] | None = None
     sq, tq, _ = quad_diagonal_crossing(P)
     ang = min_corner_angles(V, quad)
     tri_min = np.zeros(len(tri))
-    near = unique(np.concatenate([t1, t2]))
-    tri_min[near] = min_corner_angles(V, tri[near])
+    paired = unique(np.concatenate([t1, t2]))
+    tri_min[paired] = min_corner_angles(V, tri[paired])
     ok = (sq > _MIN_CROSSING) & (sq < 1 - _MIN_CROSSING) \
         & (tq > _MIN_CROSSING) & (tq < 1 - _MIN_CROSSING) \
         & (ang >= np.minimum(tri_min[t1], tri_min[t2])) & (ang >= SPLINTER_DEG)
     t1, t2, quad, score = t1[ok], t2[ok], quad[ok], ang[ok]
-    taken = np.zeros(len(tri), bool)
+    chosen, taken, settled = _matched(t1, t2, score, len(tri))
+    made = np.flatnonzero(chosen)
+    if report is not None:
+        report["settled"] = settled
+        report["touched"][quad[made]] = True
+    if made.size == 0:
+        return mesh, 0
+    g = np.sort(np.asarray(mesh.vertex_data["generator"])[quad[made]], axis=1)
+    on_two = (g[:, 1:] != g[:, :-1]).sum(axis=1) <= 1
+    keep = np.ones(mesh.n_faces, bool)
+    keep[ids[taken]] = False
+    return _rebuilt(mesh, keep, quad[made], np.where(on_two, FaceKind.STRIP, FaceKind.QUAD)), int(made.size)
+
+
+def _matched(t1: np.ndarray, t2: np.ndarray, score: np.ndarray, n: int) -> tuple[np.ndarray, np.ndarray, bool]:
+    """Pairs ``t1, t2`` (P,) of ``n`` triangles taken by rounds of mutual best ``score``.
+
+    Returns (P,) bool the pairs taken, (n,) bool the triangles in them, and whether
+    every pair left has a triangle taken (else the rounds ran out first).
+    """
+    taken = np.zeros(n, bool)
     chosen = np.zeros(len(t1), bool)
     for _ in range(_ROUNDS):
         live = ~taken[t1] & ~taken[t2] & ~chosen
         if not live.any():
-            break
-        best = np.full(len(tri), -1.0)
+            return chosen, taken, True
+        best = np.full(n, -1.0)
         np.maximum.at(best, t1[live], score[live])
         np.maximum.at(best, t2[live], score[live])
         # Ties: the first candidate of each triangle wins, so both ends agree.
         top = live & (score >= best[t1]) & (score >= best[t2])
-        first_of = np.full(len(tri), len(t1))
+        first_of = np.full(n, len(t1))
         cand = np.flatnonzero(top)
         np.minimum.at(first_of, t1[cand], cand)
         np.minimum.at(first_of, t2[cand], cand)
@@ -136,14 +193,7 @@ def pair_triangles(mesh: Mesh, ptol: float, kinds: tuple[int, ...] | None = None
         chosen[mutual] = True
         taken[t1[mutual]] = True
         taken[t2[mutual]] = True
-    made = np.flatnonzero(chosen)
-    if made.size == 0:
-        return mesh, 0
-    g = np.sort(np.asarray(mesh.vertex_data["generator"])[quad[made]], axis=1)
-    on_two = (g[:, 1:] != g[:, :-1]).sum(axis=1) <= 1
-    keep = np.ones(mesh.n_faces, bool)
-    keep[ids[taken]] = False
-    return _rebuilt(mesh, keep, quad[made], np.where(on_two, FaceKind.STRIP, FaceKind.QUAD)), int(made.size)
+    return chosen, taken, not (~taken[t1] & ~taken[t2] & ~chosen).any()
 
 
 def _rebuilt(mesh: Mesh, keep: np.ndarray, quads: np.ndarray, quad_kind: np.ndarray) -> Mesh:

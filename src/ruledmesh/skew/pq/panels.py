@@ -91,7 +91,7 @@ def _neighbours(mesh: Mesh, a: np.ndarray, b: np.ndarray) -> tuple[np.ndarray, n
     pos = lookup(b.astype(np.int64) * n + a, key[order])
     found = pos >= 0
     corner = np.where(found, order[pos], -1)
-    face_of = np.repeat(np.arange(mesh.n_faces), mesh.valences)
+    face_of = mesh.face_of
     face = np.where(found, face_of[np.maximum(corner, 0)], -1)
     tri = found & (mesh.valences[np.maximum(face, 0)] == 3)
     # In a triangle (b, a, x) the corner after a is x.

@@ -55,7 +55,7 @@ def _splinter_edges(mesh: Mesh, amin: np.ndarray) -> np.ndarray:
     n = np.int64(mesh.n_vertices)
     idx = mesh.face_indices
     nxt = idx[mesh.next_corners()]
-    face_of = np.repeat(np.arange(mesh.n_faces), mesh.valences)
+    face_of = mesh.face_of
     bad = ((amin < RESTART_ANGLE_DEG) & (mesh.valences == 3))[face_of]
     return unique(np.minimum(idx, nxt)[bad] * n + np.maximum(idx, nxt)[bad])
 
@@ -126,7 +126,8 @@ def snap_to_border(mesh: Mesh) -> tuple[Mesh, int]:
     return moved, int(v.size)
 
 
-def trim_border_needles(mesh: Mesh, scale: float | None = None) -> tuple[Mesh, int]:
+def trim_border_needles(mesh: Mesh, scale: float | None = None, *,
+                        report: dict | None = None) -> tuple[Mesh, int]:
     """Drop border vertices whose faces are all needles, where the border moves by a hair.
 
     Where the generators meet a director curve at a grazing angle, an end
@@ -146,6 +147,9 @@ def trim_border_needles(mesh: Mesh, scale: float | None = None) -> tuple[Mesh, i
     scale : float, optional
         Length the bound is relative to (default: the mesh's bounding-box diagonal).
 
+    report : dict, optional
+        Filled with ``"touched"``: (V_out,) bool, the rim vertices of the fans dropped.
+
     Returns
     -------
     Mesh
@@ -153,11 +157,13 @@ def trim_border_needles(mesh: Mesh, scale: float | None = None) -> tuple[Mesh, i
     int
         Number of vertices dropped.
     """
+    if report is not None:
+        report["touched"] = np.zeros(mesh.n_vertices, bool)
     if mesh.n_faces == 0:
         return mesh, 0
     n = np.int64(mesh.n_vertices)
     idx = mesh.face_indices
-    face_of = np.repeat(np.arange(mesh.n_faces), mesh.valences)
+    face_of = mesh.face_of
     needle = _triangle_min_angles(mesh) < RESTART_ANGLE_DEG
     faces_at = np.bincount(idx, minlength=n)
     cand = (faces_at > 0) & (np.bincount(idx[needle[face_of]], minlength=n) == faces_at)
@@ -201,7 +207,11 @@ def trim_border_needles(mesh: Mesh, scale: float | None = None) -> tuple[Mesh, i
     drop = np.zeros(mesh.n_faces, bool)
     drop[tid[rows[ok[owner]]]] = True
     members, member_id = _rejoined(mesh.members, mesh.member_id, ok, int(n))
-    out = replace(mesh.select_faces(~drop), members=members, member_id=member_id).compact()
+    out, new_index = replace(mesh.select_faces(~drop), members=members, member_id=member_id).compact_index()
+    if report is not None:
+        rim = new_index[np.concatenate([p, q])[np.tile(ok[owner], 2)]]
+        report["touched"] = np.zeros(out.n_vertices, bool)
+        report["touched"][rim[rim >= 0]] = True
     return out, int(ok.sum())
 
 
@@ -241,7 +251,7 @@ def _around_min(mesh: Mesh, groups: list[np.ndarray]) -> tuple[np.ndarray, np.nd
     for g in groups:
         there = g >= 0                          # (-1: a vertex the mesh no longer has)
         slot[g[there]] = np.arange(g.size)[there]
-    face_of = np.repeat(np.arange(mesh.n_faces), mesh.valences)
+    face_of = mesh.face_of
     s = slot[mesh.face_indices]
     out = np.full(groups[0].size, 180.0)
     angles = face_min_angles(mesh)
@@ -330,7 +340,8 @@ def _short_edges(mesh: Mesh, bad: np.ndarray) -> np.ndarray:
 
 
 def open_walled_splinters(mesh: Mesh, fatten: Callable[[Mesh, np.ndarray, float], Mesh],
-                          measured: tuple[np.ndarray, np.ndarray] | None = None) -> tuple[Mesh, int]:
+                          measured: tuple[np.ndarray, np.ndarray] | None = None, *,
+                          report: dict | None = None) -> tuple[Mesh, int]:
     """Cut the quads beside the splinters left into triangles and fatten again.
 
     Only a neighbourhood of the splinters is re-cut: the faces within two
@@ -351,6 +362,8 @@ def open_walled_splinters(mesh: Mesh, fatten: Callable[[Mesh, np.ndarray, float]
         region mesh numbers its vertices in ``mesh`` by ``vertex_data["_id"]``.
     measured : ((F,) float64, (F,) float64), optional
         ``face_min_angles(mesh)`` and ``face_normals(mesh)[1]`` if the caller has them.
+    report : dict, optional
+        Filled with ``"touched"``: (V_out,) bool, the corners of the re-cut faces kept.
 
     Returns
     -------
@@ -359,6 +372,9 @@ def open_walled_splinters(mesh: Mesh, fatten: Callable[[Mesh, np.ndarray, float]
         Number of quads opened (net of those joined again).
     """
     opened = 0
+    touched = np.zeros(mesh.n_vertices, bool)
+    if report is not None:
+        report["touched"] = touched
     if mesh.n_faces == 0:
         return mesh, 0
     amin, area = measured if measured is not None else (face_min_angles(mesh), face_normals(mesh)[1])
@@ -387,10 +403,17 @@ def open_walled_splinters(mesh: Mesh, fatten: Callable[[Mesh, np.ndarray, float]
         quads = new_of[ids[quads]]
         whole = (quads >= 0).all(axis=1)
         done = _joined_again(done, quads[whole], kinds[whole])
-        mesh, amin, n_open = _kept_pieces(mesh, amin, region, sub, done, total)
+        mesh, amin, n_open, new_index, spliced = _kept_pieces(mesh, amin, region, sub, done, total)
+        if new_index is not None:
+            moved = new_index[np.flatnonzero(touched)]
+            touched = np.zeros(mesh.n_vertices, bool)
+            touched[moved[moved >= 0]] = True
+            touched[spliced] = True
         opened += n_open
         if n_open == 0 and k > 0:
             break       # nothing changed: a further round would open the same quads
+    if report is not None:
+        report["touched"] = touched
     return mesh, opened
 
 
@@ -398,7 +421,7 @@ def _region(mesh: Mesh, region: np.ndarray) -> tuple[Mesh, np.ndarray]:
     """The faces marked ``region`` (F,) as a mesh of their own vertices, numbered in
     ``mesh`` by ``vertex_data["_id"]`` (no members), and (V,) the vertices of ``mesh``
     that a face outside the region also has."""
-    face_of = np.repeat(np.arange(mesh.n_faces), mesh.valences)
+    face_of = mesh.face_of
     frozen = np.zeros(mesh.n_vertices, bool)
     frozen[mesh.face_indices[~region[face_of]]] = True
     sub = Mesh(mesh.vertices, mesh.face_offsets, mesh.face_indices, mesh.face_kind,
@@ -427,11 +450,13 @@ def _components(n: int, a: np.ndarray, b: np.ndarray) -> np.ndarray:
 
 
 def _kept_pieces(mesh: Mesh, amin: np.ndarray, region: np.ndarray, sub: Mesh, done: Mesh,
-                 total: float) -> tuple[Mesh, np.ndarray, int]:
+                 total: float) -> tuple[Mesh, np.ndarray, int, np.ndarray | None, np.ndarray]:
     """``mesh`` with the pieces of ``region`` (``sub``) where ``done``, their re-cut faces, is
     better.
 
-    Returns the mesh, its (F,) smallest face angles and the number of quads opened.
+    Returns the mesh, its (F,) smallest face angles, the number of quads opened, the new
+    index of each old vertex (-1: removed; None: the mesh is unchanged) and the corners
+    of the faces put in (new numbers).
     """
 
     n = sub.n_vertices
@@ -460,7 +485,7 @@ def _kept_pieces(mesh: Mesh, amin: np.ndarray, region: np.ndarray, sub: Mesh, do
     better = (now < was) | ((now == was) & (lo_new > lo_old))
     take = better & (lost <= _OPEN_MAX_SHARE * np.maximum(was - now, 0) * total)
     if not take.any():
-        return mesh, amin, 0
+        return mesh, amin, 0, None, np.zeros(0, np.int64)
     swap = np.zeros(mesh.n_faces, bool)
     swap[np.flatnonzero(region)[take[old_piece]]] = True
     part = done.select_faces(take[new_piece])
@@ -469,10 +494,11 @@ def _kept_pieces(mesh: Mesh, amin: np.ndarray, region: np.ndarray, sub: Mesh, do
     kept[done_ids] = True
     removed = np.zeros(mesh.n_vertices, bool)
     removed[ids] = ~kept[ids] & take[label]
-    out = _spliced(mesh, swap, part, removed)
+    out, new_index = _spliced(mesh, swap, part, removed)
     out_min = np.concatenate([amin[~swap], new_min[take[new_piece]]])
     n_open = int((mesh.valences[swap] == 4).sum() - (part.valences == 4).sum())
-    return out, out_min, n_open
+    put_in = new_index[np.asarray(part.vertex_data["_id"])[part.face_indices]]
+    return out, out_min, n_open, new_index, put_in
 
 
 def _beside(mesh: Mesh, amin: np.ndarray, bad: np.ndarray, ends: bool = True) -> np.ndarray:
@@ -480,7 +506,7 @@ def _beside(mesh: Mesh, amin: np.ndarray, bad: np.ndarray, ends: bool = True) ->
     keys = _splinter_edges(mesh, amin)
     n = np.int64(mesh.n_vertices)
     idx = mesh.face_indices
-    face_of = np.repeat(np.arange(mesh.n_faces), mesh.valences)
+    face_of = mesh.face_of
     # Only the corners of faces at a splinter's corners can be on its edges.
     at = np.zeros(mesh.n_vertices, bool)
     at[keys // n] = True
@@ -500,9 +526,10 @@ def _beside(mesh: Mesh, amin: np.ndarray, bad: np.ndarray, ends: bool = True) ->
     return beside & (mesh.valences == 4)
 
 
-def _spliced(mesh: Mesh, replaced: np.ndarray, part: Mesh, removed: np.ndarray) -> Mesh:
+def _spliced(mesh: Mesh, replaced: np.ndarray, part: Mesh, removed: np.ndarray) -> tuple[Mesh, np.ndarray]:
     """``mesh`` with its faces marked ``replaced`` (F,) swapped for the faces of ``part``
-    (appended, in order) and the vertices marked ``removed`` (V,) taken out.
+    (appended, in order) and the vertices marked ``removed`` (V,) taken out; (V,) the new
+    index of each vertex (-1: dropped).
 
     ``part`` came from ``mesh`` with ``vertex_data["_id"]`` numbering its vertices in
     ``mesh``; the members are joined across the removed vertices.
@@ -514,4 +541,4 @@ def _spliced(mesh: Mesh, replaced: np.ndarray, part: Mesh, removed: np.ndarray) 
     out = Mesh(mesh.vertices, off, np.concatenate([kept.face_indices, ids[part.face_indices]]),
                np.concatenate([kept.face_kind, part.face_kind]), members, member_id,
                mesh.vertex_data, mesh.info)
-    return out.compact()
+    return out.compact_index()
