@@ -26,9 +26,9 @@ from dataclasses import replace
 
 import numpy as np
 
-from ..._arrays import diagonal, unique
+from ..._arrays import diagonal, ranks, unique
 from ...analysis.faces import face_min_angles, face_normals
-from ...mesh import FaceKind, Mesh
+from ...mesh import FaceKind, Mesh, offsets_from_valences
 from ...tolerances import (
     BORDER_TRIM_MAX_GAP,
     ON_BORDER,
@@ -53,11 +53,10 @@ _OPEN_MAX_SPLINTERS = 0.05
 def _splinter_edges(mesh: Mesh, amin: np.ndarray) -> np.ndarray:
     """Sorted undirected edge keys of the triangles below the splinter bar."""
     n = np.int64(mesh.n_vertices)
-    idx = mesh.face_indices
-    nxt = idx[mesh.next_corners()]
-    face_of = mesh.face_of
-    bad = ((amin < RESTART_ANGLE_DEG) & (mesh.valences == 3))[face_of]
-    return unique(np.minimum(idx, nxt)[bad] * n + np.maximum(idx, nxt)[bad])
+    bad = np.flatnonzero((amin < RESTART_ANGLE_DEG) & (mesh.valences == 3))
+    T = mesh.face_indices[mesh.face_offsets[bad][:, None] + np.arange(3)]
+    a, b = T.reshape(-1), T[:, [1, 2, 0]].reshape(-1)
+    return unique(np.minimum(a, b) * n + np.maximum(a, b))
 
 
 def snap_to_border(mesh: Mesh) -> tuple[Mesh, int]:
@@ -420,14 +419,23 @@ def open_walled_splinters(mesh: Mesh, fatten: Callable[[Mesh, np.ndarray, float]
 def _region(mesh: Mesh, region: np.ndarray) -> tuple[Mesh, np.ndarray]:
     """The faces marked ``region`` (F,) as a mesh of their own vertices, numbered in
     ``mesh`` by ``vertex_data["_id"]`` (no members), and (V,) the vertices of ``mesh``
-    that a face outside the region also has."""
-    face_of = mesh.face_of
-    frozen = np.zeros(mesh.n_vertices, bool)
-    frozen[mesh.face_indices[~region[face_of]]] = True
-    sub = Mesh(mesh.vertices, mesh.face_offsets, mesh.face_indices, mesh.face_kind,
+    that a face outside the region also has.
+
+    Read from the region's faces alone (the region is small, the mesh may be large),
+    but for one count of the faces at every vertex.
+    """
+    faces = np.flatnonzero(region)
+    val = mesh.valences[faces]
+    corners = mesh.face_indices[np.repeat(mesh.face_offsets[faces], val) + ranks(val)]
+    ids = unique(corners)
+    local = np.searchsorted(ids, corners)
+    faces_at = np.bincount(mesh.face_indices, minlength=mesh.n_vertices)
+    frozen = faces_at > 0
+    frozen[ids] = faces_at[ids] > np.bincount(local, minlength=ids.size)
+    sub = Mesh(mesh.vertices[ids], offsets_from_valences(val), local, mesh.face_kind[faces],
                np.zeros((0, 2), np.int64), np.zeros(0, np.int64),
-               {**mesh.vertex_data, "_id": np.arange(mesh.n_vertices)}, mesh.info)
-    return sub.select_faces(region).compact(), frozen
+               {**{k: v[ids] for k, v in mesh.vertex_data.items()}, "_id": ids}, mesh.info)
+    return sub, frozen
 
 
 def _components(n: int, a: np.ndarray, b: np.ndarray) -> np.ndarray:
