@@ -11,6 +11,7 @@ become beams or cables, paper §6).
 
 from __future__ import annotations
 
+import weakref
 from collections.abc import Callable, Iterable, Mapping
 from dataclasses import dataclass, field, replace
 from enum import IntEnum
@@ -68,6 +69,22 @@ def offsets_from_valences(valences: np.ndarray) -> np.ndarray:
     offsets = np.zeros(len(valences) + 1, dtype=np.int64)
     np.cumsum(valences, out=offsets[1:])
     return offsets
+
+
+# id(face_offsets) -> (weak reference to that array, arrays derived from it); an entry goes
+# when its array does.
+_BY_OFFSETS: dict[int, tuple[weakref.ref, dict[str, np.ndarray]]] = {}
+
+
+def _offsets_cache(offsets: np.ndarray) -> dict[str, np.ndarray]:
+    """The cache of arrays derived from ``offsets``, shared by every mesh built on it."""
+    key = id(offsets)
+    entry = _BY_OFFSETS.get(key)
+    if entry is not None and entry[0]() is offsets:
+        return entry[1]
+    cache: dict[str, np.ndarray] = {}
+    _BY_OFFSETS[key] = (weakref.ref(offsets, lambda _, key=key: _BY_OFFSETS.pop(key, None)), cache)
+    return cache
 
 
 @dataclass(frozen=True, eq=False)
@@ -220,17 +237,27 @@ class Mesh:
         """Number of faces."""
         return int(self.face_offsets.shape[0] - 1)
 
+    def __getstate__(self) -> dict[str, Any]:
+        # The derived arrays stay behind: a pickled mesh (the designer's worker sends one
+        # per edit) carries what it is made of, not what was computed from it.
+        state = dict(self.__dict__)
+        state.pop("_cache", None)
+        return state
+
     def _derived(self, name: str, make: Callable[[], np.ndarray]) -> np.ndarray:
-        """``make()``, computed once per mesh and kept read-only.
+        """``make()``, computed once per ``face_offsets`` array and kept read-only.
 
         The mesh is immutable, so arrays derived from its faces hold for its life;
         a build's passes ask for the same ones many times (at 1000 x 1000 each
-        costs several milliseconds).  Read-only, so that a caller changing one
-        in place fails at once instead of corrupting the next caller's.
+        costs several milliseconds).  The ones asked for here depend on the
+        offsets alone, and a pass that changes corners but not the faces' sizes
+        keeps the offsets array: the meshes it makes share them.  Read-only, so
+        that a caller changing one in place fails at once instead of corrupting
+        the next caller's.
         """
         cache = self.__dict__.get("_cache")
         if cache is None:
-            cache = {}
+            cache = _offsets_cache(self.face_offsets)
             object.__setattr__(self, "_cache", cache)
         out = cache.get(name)
         if out is None:

@@ -23,6 +23,8 @@ Collapses are chosen by rounds of best choice, whole arrays per round.
 
 from __future__ import annotations
 
+from dataclasses import replace
+
 import numpy as np
 
 from ..._arrays import cross, diagonal, lookup, member, unique
@@ -134,14 +136,20 @@ def _border_vertices(keys: np.ndarray, uses: np.ndarray, n: int) -> np.ndarray:
 
 
 def _near(mesh: Mesh, vertices: np.ndarray) -> Mesh:
-    """The faces with a corner among ``vertices`` (all vertices kept).
+    """The faces with a corner among ``vertices`` and the members with an end there (all
+    vertices kept).
 
     Every face around a candidate's two ends is there, so the edges at them,
-    their uses and the neighbours they share are those of the whole mesh.
+    their uses and the neighbours they share are those of the whole mesh; so are
+    the members at them (a vertex a member ends at outlives its faces).  The other
+    members are left out: a large mesh has a million, and the collapses measured
+    on this part of it would join and renumber every one.
     """
     mark = np.zeros(mesh.n_vertices, bool)
     mark[vertices] = True
-    return mesh.select_faces(_touching(mesh, mark))
+    at = mark[mesh.members[:, 0]] | mark[mesh.members[:, 1]]
+    return replace(mesh.select_faces(_touching(mesh, mark)), members=mesh.members[at],
+                   member_id=mesh.member_id[at])
 
 
 def _collapsed_star(tri, stars: _Stars, v, u):
