@@ -27,7 +27,7 @@ from dataclasses import replace
 
 import numpy as np
 
-from ..._arrays import cross, diagonal, lookup, member, unique
+from ..._arrays import cross, diagonal, lookup, member, norm, unique
 from ...analysis.faces import min_corner_angles
 from ...mesh import FaceKind, Mesh
 from ...tolerances import COLLAPSE_MAX_SAG, FLIP_MAX_BEND_DEG, FLIP_MIN_GAIN_DEG, RESTART_ANGLE_DEG, TINY
@@ -53,7 +53,7 @@ def _segment_distance(p: np.ndarray, a: np.ndarray, b: np.ndarray) -> np.ndarray
     """(k,) distance of points ``p`` from segments ``a b`` (all (k, 3))."""
     ab = b - a
     s = np.clip(np.einsum("ij,ij->i", p - a, ab) / np.maximum(np.einsum("ij,ij->i", ab, ab), TINY), 0, 1)
-    return np.linalg.norm(p - a - s[:, None] * ab, axis=1)
+    return norm(p - a - s[:, None] * ab)
 
 
 def _triangle_distance(p: np.ndarray, P: np.ndarray) -> np.ndarray:
@@ -183,12 +183,12 @@ def _evaluate(V, tri, stars: _Stars, keys, faces_at, v, u, scale) -> tuple[np.nd
     P0 = V[old]
     star = np.zeros((C, 3))
     np.add.at(star, rep, cross(P0[:, 1] - P0[:, 0], P0[:, 2] - P0[:, 0]))
-    star /= np.maximum(np.linalg.norm(star, axis=1, keepdims=True), TINY)
+    star /= np.maximum(norm(star), TINY)[:, None]
     n_new = _normals(Pn)
     cos = np.cos(np.radians(FLIP_MAX_BEND_DEG))
     bend = (np.einsum("ij,ij->i", _normals(P0[keep]), n_new) >= cos) | (
         (old_ang[keep] < RESTART_ANGLE_DEG) & (np.einsum("ij,ij->i", star[rep[keep]], n_new) >= cos))
-    bad = ~bend | (np.linalg.norm(n_new, axis=1) < 0.5)
+    bad = ~bend | (norm(n_new) < 0.5)
     gain = new_min - old_min
     ok = (np.bincount(rep[keep][bad], minlength=C) == 0) & (gain > FLIP_MIN_GAIN_DEG)
     removed = np.bincount(rep[gone], minlength=C)

@@ -18,7 +18,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..._arrays import cross, diagonal, lookup, unique
+from ..._arrays import cross, diagonal, lookup, norm, unique
 from ...analysis.faces import min_corner_angles
 from ...kernels import wanted
 from ...mesh import FaceKind, Mesh
@@ -49,7 +49,7 @@ def _angles(P: np.ndarray) -> np.ndarray:
 
 def _unit_normals(p, q, r) -> np.ndarray:
     n = cross(q - p, r - p)
-    return n / np.maximum(np.linalg.norm(n, axis=1, keepdims=True), TINY)
+    return n / np.maximum(norm(n), TINY)[:, None]
 
 
 def _edge_keys(mesh_faces: list[np.ndarray], n: int, among: np.ndarray) -> np.ndarray:
@@ -95,7 +95,7 @@ def _pair_measures(V: np.ndarray, a: np.ndarray, b: np.ndarray, c: np.ndarray, d
     n1, n2 = _unit_normals(A, B, C), _unit_normals(B, D, C)
     m1, m2 = _unit_normals(A, B, D), _unit_normals(A, D, C)
     mean = n1 + n2
-    mean /= np.maximum(np.linalg.norm(mean, axis=1, keepdims=True), TINY)
+    mean /= np.maximum(norm(mean), TINY)[:, None]
     # The flipped pair's height over the old one: how far the surface moves.
     sag = np.abs(np.einsum("ij,ij->i", 0.5 * (A + D) - 0.5 * (B + C), mean))
     ok = (new > old + FLIP_MIN_GAIN_DEG) & (np.einsum("ij,ij->i", n1, n2) >= bend) \
@@ -395,7 +395,7 @@ def _splinter_pairs(V: np.ndarray, tri: np.ndarray, tmin: np.ndarray, on_generat
     m1, m2 = _unit_normals(A, B, D), _unit_normals(A, D, C)
     bend = np.cos(np.radians(FLIP_MAX_BEND_DEG))
     across = cross(D - A, C - B)
-    height = np.abs(np.einsum("ij,ij->i", B - A, across)) / np.maximum(np.linalg.norm(across, axis=1), TINY)
+    height = np.abs(np.einsum("ij,ij->i", B - A, across)) / np.maximum(norm(across), TINY)
     new_key = np.minimum(a, d) * n + np.maximum(a, d)
     ok = (new > old + FLIP_MIN_GAIN_DEG) & (np.einsum("ij,ij->i", m1, m2) >= bend) \
         & (np.einsum("ij,ij->i", m1, fat) >= bend) & (np.einsum("ij,ij->i", m2, fat) >= bend) \
