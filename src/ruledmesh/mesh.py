@@ -248,8 +248,7 @@ class Mesh:
         """``make()``, computed once per ``face_offsets`` array and kept read-only.
 
         The mesh is immutable, so arrays derived from its faces hold for its life;
-        a build's passes ask for the same ones many times (at 1000 x 1000 each
-        costs several milliseconds).  The ones asked for here depend on the
+        a build asks for the valences hundreds of times.  They depend on the
         offsets alone, and a pass that changes corners but not the faces' sizes
         keeps the offsets array: the meshes it makes share them.  Read-only, so
         that a caller changing one in place fails at once instead of corrupting
@@ -275,8 +274,13 @@ class Mesh:
 
     @property
     def face_of(self) -> np.ndarray:
-        """(N,) int64: for each entry of ``face_indices``, the face it belongs to (read-only)."""
-        return self._derived("face_of", lambda: np.repeat(np.arange(self.n_faces), self.valences))
+        """(N,) int64: for each entry of ``face_indices``, the face it belongs to.
+
+        Computed on each call, like :meth:`next_corners`: kept with the mesh, the two
+        held 35 MB per mesh of a 1000 x 1000 build (old and new mesh of a pass both
+        alive) for no time saved.
+        """
+        return np.repeat(np.arange(self.n_faces), self.valences)
 
     @property
     def kinds(self) -> np.ndarray:
@@ -318,13 +322,10 @@ class Mesh:
         return self.face_indices[self.face_offsets[f]:self.face_offsets[f + 1]]
 
     def next_corners(self) -> np.ndarray:
-        """(N,) int64: for each entry of ``face_indices``, the position of the next corner of its
-        face (read-only)."""
-        def make() -> np.ndarray:
-            nxt = np.arange(self.face_indices.size) + 1
-            nxt[self.face_offsets[1:] - 1] = self.face_offsets[:-1]
-            return nxt
-        return self._derived("next_corners", make)
+        """(N,) int64: for each entry of ``face_indices``, the position of the next corner of its face."""
+        nxt = np.arange(self.face_indices.size) + 1
+        nxt[self.face_offsets[1:] - 1] = self.face_offsets[:-1]
+        return nxt
 
     def edge_uses(self) -> tuple[np.ndarray, np.ndarray]:
         """Sorted undirected edge keys ``low * n_vertices + high`` and how many faces use each.
