@@ -83,7 +83,11 @@ def _offsets_cache(offsets: np.ndarray) -> dict[str, np.ndarray]:
     if entry is not None and entry[0]() is offsets:
         return entry[1]
     cache: dict[str, np.ndarray] = {}
-    _BY_OFFSETS[key] = (weakref.ref(offsets, lambda _, key=key: _BY_OFFSETS.pop(key, None)), cache)
+
+    def forget(_: weakref.ref) -> None:
+        _BY_OFFSETS.pop(key, None)
+
+    _BY_OFFSETS[key] = (weakref.ref(offsets, forget), cache)
     return cache
 
 
