@@ -304,12 +304,9 @@ def _apply(mesh: Mesh, v: np.ndarray, u: np.ndarray) -> tuple[Mesh, np.ndarray]:
     # The triangles on each edge u v now repeat u: they go with the repeated corner.
     out = Mesh(mesh.vertices, mesh.face_offsets, remap[mesh.face_indices], kind, members, member_id,
                mesh.vertex_data, mesh.info).drop_repeated_corners()
-    # The new index as compact() numbers them: it drops every vertex no face or member
-    # uses, not only the collapsed ones (a part of a mesh, a face gone with its corner).
-    used = np.zeros(n, bool)
-    used[out.face_indices] = True
-    used[out.members.reshape(-1)] = True
-    return out.compact(), np.where(used, np.cumsum(used) - 1, -1)
+    # The compaction drops every vertex no face or member uses, not only the collapsed ones
+    # (a part of a mesh, a face gone with its corner): its own new index says which.
+    return out.compact_index()
 
 
 def collapse_splinters(mesh: Mesh, removable: np.ndarray | None = None,

@@ -30,7 +30,7 @@ from ...tolerances import (
     SPLINTER_FLIP_MAX_SAG,
     TINY,
 )
-from .pairing import _adjacent, _around, _corners
+from .pairing import _adjacent, _around, _at, _corners
 
 __all__ = ["flip_splinters", "flip_triangles"]
 
@@ -338,7 +338,7 @@ def _active_near(V: np.ndarray, tri: np.ndarray, near: np.ndarray) -> tuple[np.n
     measured.
     """
     n = len(V)
-    core = _around(tri, n, near[tri[:, 0]] | near[tri[:, 1]] | near[tri[:, 2]], NEAR_RINGS)
+    core = _around(tri, n, _at(tri, near), NEAR_RINGS)
     rows = np.flatnonzero(_around(tri, n, core, 2))
     live = np.zeros(len(tri), bool)
     ang = np.zeros(len(tri))

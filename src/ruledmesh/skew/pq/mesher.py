@@ -8,7 +8,7 @@ from enum import Enum
 
 import numpy as np
 
-from ..._arrays import unique
+from ..._arrays import member, unique
 from ..._validation import check_bool, check_choice, check_float, check_int, check_points, describe
 from ...analysis.asymptotic import SLENDER_DEG, SLENDER_ELONGATION, slender_share
 from ...errors import GeometryError, ParameterError
@@ -521,9 +521,7 @@ class _Changes:
         """(V,) bool of ``mesh``: the vertices changed; None: everywhere."""
         if self.ids is None:
             return None
-        fid = np.asarray(mesh.vertex_data[_FID])
-        pos = np.minimum(np.searchsorted(self.ids, fid), max(self.ids.size - 1, 0))
-        return self.ids[pos] == fid if self.ids.size else np.zeros(len(fid), bool)
+        return member(np.asarray(mesh.vertex_data[_FID]), self.ids)
 
 
 def _pass(step: Callable[..., tuple[Mesh, int]], mesh: Mesh, *args, **kwargs) -> tuple[Mesh, int, bool]:

@@ -73,6 +73,11 @@ def _corners(tri: np.ndarray, n: int) -> np.ndarray:
     return out
 
 
+def _at(tri: np.ndarray, vertices: np.ndarray) -> np.ndarray:
+    """(T,) bool: the triangles ``tri`` with a corner marked in ``vertices`` (n,) bool."""
+    return vertices[tri[:, 0]] | vertices[tri[:, 1]] | vertices[tri[:, 2]]
+
+
 def _around(tri: np.ndarray, n: int, mark: np.ndarray, times: int) -> np.ndarray:
     """(T,) bool: ``mark`` and the triangles ``times`` corner-sharing steps from a marked one.
 
@@ -80,8 +85,7 @@ def _around(tri: np.ndarray, n: int, mark: np.ndarray, times: int) -> np.ndarray
     holds every triangle ``times`` edge-sharing steps away (and some more).
     """
     for _ in range(times):
-        hit = _corners(tri[mark], n)
-        mark = hit[tri[:, 0]] | hit[tri[:, 1]] | hit[tri[:, 2]]
+        mark = _at(tri, _corners(tri[mark], n))
     return mark
 
 
@@ -133,7 +137,7 @@ def pair_triangles(mesh: Mesh, ptol: float, kinds: tuple[int, ...] | None = None
     tri = mesh.face_indices[mesh.face_offsets[ids][:, None] + np.arange(3)]
     if near is not None:
         # Rows in order: the pairs come in the same order and with the same sides.
-        rows = np.flatnonzero(_around(tri, len(V), near[tri[:, 0]] | near[tri[:, 1]] | near[tri[:, 2]], 2))
+        rows = np.flatnonzero(_around(tri, len(V), _at(tri, near), 2))
         ids, tri = ids[rows], tri[rows]
     t1, t2, a, b, c, d = adjacent_triangles(tri, len(V))
     quad = np.stack([a, b, d, c], axis=1)
