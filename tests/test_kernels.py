@@ -114,6 +114,69 @@ def test_flip_measures(monkeypatch, seed, n, pairs, spread):
     assert all(same(r, g) for r, g in zip(ref, got))
 
 
+def _triangulated_grid(rng, m: int, squash: float) -> tuple[np.ndarray, np.ndarray]:
+    """Vertices and triangles of an m x m grid cut along random diagonals, some columns
+    squashed together (needles)."""
+    x = np.cumsum(rng.uniform(0.0, 1.0, m))
+    x[rng.integers(1, m, max(1, m // 3))] -= squash * rng.uniform(0.5, 1.0)
+    X, Y = np.meshgrid(x, np.arange(m, dtype=float), indexing="ij")
+    V = np.stack([X.ravel(), Y.ravel(), 0.05 * rng.standard_normal(m * m)], axis=1)
+    i, j = np.meshgrid(np.arange(m - 1), np.arange(m - 1), indexing="ij")
+    a, b, c, d = (i * m + j).ravel(), ((i + 1) * m + j).ravel(), ((i + 1) * m + j + 1).ravel(), \
+        (i * m + j + 1).ravel()
+    cut = rng.random(a.size) < 0.5
+    tri = np.concatenate([np.where(cut[:, None], np.stack([a, b, c], 1), np.stack([a, b, d], 1)),
+                          np.where(cut[:, None], np.stack([a, c, d], 1), np.stack([b, c, d], 1))])
+    return V, tri
+
+
+@SETTINGS
+@given(seed=st.integers(0, 2**31), m=st.integers(3, 12), squash=st.floats(0.0, 1.0),
+       spread=st.floats(-3, 6))
+def test_collapse_measures(monkeypatch, seed, m, squash, spread):
+    """The collapses' gains and verdicts of every directed edge of a triangle mesh with
+    needles, the border's and those the link condition refuses included."""
+    from ruledmesh.mesh import FaceKind, Mesh
+    from ruledmesh.skew.pq.collapses import _evaluate, _Stars
+
+    rng = np.random.default_rng(seed)
+    V, tri = _triangulated_grid(rng, m, squash)
+    V = V * 10.0 ** spread + rng.uniform(-1e4, 1e4, 3)
+    mesh = Mesh(V, np.arange(0, tri.size + 1, 3), tri.reshape(-1), np.full(len(tri), FaceKind.FILL))
+    keys, _ = mesh.edge_uses()
+    n = len(V)
+    v, u = keys // n, keys % n
+    v, u = np.concatenate([v, u]), np.concatenate([u, v])
+    faces_at = np.bincount(tri.reshape(-1), minlength=n)
+    scale = float(10 * 10.0 ** spread)
+    ref, got = both(monkeypatch, lambda: _evaluate(V, tri, _Stars(tri, keys, n), keys, faces_at, v, u, scale))
+    assert all(same(r, g) for r, g in zip(ref, got))
+
+
+@SETTINGS
+@given(seed=st.integers(0, 2**31), m=st.integers(3, 12), squash=st.floats(0.0, 1.0),
+       ghosts=st.integers(0, 40), spread=st.floats(-3, 6))
+def test_ghosts_kept(monkeypatch, seed, m, squash, ghosts, spread):
+    """Which collapses keep the vertices removed earlier near a face: ghosts on, beside and
+    far from the mesh, several at one anchor."""
+    from ruledmesh.mesh import FaceKind, Mesh
+    from ruledmesh.skew.pq.collapses import _keeps_ghosts, _Stars
+
+    rng = np.random.default_rng(seed)
+    V, tri = _triangulated_grid(rng, m, squash)
+    anchors = rng.integers(0, len(V), ghosts)
+    G = V[anchors] + rng.standard_normal((ghosts, 3)) * rng.choice([0.0, 1e-4, 1e-2, 1.0], (ghosts, 1))
+    shift = rng.uniform(-1e4, 1e4, 3)
+    V, G = V * 10.0 ** spread + shift, G * 10.0 ** spread + shift
+    mesh = Mesh(V, np.arange(0, tri.size + 1, 3), tri.reshape(-1), np.full(len(tri), FaceKind.FILL))
+    keys, _ = mesh.edge_uses()
+    n = len(V)
+    v, u = np.concatenate([keys // n, keys % n]), np.concatenate([keys % n, keys // n])
+    scale = float(10 * 10.0 ** spread)
+    ref, got = both(monkeypatch, lambda: _keeps_ghosts(V, tri, _Stars(tri, keys, n), v, u, G, anchors, scale))
+    assert same(ref, got)
+
+
 @SETTINGS
 @given(seed=st.integers(0, 2**31), m=st.integers(3, 40), rows=st.integers(1, 40),
        twist=st.floats(0.1, 3.0), wobble=st.floats(0.0, 1.5), option=st.integers(0, 1))

@@ -19,7 +19,8 @@ import numpy as np
 from .._arrays import ATAN_EVEN, ATAN_HI, ATAN_LO, ATAN_ODD, DEGREES, HALF_PI
 from ..tolerances import ROUNDING_SQ, TINY
 
-__all__ = ["crossing", "flip_pairs", "min_angles", "newell", "polygon_angles", "quad_planarity"]
+__all__ = ["collapse_measures", "crossing", "flip_pairs", "ghosts_kept", "min_angles", "newell", "polygon_angles",
+           "quad_planarity"]
 
 E0, E1, E2, E3, E4, E5 = ATAN_EVEN
 O0, O1, O2, O3, O4 = ATAN_ODD
@@ -435,3 +436,254 @@ def flip_pairs(V: np.ndarray, a: np.ndarray, b: np.ndarray, c: np.ndarray, d: np
     return _flip_pairs(c_(V, dtype=np.float64), c_(a, dtype=np.int64), c_(b, dtype=np.int64),
                        c_(c, dtype=np.int64), c_(d, dtype=np.int64), c_(old, dtype=np.float64),
                        float(gain), float(bend), float(max_sag))
+
+
+@nb.njit(cache=True, inline="always")
+def _min(x: float, y: float) -> float:
+    """np.minimum: NaN if either is NaN."""
+    if x != x or y != y:
+        return math.nan
+    return x if x <= y else y
+
+
+@nb.njit(cache=True, inline="always")
+def _segment_distance(p0, p1, p2, a0, a1, a2, b0, b1, b2):
+    """``collapses._segment_distance`` of one point and segment."""
+    e0, e1, e2 = b0 - a0, b1 - a1, b2 - a2
+    w0, w1, w2 = p0 - a0, p1 - a1, p2 - a2
+    s = _dot(w0, w1, w2, e0, e1, e2) / _max(_dot(e0, e1, e2, e0, e1, e2), TINY)
+    if s != s:
+        pass
+    elif s < 0.0:
+        s = 0.0
+    elif s > 1.0:
+        s = 1.0
+    return _norm(w0 - s * e0, w1 - s * e1, w2 - s * e2)
+
+
+@nb.njit(cache=True, inline="always")
+def _edge_side(x0, x1, x2, y0, y1, y2, q0, q1, q2, n0, n1, n2) -> bool:
+    """Whether ``q`` is on the inner side of the edge ``x y`` of a triangle with normal ``n``."""
+    e0, e1, e2 = y0 - x0, y1 - x1, y2 - x2
+    f0, f1, f2 = q0 - x0, q1 - x1, q2 - x2
+    return _dot(e1 * f2 - e2 * f1, e2 * f0 - e0 * f2, e0 * f1 - e1 * f0, n0, n1, n2) >= 0.0
+
+
+@nb.njit(cache=True)
+def _triangle_distance(p0, p1, p2, V, i, j, k):
+    """``collapses._triangle_distance`` of the point ``p`` and the triangle ``V[[i, j, k]]``."""
+    A0, A1, A2 = V[i, 0], V[i, 1], V[i, 2]
+    B0, B1, B2 = V[j, 0], V[j, 1], V[j, 2]
+    C0, C1, C2 = V[k, 0], V[k, 1], V[k, 2]
+    n0, n1, n2 = _unit_normal(V, i, j, k)
+    h = _dot(p0 - A0, p1 - A1, p2 - A2, n0, n1, n2)
+    q0, q1, q2 = p0 - h * n0, p1 - h * n1, p2 - h * n2
+    if (_edge_side(A0, A1, A2, B0, B1, B2, q0, q1, q2, n0, n1, n2)
+            and _edge_side(B0, B1, B2, C0, C1, C2, q0, q1, q2, n0, n1, n2)
+            and _edge_side(C0, C1, C2, A0, A1, A2, q0, q1, q2, n0, n1, n2)):
+        return abs(h)
+    return _min(_min(_segment_distance(p0, p1, p2, A0, A1, A2, B0, B1, B2),
+                     _segment_distance(p0, p1, p2, B0, B1, B2, C0, C1, C2)),
+                _segment_distance(p0, p1, p2, C0, C1, C2, A0, A1, A2))
+
+
+@nb.njit(cache=True, inline="always")
+def _with(x: int, at: int, corner: int, u: int) -> int:
+    """Corner ``at`` of a triangle whose corner ``corner`` is now ``u``; ``x`` was there."""
+    return u if at == corner else x
+
+
+@nb.njit(cache=True)
+def _to_collapsed_star(p0, p1, p2, V, tri, order, lo, hi, u, near):
+    """``near`` and the distances of ``p`` from the triangles ``order[lo:hi] // 3`` of ``tri``
+    with their corner ``order % 3`` moved to ``u``, those on an edge to ``u`` left out; the
+    smallest (NaN if one is)."""
+    for q in range(lo, hi):
+        h = order[q] // 3
+        i, j, k = tri[h, 0], tri[h, 1], tri[h, 2]
+        if i == u or j == u or k == u:
+            continue
+        e = order[q] % 3
+        near = _min(near, _triangle_distance(p0, p1, p2, V, _with(i, 0, e, u), _with(j, 1, e, u),
+                                             _with(k, 2, e, u)))
+    return near
+
+
+@nb.njit(cache=True, nogil=True)
+def _collapse_measures(V, tri, order, tri_start, nbr, nbr_start, keys, faces_at, v, u, gain_min,
+                       bend, restart, max_sag):
+    C = v.shape[0]
+    gain = np.empty(C)
+    ok = np.zeros(C, np.bool_)
+    for c in range(C):
+        vc, uc = v[c], u[c]
+        lo, hi = tri_start[vc], tri_start[vc + 1]
+        old_min, new_min = 180.0, 180.0
+        s0, s1, s2 = 0.0, 0.0, 0.0
+        for r in range(lo, hi):
+            f = order[r] // 3
+            i, j, k = tri[f, 0], tri[f, 1], tri[f, 2]
+            old_min = _min(old_min, _triangle_min(V, i, j, k))
+            x0, x1, x2 = V[j, 0] - V[i, 0], V[j, 1] - V[i, 1], V[j, 2] - V[i, 2]
+            y0, y1, y2 = V[k, 0] - V[i, 0], V[k, 1] - V[i, 1], V[k, 2] - V[i, 2]
+            s0 += x1 * y2 - x2 * y1
+            s1 += x2 * y0 - x0 * y2
+            s2 += x0 * y1 - x1 * y0
+        g = _max(_norm(s0, s1, s2), TINY)
+        s0, s1, s2 = s0 / g, s1 / g, s2 / g
+        good = True
+        removed = 0
+        for r in range(lo, hi):
+            f = order[r] // 3
+            i, j, k = tri[f, 0], tri[f, 1], tri[f, 2]
+            if i == uc or j == uc or k == uc:
+                removed += 1
+                third = max(i if i != vc and i != uc else -1,
+                            max(j if j != vc and j != uc else -1, k if k != vc and k != uc else -1))
+                if faces_at[third if third >= 0 else faces_at.shape[0] - 1] < 2:
+                    good = False
+                continue
+            e = order[r] % 3
+            a, b, d = _with(i, 0, e, uc), _with(j, 1, e, uc), _with(k, 2, e, uc)
+            new_min = _min(new_min, _triangle_min(V, a, b, d))
+            m0, m1, m2 = _unit_normal(V, a, b, d)
+            o0, o1, o2 = _unit_normal(V, i, j, k)
+            bent = not (_dot(o0, o1, o2, m0, m1, m2) >= bend or (
+                _triangle_min(V, i, j, k) < restart and _dot(s0, s1, s2, m0, m1, m2) >= bend))
+            if bent or _norm(m0, m1, m2) < 0.5:
+                good = False
+        gain[c] = new_min - old_min
+        if not (good and gain[c] > gain_min and removed >= 1 and hi - lo > removed):
+            continue
+        # Link condition: the neighbours u and v share are the corners opposite their edge.
+        n = V.shape[0]
+        common = 0
+        for r in range(nbr_start[vc], nbr_start[vc + 1]):
+            w = nbr[r]
+            if w == uc:
+                continue
+            key = min(uc, w) * n + max(uc, w)
+            at = np.searchsorted(keys, key)
+            if at < keys.shape[0] and keys[at] == key:
+                common += 1
+        if common != removed:
+            continue
+        # How far the surface moves: v's distance from the faces left around it.
+        sag = _to_collapsed_star(V[vc, 0], V[vc, 1], V[vc, 2], V, tri, order, lo, hi, uc, math.inf)
+        ok[c] = sag <= max_sag
+    return gain, ok
+
+
+def collapse_measures(V: np.ndarray, tri: np.ndarray, order: np.ndarray, tri_start: np.ndarray,
+                      nbr: np.ndarray, nbr_start: np.ndarray, keys: np.ndarray, faces_at: np.ndarray,
+                      v: np.ndarray, u: np.ndarray, gain: float, bend: float, restart: float,
+                      max_sag: float) -> tuple[np.ndarray, np.ndarray]:
+    """The measures of :func:`ruledmesh.skew.pq.collapses._evaluate`, bit for bit.
+
+    Parameters
+    ----------
+    V : (n, 3) float64
+    tri : (T, 3) int
+        The triangles around the candidates.
+    order, tri_start : (3 T,) int, (n + 1,) int
+        The corners of ``tri`` by vertex (``collapses._Stars``).
+    nbr, nbr_start : (2 E,) int, (n + 1,) int
+        Every vertex's neighbours by vertex.
+    keys : (E,) int64
+        Sorted undirected edge keys ``lo * n + hi``.
+    faces_at : (n,) int
+        Faces of the whole mesh at each vertex.
+    v, u : (C,) int
+        The collapses ``v -> u``.
+    gain : float
+        Degrees a collapse must gain.
+    bend : float
+        Cosine of the largest bend of a face's normal.
+    restart : float
+        Smallest angle (degrees) below which a face's own normal is noise.
+    max_sag : float
+        Largest distance of ``v`` from the faces left around it.
+
+    Returns
+    -------
+    gain : (C,) float64
+        Gain in smallest angle, degrees.
+    ok : (C,) bool
+        Whether each collapse may be taken.
+    """
+    c_ = np.ascontiguousarray
+    i64 = np.int64
+    return _collapse_measures(c_(V, dtype=np.float64), c_(tri, dtype=i64), c_(order, dtype=i64),
+                              c_(tri_start, dtype=i64), c_(nbr, dtype=i64), c_(nbr_start, dtype=i64),
+                              c_(keys, dtype=i64), c_(faces_at, dtype=i64), c_(v, dtype=i64),
+                              c_(u, dtype=i64), float(gain), float(bend), float(restart),
+                              float(max_sag))
+
+
+@nb.njit(cache=True, nogil=True)
+def _ghosts_kept(V, tri, order, tri_start, v, u, ghosts, anchors, by_anchor, sorted_anchors, bound):
+    C = v.shape[0]
+    ok = np.ones(C, np.bool_)
+    seen = np.full(ghosts.shape[0], -1, np.int64)
+    for c in range(C):
+        vc, uc = v[c], u[c]
+        lo, hi = tri_start[vc], tri_start[vc + 1]
+        for r in range(lo, hi):
+            f = order[r] // 3
+            for x in (tri[f, 0], tri[f, 1], tri[f, 2]):
+                g_lo = np.searchsorted(sorted_anchors, x)
+                g_hi = np.searchsorted(sorted_anchors, x, side="right")
+                for s in range(g_lo, g_hi):
+                    g = by_anchor[s]
+                    if seen[g] == c:
+                        continue
+                    seen[g] = c
+                    p0, p1, p2 = ghosts[g, 0], ghosts[g, 1], ghosts[g, 2]
+                    # The collapse's new faces ...
+                    near = _to_collapsed_star(p0, p1, p2, V, tri, order, lo, hi, uc, math.inf)
+                    # ... or the triangles at the anchor that do not have v for a corner.
+                    a = anchors[g]
+                    for q in range(tri_start[a], tri_start[a + 1]):
+                        h = order[q] // 3
+                        i, j, k = tri[h, 0], tri[h, 1], tri[h, 2]
+                        if i == vc or j == vc or k == vc:
+                            continue
+                        near = _min(near, _triangle_distance(p0, p1, p2, V, i, j, k))
+                    if near > bound:
+                        ok[c] = False
+    return ok
+
+
+def ghosts_kept(V: np.ndarray, tri: np.ndarray, order: np.ndarray, tri_start: np.ndarray, v: np.ndarray,
+                u: np.ndarray, ghosts: np.ndarray, anchors: np.ndarray, bound: float) -> np.ndarray:
+    """:func:`ruledmesh.skew.pq.collapses._keeps_ghosts`, bit for bit.
+
+    Parameters
+    ----------
+    V : (n, 3) float64
+    tri : (T, 3) int
+        The triangles around the candidates.
+    order, tri_start : (3 T,) int, (n + 1,) int
+        The corners of ``tri`` by vertex (``collapses._Stars``).
+    v, u : (C,) int
+        The collapses ``v -> u``.
+    ghosts : (k, 3) float64
+        Vertices removed earlier ...
+    anchors : (k,) int
+        ... and the vertex each went into.
+    bound : float
+        Largest distance of a ghost from the faces near it.
+
+    Returns
+    -------
+    (C,) bool
+        The collapses that leave every ghost near a face.
+    """
+    c_ = np.ascontiguousarray
+    i64 = np.int64
+    anchors = c_(anchors, dtype=i64)
+    by_anchor = np.argsort(anchors, kind="stable")
+    return _ghosts_kept(c_(V, dtype=np.float64), c_(tri, dtype=i64), c_(order, dtype=i64),
+                        c_(tri_start, dtype=i64), c_(v, dtype=i64), c_(u, dtype=i64),
+                        c_(ghosts, dtype=np.float64), anchors, by_anchor, anchors[by_anchor],
+                        float(bound))

@@ -29,6 +29,7 @@ import numpy as np
 
 from ..._arrays import cross, diagonal, lookup, member, norm, unique
 from ...analysis.faces import min_corner_angles
+from ...kernels import wanted
 from ...mesh import FaceKind, Mesh
 from ...tolerances import COLLAPSE_MAX_SAG, FLIP_MAX_BEND_DEG, FLIP_MIN_GAIN_DEG, RESTART_ANGLE_DEG, TINY
 from .flips import _member, _unit_normals
@@ -168,8 +169,17 @@ def _collapsed_star(tri, stars: _Stars, v, u):
 
 def _evaluate(V, tri, stars: _Stars, keys, faces_at, v, u, scale) -> tuple[np.ndarray, np.ndarray]:
     """(C,) gain in smallest angle (degrees) of each collapse ``v -> u``, and whether it is
-    allowed (it gains more than :data:`~ruledmesh.tolerances.FLIP_MIN_GAIN_DEG` too)."""
+    allowed (it gains more than :data:`~ruledmesh.tolerances.FLIP_MIN_GAIN_DEG` too).
+
+    :func:`ruledmesh.kernels.geometry.collapse_measures` is the same, bit for bit.
+    """
     C = v.size
+    cos = np.cos(np.radians(FLIP_MAX_BEND_DEG))
+    kern = wanted(C)
+    if kern is not None:
+        return kern.collapse_measures(V, tri, stars.order, stars.tri_start, stars.nbr, stars.nbr_start,
+                                      keys, faces_at, v, u, FLIP_MIN_GAIN_DEG, cos, RESTART_ANGLE_DEG,
+                                      COLLAPSE_MAX_SAG * scale)
     rep, old, new, gone = _collapsed_star(tri, stars, v, u)
     old_ang = min_corner_angles(V, old)
     old_min = np.full(C, 180.0)
@@ -185,7 +195,6 @@ def _evaluate(V, tri, stars: _Stars, keys, faces_at, v, u, scale) -> tuple[np.nd
     np.add.at(star, rep, cross(P0[:, 1] - P0[:, 0], P0[:, 2] - P0[:, 0]))
     star /= np.maximum(norm(star), TINY)[:, None]
     n_new = _normals(Pn)
-    cos = np.cos(np.radians(FLIP_MAX_BEND_DEG))
     bend = (np.einsum("ij,ij->i", _normals(P0[keep]), n_new) >= cos) | (
         (old_ang[keep] < RESTART_ANGLE_DEG) & (np.einsum("ij,ij->i", star[rep[keep]], n_new) >= cos))
     bad = ~bend | (norm(n_new) < 0.5)
@@ -215,8 +224,15 @@ def _keeps_ghosts(V, tri, stars: _Stars, v, u, ghosts, anchors, scale) -> np.nda
     """(C,) bool: the collapses ``v -> u`` that leave every earlier removed vertex (``ghosts``
     (k, 3), each with the vertex it went into, ``anchors`` (k,)) within the sag bound of a
     face: of one of the collapse's new faces, or of a triangle at its anchor that the
-    collapse does not change."""
+    collapse does not change.
+
+    :func:`ruledmesh.kernels.geometry.ghosts_kept` is the same, bit for bit.
+    """
     C = v.size
+    kern = wanted(C)
+    if kern is not None:
+        return kern.ghosts_kept(V, tri, stars.order, stars.tri_start, v, u, ghosts, anchors,
+                                COLLAPSE_MAX_SAG * scale)
     rep, face, _ = stars.triangles(v)
     order = np.argsort(anchors, kind="stable")
     sa = anchors[order]
