@@ -9,7 +9,7 @@ operation per formula term, so their results are bit for bit the numpy ones
 
 Importing numba and loading the compiled kernels from the on-disk cache costs
 about 0.9 s of CPU once per process (compiling them on a new machine, once,
-about 15 s), where a small build takes milliseconds in numpy.  So the kernels
+about 30-35 s), where a small build takes milliseconds in numpy.  So the kernels
 are loaded when one stage has :data:`MIN_ITEMS` items (a build that takes a
 good part of a second in numpy), or when the process has put :data:`MIN_WORK`
 items through the stages (a designer or a notebook rebuilding the same design

@@ -20,7 +20,7 @@ from .._arrays import ATAN_EVEN, ATAN_HI, ATAN_LO, ATAN_ODD, DEGREES, HALF_PI
 from ..tolerances import ROUNDING_SQ, TINY
 
 __all__ = ["collapse_measures", "crossing", "flip_pairs", "ghosts_kept", "min_angles", "newell", "polygon_angles",
-           "quad_planarity"]
+           "quad_planarity", "warm"]
 
 E0, E1, E2, E3, E4, E5 = ATAN_EVEN
 O0, O1, O2, O3, O4 = ATAN_ODD
@@ -370,6 +370,13 @@ def _triangle_min(V, i, j, k):
     return min(a0, min(a1, a2))
 
 
+@nb.njit(cache=True)
+def _smallest_angle(V, i, j, k):
+    """:func:`_triangle_min` as a function of its own: inlined three times over in a kernel it
+    took numba ten seconds to compile."""
+    return _triangle_min(V, i, j, k)
+
+
 @nb.njit(cache=True, inline="always")
 def _unit_normal(V, p, q, r):
     """``flips._unit_normals`` of one triangle: cross(q - p, r - p) over its norm (at least TINY)."""
@@ -387,7 +394,7 @@ def _flip_pairs(V, a, b, c, d, old, gain, bend, max_sag):
     ok = np.empty(P, np.bool_)
     for k in range(P):
         A, B, C, D = a[k], b[k], c[k], d[k]
-        x, y = _triangle_min(V, A, B, D), _triangle_min(V, A, D, C)
+        x, y = _smallest_angle(V, A, B, D), _smallest_angle(V, A, D, C)
         nw = math.nan if x != x or y != y else min(x, y)
         new[k] = nw
         p0, p1, p2 = _unit_normal(V, A, B, C)
@@ -523,7 +530,7 @@ def _collapse_measures(V, tri, order, tri_start, nbr, nbr_start, keys, faces_at,
         for r in range(lo, hi):
             f = order[r] // 3
             i, j, k = tri[f, 0], tri[f, 1], tri[f, 2]
-            old_min = _min(old_min, _triangle_min(V, i, j, k))
+            old_min = _min(old_min, _smallest_angle(V, i, j, k))
             x0, x1, x2 = V[j, 0] - V[i, 0], V[j, 1] - V[i, 1], V[j, 2] - V[i, 2]
             y0, y1, y2 = V[k, 0] - V[i, 0], V[k, 1] - V[i, 1], V[k, 2] - V[i, 2]
             s0 += x1 * y2 - x2 * y1
@@ -545,11 +552,11 @@ def _collapse_measures(V, tri, order, tri_start, nbr, nbr_start, keys, faces_at,
                 continue
             e = order[r] % 3
             a, b, d = _with(i, 0, e, uc), _with(j, 1, e, uc), _with(k, 2, e, uc)
-            new_min = _min(new_min, _triangle_min(V, a, b, d))
+            new_min = _min(new_min, _smallest_angle(V, a, b, d))
             m0, m1, m2 = _unit_normal(V, a, b, d)
             o0, o1, o2 = _unit_normal(V, i, j, k)
             bent = not (_dot(o0, o1, o2, m0, m1, m2) >= bend or (
-                _triangle_min(V, i, j, k) < restart and _dot(s0, s1, s2, m0, m1, m2) >= bend))
+                _smallest_angle(V, i, j, k) < restart and _dot(s0, s1, s2, m0, m1, m2) >= bend))
             if bent or _norm(m0, m1, m2) < 0.5:
                 good = False
         gain[c] = new_min - old_min
@@ -687,3 +694,22 @@ def ghosts_kept(V: np.ndarray, tri: np.ndarray, order: np.ndarray, tri_start: np
                         c_(tri_start, dtype=i64), c_(v, dtype=i64), c_(u, dtype=i64),
                         c_(ghosts, dtype=np.float64), anchors, by_anchor, anchors[by_anchor],
                         float(bound))
+
+
+def warm() -> None:
+    """Call the collapses' kernels once on two triangles (compiling them, or loading them
+    from numba's cache): a small design's build may have no splinter to collapse, or none
+    after another, and a live application must not compile them inside an edit."""
+    V = np.array([[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [1.0, 1.0, 0.0]])
+    tri = np.array([[0, 1, 2], [1, 3, 2]])
+    order = np.argsort(tri.reshape(-1), kind="stable")
+    start = np.searchsorted(tri.reshape(-1)[order], np.arange(5))
+    keys = np.array([1, 2, 6, 7, 11])                 # the five edges, lo * 4 + hi
+    ends = np.concatenate([keys // 4, keys % 4])
+    by_end = np.argsort(ends, kind="stable")
+    nbr = np.concatenate([keys % 4, keys // 4])[by_end]
+    nbr_start = np.searchsorted(ends[by_end], np.arange(5))
+    v, u = np.array([1]), np.array([2])
+    collapse_measures(V, tri, order, start, nbr, nbr_start, keys, np.bincount(tri.reshape(-1)), v, u,
+                      0.0, 0.0, 0.0, 1.0)
+    ghosts_kept(V, tri, order, start, v, u, V[:1], np.array([0]), 1.0)

@@ -211,11 +211,11 @@ def _warm_up(build: Any) -> bool:
 
     ``build`` builds the default design and makes its frame.  The worker
     holds the kernels (:func:`ruledmesh.kernels.hold`) until it is idle:
-    compiling them (about 15 s on a new installation, a second from numba's
+    compiling them (30-35 s on a new installation, a second from numba's
     cache) inside an edit would count against that edit's time limit and
     refuse it, which is what happened when a long session crossed
     :data:`~ruledmesh.kernels.MIN_WORK`.  One build inside
-    :func:`~ruledmesh.kernels.everywhere` calls every kernel once.
+    :func:`~ruledmesh.kernels.everywhere` calls every kernel once ...
     """
     from .. import kernels
 
@@ -223,6 +223,10 @@ def _warm_up(build: Any) -> bool:
         return False
     with kernels.everywhere():
         build()
+        # ... every kernel but the collapses', which that design may not reach.
+        geometry = kernels.wanted(0)
+        if geometry is not None:
+            geometry.warm()
     return True
 
 
@@ -362,7 +366,7 @@ class BuildWorker(InProcessBuilder):
         proc, parent = spawn_worker(self._ctx, _worker_main, "ruledmesh-build")
         self._proc, self._conn = proc, parent
         # Importing numpy and scipy takes a second or more on a busy machine, compiling the
-        # kernels on a new installation 15 s or more: neither is build time.
+        # kernels on a new installation 30 s or more: neither is build time.
         try:
             deadline = time.monotonic() + STARTUP_SECONDS
             while not parent.poll(0.05):
