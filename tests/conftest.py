@@ -74,17 +74,24 @@ import _shared  # noqa: E402 - importable only once the finder is in place
 
 SMALL_DESIGN = _shared.SMALL_DESIGN
 
-# The longest test files, longest first (seconds of one worker, measured with --durations=0).
-# The two workers take a file at a time in collection order (--dist loadfile): test_fuzz.py
-# came last and ran alone for its 170 s after the other worker had finished everything.
-LONGEST_FIRST = ("test_quality.py",            # 230 s
-                 "test_fuzz.py",               # 170 s
+# The longest test files, longest first (seconds of one worker, measured with --durations=0 on
+# 2026-12-06, 1,257 s in all).  The two workers take a file at a time in collection order
+# (--dist loadfile --no-loadscope-reorder): the longest files first, so the short ones even out
+# the end.  (Since pytest-xdist 3.8 orders files by their number of tests unless told not to,
+# the long files with few tests each came last, and one worker ran on alone for about 70 s.)
+LONGEST_FIRST = ("test_fuzz.py",               # 167 s
+                 "test_quality.py",            # 161 s
                  "test_designer_browser.py",   # 110 s
-                 "test_designer.py",           # 80 s
-                 "test_pq_quality.py",         # 60 s
-                 "test_pq_choice.py",          # 55 s
-                 "test_fuzz_cli.py",           # 55 s
-                 "test_pq_splinters.py")       # 45 s
+                 "test_designer.py",           # 87 s
+                 "test_pq_quality.py",         # 68 s
+                 "test_pq_splinters.py",       # 59 s
+                 "test_pq_choice.py",          # 57 s
+                 "test_fuzz_cli.py",           # 47 s
+                 "test_help_examples.py",      # 43 s
+                 "test_designer_security.py",  # 34 s
+                 "test_cli.py",                # 33 s
+                 "test_analysis_claims.py",    # 29 s
+                 "test_robustness_geometry.py")  # 29 s
 
 
 def pytest_collection_modifyitems(config, items):
