@@ -361,6 +361,14 @@ def _angle(X, p, j, q):
     return _corner_angle(sin, cos)
 
 
+@nb.njit(cache=True)
+def angle_at(X, p, j, q):
+    """:func:`_angle` as a function of its own, for kernels that take many angles: numba
+    compiles each inlined copy of its arctangent anew (seven in the grid's sliver test took
+    about 9 s to compile), and the called function runs as fast."""
+    return _angle(X, p, j, q)
+
+
 @nb.njit(cache=True, inline="always")
 def _triangle_min(V, i, j, k):
     """``polygon_angles(V[[i, j, k]]).min()``: NaN if an angle is."""

@@ -16,7 +16,7 @@ import math
 import numba as nb
 import numpy as np
 
-from .geometry import _angle
+from .geometry import angle_at
 
 __all__ = ["grid", "propagate"]
 
@@ -111,11 +111,11 @@ def _thin(X, i0, i1, i2, i3, thin_deg):
     The smallest angle is NaN, and so not below, when any angle is.
     """
     if i3 < 0:
-        a0, a1, a2 = _angle(X, i2, i0, i1), _angle(X, i0, i1, i2), _angle(X, i1, i2, i0)
+        a0, a1, a2 = angle_at(X, i2, i0, i1), angle_at(X, i0, i1, i2), angle_at(X, i1, i2, i0)
         a3 = a2
     else:
-        a0, a1 = _angle(X, i3, i0, i1), _angle(X, i0, i1, i2)
-        a2, a3 = _angle(X, i1, i2, i3), _angle(X, i2, i3, i0)
+        a0, a1 = angle_at(X, i3, i0, i1), angle_at(X, i0, i1, i2)
+        a2, a3 = angle_at(X, i1, i2, i3), angle_at(X, i2, i3, i0)
     if a0 != a0 or a1 != a1 or a2 != a2 or a3 != a3:
         return False
     return min(min(a0, a1), min(a2, a3)) < thin_deg
