@@ -77,8 +77,9 @@ SMALL_DESIGN = _shared.SMALL_DESIGN
 # The longest test files, longest first (seconds of one worker, measured with --durations=0 on
 # 2026-12-06, 1,257 s in all).  The two workers take a file at a time in collection order
 # (--dist loadfile --no-loadscope-reorder): the longest files first, so the short ones even out
-# the end.  (Since pytest-xdist 3.8 orders files by their number of tests unless told not to,
-# the long files with few tests each came last, and one worker ran on alone for about 70 s.)
+# the end.  (pytest-xdist orders the files by their number of tests unless told not to, which
+# it can be since 3.8: until then this order had no effect, the long files with few tests each
+# came last, and one worker ran on alone for about 70 s.)
 LONGEST_FIRST = ("test_fuzz.py",               # 167 s
                  "test_quality.py",            # 161 s
                  "test_designer_browser.py",   # 110 s
