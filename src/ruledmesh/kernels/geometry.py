@@ -20,7 +20,7 @@ from .._arrays import ATAN_EVEN, ATAN_HI, ATAN_LO, ATAN_ODD, DEGREES, HALF_PI
 from ..tolerances import ROUNDING_SQ, TINY
 
 __all__ = ["collapse_measures", "crossing", "flip_pairs", "ghosts_kept", "min_angles", "newell", "polygon_angles",
-           "quad_planarity", "warm"]
+           "quad_planarity"]
 
 E0, E1, E2, E3, E4, E5 = ATAN_EVEN
 O0, O1, O2, O3, O4 = ATAN_ODD
@@ -467,9 +467,8 @@ def _segment_distance(p0, p1, p2, a0, a1, a2, b0, b1, b2):
     e0, e1, e2 = b0 - a0, b1 - a1, b2 - a2
     w0, w1, w2 = p0 - a0, p1 - a1, p2 - a2
     s = _dot(w0, w1, w2, e0, e1, e2) / _max(_dot(e0, e1, e2, e0, e1, e2), TINY)
-    if s != s:
-        pass
-    elif s < 0.0:
+    # np.clip: NaN stays NaN (both comparisons are false).
+    if s < 0.0:
         s = 0.0
     elif s > 1.0:
         s = 1.0
@@ -527,7 +526,7 @@ def _to_collapsed_star(p0, p1, p2, V, tri, order, lo, hi, u, near):
 @nb.njit(cache=True, nogil=True)
 def _collapse_measures(V, tri, order, tri_start, nbr, nbr_start, keys, faces_at, v, u, gain_min,
                        bend, restart, max_sag):
-    C = v.shape[0]
+    C, n = v.shape[0], V.shape[0]
     gain = np.empty(C)
     ok = np.zeros(C, np.bool_)
     for c in range(C):
@@ -571,7 +570,6 @@ def _collapse_measures(V, tri, order, tri_start, nbr, nbr_start, keys, faces_at,
         if not (good and gain[c] > gain_min and removed >= 1 and hi - lo > removed):
             continue
         # Link condition: the neighbours u and v share are the corners opposite their edge.
-        n = V.shape[0]
         common = 0
         for r in range(nbr_start[vc], nbr_start[vc + 1]):
             w = nbr[r]
@@ -703,21 +701,3 @@ def ghosts_kept(V: np.ndarray, tri: np.ndarray, order: np.ndarray, tri_start: np
                         c_(ghosts, dtype=np.float64), anchors, by_anchor, anchors[by_anchor],
                         float(bound))
 
-
-def warm() -> None:
-    """Call the collapses' kernels once on two triangles (compiling them, or loading them
-    from numba's cache): a small design's build may have no splinter to collapse, or none
-    after another, and a live application must not compile them inside an edit."""
-    V = np.array([[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [1.0, 1.0, 0.0]])
-    tri = np.array([[0, 1, 2], [1, 3, 2]])
-    order = np.argsort(tri.reshape(-1), kind="stable")
-    start = np.searchsorted(tri.reshape(-1)[order], np.arange(5))
-    keys = np.array([1, 2, 6, 7, 11])                 # the five edges, lo * 4 + hi
-    ends = np.concatenate([keys // 4, keys % 4])
-    by_end = np.argsort(ends, kind="stable")
-    nbr = np.concatenate([keys % 4, keys // 4])[by_end]
-    nbr_start = np.searchsorted(ends[by_end], np.arange(5))
-    v, u = np.array([1]), np.array([2])
-    collapse_measures(V, tri, order, start, nbr, nbr_start, keys, np.bincount(tri.reshape(-1)), v, u,
-                      0.0, 0.0, 0.0, 1.0)
-    ghosts_kept(V, tri, order, start, v, u, V[:1], np.array([0]), 1.0)

@@ -224,9 +224,9 @@ def _warm_up(build: Any) -> bool:
     with kernels.everywhere():
         build()
         # ... every kernel but the collapses', which that design may not reach.
-        geometry = kernels.wanted(0)
-        if geometry is not None:
-            geometry.warm()
+        from ..skew.pq.collapses import warm
+
+        warm()
     return True
 
 

@@ -34,7 +34,7 @@ from ...mesh import FaceKind, Mesh
 from ...tolerances import COLLAPSE_MAX_SAG, FLIP_MAX_BEND_DEG, FLIP_MIN_GAIN_DEG, RESTART_ANGLE_DEG, TINY
 from .flips import _member, _unit_normals
 
-__all__ = ["collapse_splinters"]
+__all__ = ["collapse_splinters", "warm"]
 
 _ROUNDS = 12
 
@@ -449,3 +449,17 @@ def _rings(mesh: Mesh, seeds: np.ndarray, k: int) -> np.ndarray:
     for _ in range(k):
         mark[mesh.face_indices[np.repeat(_touching(mesh, mark), mesh.valences)]] = True
     return mark
+
+
+def warm() -> None:
+    """Weigh one collapse on two triangles, after an earlier one: inside
+    :func:`ruledmesh.kernels.everywhere` this compiles the collapses' kernels (or loads them
+    from numba's cache), which a small design's build may not reach (no splinter to collapse,
+    or none after another), so that a live application does not compile them inside an edit."""
+    V = np.array([[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [1.0, 1.0, 0.0]])
+    tri = np.array([[0, 1, 2], [1, 3, 2]])
+    keys, _ = Mesh(V, np.array([0, 3, 6]), tri.reshape(-1), np.full(2, FaceKind.FILL)).edge_uses()
+    stars = _Stars(tri, keys, len(V))
+    v, u = np.array([1]), np.array([2])
+    _evaluate(V, tri, stars, keys, np.bincount(tri.reshape(-1)), v, u, 1.0)
+    _keeps_ghosts(V, tri, stars, v, u, V[:1], np.array([0]), 1.0)
