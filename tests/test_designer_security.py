@@ -264,6 +264,54 @@ def test_live_sockets_are_bounded(designer):
     assert status == 200
 
 
+def test_shutdown_right_after_the_page_closed_its_socket():
+    """A shutdown in the loop turn after the page's close frame: no second close frame.
+
+    uvicorn answers the page's close and closes the transport, but forgets the
+    connection only on the loop's next turn; its shutdown in between sent a close
+    frame in wsproto's CLOSED state, which raised in the server's thread.  Driven
+    here with a real transport (a socket pair) in exactly that order.
+    """
+    import asyncio
+
+    import uvicorn
+    from uvicorn.server import ServerState
+    from wsproto import ConnectionType, WSConnection
+    from wsproto.connection import ConnectionState
+    from wsproto.events import AcceptConnection, CloseConnection, Request
+
+    from ruledmesh.web.server import _ws_protocol
+
+    async def app(scope, receive, send):
+        await receive()
+        await send({"type": "websocket.accept"})
+        while (await receive())["type"] != "websocket.disconnect":
+            pass
+
+    async def run():
+        loop = asyncio.get_running_loop()
+        config = uvicorn.Config(app, ws=_ws_protocol(), lifespan="off", log_level="critical")
+        config.load()
+        state = ServerState()
+        ours, page = socket.socketpair()
+        page.setblocking(False)
+        _, proto = await loop.connect_accepted_socket(
+            lambda: config.ws_protocol_class(config=config, server_state=state, app_state={}), ours)
+        client = WSConnection(ConnectionType.CLIENT)
+        await loop.sock_sendall(page, client.send(Request(host="127.0.0.1", target="/api/live")))
+        while not any(isinstance(e, AcceptConnection) for e in client.events()):
+            client.receive_data(await loop.sock_recv(page, 65536))
+        proto.data_received(client.send(CloseConnection(code=1000)))   # the page closes ...
+        assert proto.conn.state is ConnectionState.CLOSED and proto in state.connections
+        proto.shutdown()                                                 # ... and the server stops
+        assert proto.transport.is_closing()
+        await asyncio.sleep(0.05)
+        assert proto not in state.connections
+        page.close()
+
+    asyncio.run(run())
+
+
 # ---------------------------------------------------------------- token, Host, Origin
 @pytest.mark.parametrize(("method", "path", "body"), API)
 def test_api_needs_the_token(designer, method, path, body):

@@ -605,13 +605,41 @@ def _bind(host: str, port: int) -> socket.socket:
     return sock
 
 
-def _ws_protocol() -> str:
-    """uvicorn's WebSocket implementation: wsproto (the ``web`` extra), else none at all."""
+def _ws_protocol() -> Any:
+    """uvicorn's WebSocket implementation: wsproto (the ``web`` extra) as :func:`_closing_wsproto`
+    mends it, else none at all."""
     try:
         import wsproto  # noqa: F401
     except ImportError:  # live updates off; the page then polls the state
         return "none"
-    return "wsproto"
+    return _closing_wsproto()
+
+
+def _closing_wsproto() -> type:
+    """uvicorn's wsproto protocol, without sending a close frame at shutdown on a
+    connection the page has already closed.
+
+    When the page closes its socket (a tab closed, a reload), uvicorn answers the
+    close frame and closes the transport, but drops the connection from the server's
+    list only on the loop's next turn.  A shutdown in between sent a second close
+    frame and wsproto raised ``LocalProtocolError`` (the close "cannot be sent in
+    state CLOSED") in the server's thread (uvicorn 0.55).  Such a connection needs
+    only its transport closed.
+    """
+    from uvicorn.protocols.websockets.wsproto_impl import WSProtocol
+    from wsproto.connection import ConnectionState
+
+    class _ClosingWSProtocol(WSProtocol):
+        def shutdown(self) -> None:
+            if self.conn.state is ConnectionState.CLOSED and not getattr(self, "close_sent", False):
+                stop = getattr(self, "stop_keepalive", None)    # keep-alive pings: uvicorn >= 0.55
+                if stop is not None:
+                    stop()
+                self.transport.close()
+                return
+            super().shutdown()
+
+    return _ClosingWSProtocol
 
 
 class _Uvicorn(uvicorn.Server):
