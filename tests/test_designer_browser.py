@@ -1204,13 +1204,17 @@ def test_new_curve_by_clicking_points_and_ruling_on_it(page, designer):
 
 def test_every_numeric_field_of_the_method_has_a_widenable_slider(page, designer):
     # pq fields left at their defaults still have controls
-    for key in ("option", "max_extend", "planarity_tolerance", "respace", "rows_from"):
+    for key in ("option", "max_extend", "planarity_tolerance", "respace", "rows_from", "thin"):
         assert page.locator(f'.ctl.default[data-path="mesh.{key}"]').count() == 1
-    # respace is "auto" or a boolean: one list of the three, the booleans sent as booleans
+    # respace and thin are "auto" or a boolean: one list of the three, the booleans sent as booleans
     v = page.evaluate("window.designer.version")
     page.select_option('select[data-path="mesh.respace"]', "true")
     wait_version(page, v)
     assert designer.session.design["mesh"]["respace"] is True
+    v = page.evaluate("window.designer.version")
+    page.select_option('select[data-path="mesh.thin"]', "false")
+    wait_version(page, v)
+    assert designer.session.design["mesh"]["thin"] is False
     # rows_from: a list of where the rows start
     v = page.evaluate("window.designer.version")
     page.select_option('select[data-path="mesh.rows_from"]', "c1")

@@ -10,7 +10,8 @@ import numpy as np
 
 from ..._arrays import member, unique
 from ..._validation import check_bool, check_choice, check_float, check_int, check_points, describe
-from ...analysis.asymptotic import SLENDER_DEG, SLENDER_ELONGATION, slender_share
+from ...analysis.asymptotic import SLENDER_DEG, SLENDER_ELONGATION, crossing_angles, slender_share
+from ...analysis.faces import SPLINTER_DEG
 from ...errors import GeometryError, ParameterError
 from ...hop import coplanarity, sense_changes
 from ...mesh import Mesh
@@ -104,8 +105,12 @@ class _Plan:
     crease_generators: frozenset = frozenset()
     hops: HopMaps | None = None     # of all the generators: each run takes its part
     respace: bool = False           # restart where the rows spread (.respacing)
+    thin: bool = False              # thin the rows where they fail towards a torsal generator
     # [lo, hi, ends, option] of each segment built with a division of its own (_build_all).
     own: list = field(default_factory=list)
+    # Generators where a stretch was left without rows that thinned rows could have taken
+    # (without ``thin``: _past_hopeless), for the info's ``thinnable``.
+    unthinned: list = field(default_factory=list)
 
     def division(self, div: Division, lo: int, hi: int, primary: int) -> Division:
         """``div`` with the end points and the colour of the segment ``lo..hi`` (rows from
@@ -188,22 +193,7 @@ def _build_segment(plan: _Plan, lo: int, hi: int, primary: int, div: Division,
         if not home or m < 2 * _MIN_RUN:
             return _even(plan, lo, hi, div.rows)
     if shared is not None and _hopeless(run):
-        # Keep the part next to the shared generator where the faces are still convex.
-        bad = _bad_generators(run)
-        outward = 1 if shared == lo else -1
-        dist = (bad - primary) * outward
-        dist = dist[dist > 0]
-        if dist.size == 0:
-            return [run]
-        reach = int(dist.min())
-        if reach < 3:
-            return _even(plan, lo + 1, hi, div.rows) if shared == lo else _even(plan, lo, hi - 1, div.rows)
-        k = primary + outward * reach
-        r0, r1 = (lo, lo + k) if shared == lo else (lo + k, hi)
-        run = mesh_run(a[r0:r1 + 1], d[r0:r1 + 1], r0, primary - (r0 - lo), div, plan.tol, plan.scale,
-                       plan.warnings, plan.hops)
-        rest = _even(plan, r1 + 1, hi, div.rows) if shared == lo else _even(plan, lo, r0 - 1, div.rows)
-        return [run] + rest
+        return _past_hopeless(plan, run, lo, hi, primary, div, budget, shared)
     cut = budget[0] > 0 and m >= 2 * _MIN_RUN
     right, left = _cut_at(run, lo, primary, m, plan, div.rows) if cut else (None, None)
     if right is None and left is None:
@@ -221,6 +211,86 @@ def _build_segment(plan: _Plan, lo: int, hi: int, primary: int, div: Division,
         runs += _build_segment(plan, lo, new_lo, new_lo - lo,
                                matched(div, _handed_on(plan, run, new_lo, div)), budget, shared=new_lo)
     return runs
+
+
+def _past_hopeless(plan: _Plan, run: Run, lo: int, hi: int, primary: int, div: Division,
+                   budget: list[int], shared: int) -> list[Run]:
+    """Runs for ``lo..hi`` where ``run``, continuing another from generator ``shared`` (its
+    primary), has most of its faces failing: the part next to ``shared`` where they are
+    still convex, then the rest without rows (an even division).
+
+    With ``plan.thin`` the rest keeps rows where it can.  Rows fail towards a torsal
+    generator because its faces grow slender there (:mod:`ruledmesh.analysis.asymptotic`),
+    and with every other row left out they are twice as long along the generators.  So
+    the rest restarts with the rows thinned from the farthest generator of that part
+    where the seam makes no splinter (:func:`_thinned`), as a segment of its own, which
+    thins them again where they fail again.
+    """
+    a, d = plan.a, plan.d
+    bad = _bad_generators(run)
+    outward = 1 if shared == lo else -1
+    dist = (bad - primary) * outward
+    dist = dist[dist > 0]
+    if dist.size == 0:
+        return [run]
+    reach = int(dist.min())
+    # The seams tried, farthest first: generators of the part kept, or ``shared`` itself.
+    for j in [0] if reach < 3 else [*range(reach, 1, -1), 0]:
+        seam = shared + outward * j
+        if not _thinnable(plan, seam) or div.matched is None or len(div.matched) < 2 * _MIN_THINNED:
+            continue
+        if not plan.thin:
+            plan.unthinned.append(seam)
+            break
+        if j == 0:
+            if (thin := _thinned(plan, div, seam)) is not None:
+                return _build_segment(plan, lo, hi, primary, thin, budget, shared)
+            continue
+        r0, r1 = (lo, seam) if shared == lo else (seam, hi)
+        near = mesh_run(a[r0:r1 + 1], d[r0:r1 + 1], r0, shared - r0, div, plan.tol, plan.scale,
+                        plan.warnings, plan.hops)
+        if (thin := _thinned(plan, matched(div, _handed_on(plan, near, seam, div)), seam)) is None:
+            continue
+        rest = _build_segment(plan, seam, hi, 0, thin, budget, shared=seam) if shared == lo else \
+            _build_segment(plan, lo, seam, seam - lo, thin, budget, shared=seam)
+        return [near] + rest
+    if reach < 3:
+        return _even(plan, lo + 1, hi, div.rows) if shared == lo else _even(plan, lo, hi - 1, div.rows)
+    k = primary + outward * reach
+    r0, r1 = (lo, lo + k) if shared == lo else (lo + k, hi)
+    near = mesh_run(a[r0:r1 + 1], d[r0:r1 + 1], r0, primary - (r0 - lo), div, plan.tol, plan.scale,
+                    plan.warnings, plan.hops)
+    rest = _even(plan, r1 + 1, hi, div.rows) if shared == lo else _even(plan, lo, r0 - 1, div.rows)
+    return [near] + rest
+
+
+def _thinnable(plan: _Plan, g: int) -> bool:
+    """Whether the hop lines cross generator ``g`` at :data:`_THIN_MIN_DEG` or more all over
+    the patch (and ``g`` has neighbours on both sides): a seam of thinned rows there makes
+    no splinter."""
+    if not 0 < g < len(plan.a) - 1:
+        return False
+    near = slice(g - 1, g + 2)
+    angles, _ = crossing_angles(plan.a[near], plan.a[near] + plan.d[near], _SEAM_T)
+    return bool(angles.min() >= _THIN_MIN_DEG)
+
+
+def _thinned(plan: _Plan, div: Division, g: int) -> Division | None:
+    """``div``'s matched division with every other row left out (its end rows kept), or None
+    where it would keep fewer than :data:`_MIN_THINNED` rows or the seam on generator ``g``,
+    where the thinned rows meet the others, could make splinters (:func:`_thinnable`)."""
+    if div.matched is None or len(div.matched) < 2 * _MIN_THINNED or not _thinnable(plan, g):
+        return None
+    t = div.matched[::2] if len(div.matched) % 2 else np.r_[div.matched[:-1:2], div.matched[-1]]
+    return replace(div, matched=t)
+
+
+_MIN_THINNED = 6
+# The triangles where thinned rows meet the others are halves of exact faces, whose smallest
+# angle is about half the angle at which the face's diagonals cross: a seam there keeps clear
+# of splinters only where the hop lines cross the generator at twice the splinter bar.
+_THIN_MIN_DEG = 2.0 * SPLINTER_DEG
+_SEAM_T = np.linspace(0.0, 1.0, 9)
 
 
 def _handed_on(plan: _Plan, run: Run, g: int, div: Division) -> np.ndarray:
@@ -313,7 +383,7 @@ def pq_mesh(a, b, rows: int = 20, primary: int | str = "middle", option: int = 0
             extend: float | str = "auto", trim: bool = True, *, max_extend: float = 20.0,
             creases=None, crease_generators=None, planarity_tolerance: float | None = None,
             respace: bool = False, rows_from: str | Sequence[str] = "primary",
-            division: str = "even", tol: Tolerances = DEFAULT) -> Mesh:
+            division: str = "even", thin: bool = False, tol: Tolerances = DEFAULT) -> Mesh:
     """The §4.3 PQ mesh of the ruled surface through generators ``a_i b_i``.
 
     Parameters
@@ -351,6 +421,12 @@ def pq_mesh(a, b, rows: int = 20, primary: int | str = "middle", option: int = 0
     division : {"even", "graded"}
         The primary's steps: even, or graded for faces of even shape wherever the rows land
         (:class:`PrimaryDivision`).
+    thin : bool
+        Where a restarted run's faces fail towards a torsal generator (the faces grow
+        slender there), restart it with every other row left out, from a generator where
+        the hop lines cross at :data:`_THIN_MIN_DEG` or more (no splinter where the rows
+        meet), and again as often as that helps; else (the default) such a stretch
+        carries an even division without rows.
     tol : Tolerances
 
     Returns
@@ -361,7 +437,8 @@ def pq_mesh(a, b, rows: int = 20, primary: int | str = "middle", option: int = 0
         were not convex); members are the generator segments between vertices;
         ``vertex_data`` holds ``t`` and ``generator``; ``info`` the ``warnings``, ``runs``,
         ``restarts``, ``option``, ``primary``, ``division``, ``rows_from`` (``"mixed"`` if
-        segments differ; ``row_segments``: ``[lo, hi, rows_from, option]`` each), and the
+        segments differ; ``row_segments``: ``[lo, hi, rows_from, option]`` each), ``thin``,
+        ``thinnable`` (without ``thin``: how many stretches without rows it would thin rows into), and the
         counts of the passes after the grid (``flips``, ``collapsed``, ``paired``, ...).
 
     Raises
@@ -384,7 +461,7 @@ def pq_mesh(a, b, rows: int = 20, primary: int | str = "middle", option: int = 0
     True
     """
     a, b, args = _checked(a, b, rows, primary, option, extend, trim, max_extend,
-                          planarity_tolerance, respace, tol, rows_from, division)
+                          planarity_tolerance, respace, tol, rows_from, division, thin)
     rows, ptol, d = args.rows, args.ptol, b - a
     scale = _patch_scale(a, b, d, tol)
     warnings: list[str] = []
@@ -393,7 +470,7 @@ def pq_mesh(a, b, rows: int = 20, primary: int | str = "middle", option: int = 0
     m = len(a)
     flat, torsal, cg, segs = _cut(a, d, rows, ptol, scale, tol, creases, crease_generators, warnings)
     plan = _Plan(a, d, tol, scale, warnings, args.ends[kept], args.option[kept], frozenset(cg.tolist()),
-                 hop_maps(a, d), args.respace)
+                 hop_maps(a, d), args.respace, args.thin)
     primary = int(np.searchsorted(kept, args.primary, side="right") - 1)
     parts = _build_all(plan, segs, primary, args.middle, Division(
         rows, 0, args.extend, args.max_extend, graded=args.division == "graded"), m)
@@ -407,7 +484,9 @@ def pq_mesh(a, b, rows: int = 20, primary: int | str = "middle", option: int = 0
     if kept.size < m_given:
         mesh = _renumbered(mesh, kept)
     return mesh.with_info(runs=runs, restarts=known.restarts, planarity_tolerance=ptol, extend=args.extend,
-                          respace=plan.respace, division=args.division, **_rows_from_info(plan.own, kept),
+                          respace=plan.respace, division=args.division, thin=plan.thin,
+                          thinnable=len(plan.unthinned),
+                          **_rows_from_info(plan.own, kept),
                           primary="middle" if args.middle else args.primary, **fattening)
 
 
@@ -606,11 +685,12 @@ class _Args:
     respace: bool
     ends: np.ndarray        # (m,) RowsFrom.ends, or -1 for the primary's division
     division: str = "even"  # the primary's division: "even" or "graded"
+    thin: bool = False      # thin the rows where they fail towards a torsal generator
 
 
 def _checked(a, b, rows, primary, option, extend, trim, max_extend, planarity_tolerance, respace,
              tol: Tolerances, rows_from: str | Sequence[str] = "primary",
-             division: str = "even") -> tuple[np.ndarray, np.ndarray, _Args]:
+             division: str = "even", thin: bool = False) -> tuple[np.ndarray, np.ndarray, _Args]:
     """Validate the arguments of :func:`pq_mesh` (ParameterError naming the parameter)."""
     a = check_points(a, "a", min_count=3)
     b = check_points(b, "b", min_count=3)
@@ -638,7 +718,7 @@ def _checked(a, b, rows, primary, option, extend, trim, max_extend, planarity_to
     _check_grid_budget(m, rows, extend)
     return a, b, _Args(rows, p, middle, option, extend, trim, max_extend, max(ptol, tol.planarity),
                        check_bool(respace, "respace"), _per_generator(rows_from, m, "rows_from", _end_of),
-                       check_choice(division, PrimaryDivision, "division").value)
+                       check_choice(division, PrimaryDivision, "division").value, check_bool(thin, "thin"))
 
 
 # The per-generator code of RowsFrom.NONE (-1 is the primary's division, 0 and 1 the curves).

@@ -1246,7 +1246,7 @@ function control(parent, path, name, value) {
   row.append(label);
   const send = (v, coalesce) => queueEdit([[path, v]], coalesce);
 
-  if (name === 'respace' && path[0] === 'mesh') {
+  if ((name === 'respace' || name === 'thin') && path[0] === 'mesh') {
     // "auto" or a boolean: one list of the three, the booleans sent as booleans.
     const sel = document.createElement('select');
     for (const c of ['auto', 'true', 'false']) sel.add(new Option(c, c, false, c === String(value)));
@@ -1383,7 +1383,8 @@ function buildControls() {
 // one has a control even while the design leaves it out.
 const METHOD_FIELDS = {
   pq: { rows: 20, primary: 'middle', option: 0, extend: 'auto', trim: true, max_extend: 20.0,
-        planarity_tolerance: 1e-12, refine: true, respace: 'auto', rows_from: 'auto', division: 'auto' },
+        planarity_tolerance: 1e-12, refine: true, respace: 'auto', rows_from: 'auto', division: 'auto',
+        thin: 'auto' },
   hybrid: { midpoints: 1, divisions: 8, flip: false, orient: true },
 };
 
