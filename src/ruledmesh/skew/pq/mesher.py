@@ -425,12 +425,8 @@ def pq_mesh(a, b, rows: int = 20, primary: int | str = "middle", option: int = 0
         The primary's steps: even, or graded for faces of even shape wherever the rows land
         (:class:`PrimaryDivision`).
     thin : bool
-        Where a restarted run's faces fail towards a torsal generator (the faces grow
-        slender there), restart it with every other row left out, from a generator where
-        the hop lines cross at :data:`_THIN_MIN_DEG` or more, and again as often as that
-        helps; else (the default) such a stretch carries an even division without rows.
-        The seams' triangles can be splinters all the same (a design build keeps such a
-        mesh only where it is more fabricable: ``[mesh] thin = "auto"``).
+        Restart runs failing towards a torsal generator with every other row left out, not
+        leaving the rest without rows (:func:`_past_hopeless`; its seams may hold splinters).
     tol : Tolerances
 
     Returns
@@ -442,8 +438,7 @@ def pq_mesh(a, b, rows: int = 20, primary: int | str = "middle", option: int = 0
         ``vertex_data`` holds ``t`` and ``generator``; ``info`` the ``warnings``, ``runs``,
         ``restarts``, ``option``, ``primary``, ``division``, ``rows_from`` (``"mixed"`` if
         segments differ; ``row_segments``: ``[lo, hi, rows_from, option]`` each), ``thin``,
-        ``thinnable`` (without ``thin``: how many stretches without rows it would thin rows into), and the
-        counts of the passes after the grid (``flips``, ``collapsed``, ``paired``, ...).
+        ``thinnable`` (stretches ``thin`` would give rows), the passes' counts (``flips``, ...).
 
     Raises
     ------
@@ -470,8 +465,7 @@ def pq_mesh(a, b, rows: int = 20, primary: int | str = "middle", option: int = 0
     scale = _patch_scale(a, b, d, tol)
     warnings: list[str] = []
     kept = _single_generators(a, d, rows, warnings)
-    m_given, (a, d, creases, crease_generators) = len(a), _keep(kept, a, d, creases, crease_generators)
-    m = len(a)
+    m_given, m, (a, d, creases, crease_generators) = len(a), len(kept), _keep(kept, a, d, creases, crease_generators)
     flat, torsal, cg, segs = _cut(a, d, rows, ptol, scale, tol, creases, crease_generators, warnings)
     plan = _Plan(a, d, tol, scale, warnings, args.ends[kept], args.option[kept], frozenset(cg.tolist()),
                  hop_maps(a, d), args.respace, args.thin)
@@ -487,11 +481,15 @@ def pq_mesh(a, b, rows: int = 20, primary: int | str = "middle", option: int = 0
     _warn_splinters(mesh, warnings, torsal, measured)
     if kept.size < m_given:
         mesh = _renumbered(mesh, kept)
-    return mesh.with_info(runs=runs, restarts=known.restarts, planarity_tolerance=ptol, extend=args.extend,
-                          respace=plan.respace, division=args.division, thin=plan.thin,
-                          thinnable=len(plan.unthinned),
-                          **_rows_from_info(plan.own, kept),
-                          primary="middle" if args.middle else args.primary, **fattening)
+    return mesh.with_info(runs=runs, restarts=known.restarts, **_options_info(plan, args, kept), **fattening)
+
+
+def _options_info(plan: _Plan, args: _Args, kept: np.ndarray) -> dict:
+    """The info of :func:`pq_mesh` that says how its rows were made (``kept``: the generators
+    meshed, of those given)."""
+    return dict(planarity_tolerance=args.ptol, extend=args.extend, respace=plan.respace,
+                division=args.division, thin=plan.thin, thinnable=len(plan.unthinned),
+                **_rows_from_info(plan.own, kept), primary="middle" if args.middle else args.primary)
 
 
 def _cut(a, d, rows, ptol, scale, tol, creases, crease_generators, warnings):
