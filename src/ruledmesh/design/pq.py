@@ -358,6 +358,10 @@ def _graded(rulings, so_far: tuple, options: dict, auto: bool) -> tuple | None:
         return None
 
 
+# The options a mesh's info names as its own, which the meshes made after it take from it.
+_MADE_WITH = ("planarity_tolerance", "extend", "respace", "division")
+
+
 def _with_thinned_rows(kept: tuple, options: dict) -> tuple:
     """The round ``kept`` (as :func:`_round`), or where its mesh misses a goal or has more
     than the typical share of its area in triangles (:func:`_short`) and the same mesh with
@@ -378,8 +382,7 @@ def _with_thinned_rows(kept: tuple, options: dict) -> tuple:
     info = mesh.info
     if not _short(kept, goal) or not info.get("thinnable"):
         return kept
-    opts = {**options, **{k: info[k] for k in ("planarity_tolerance", "extend", "respace", "division",
-                                                "primary")}, **_segment_options(info, len(rulings.a)),
+    opts = {**options, **{k: info[k] for k in (*_MADE_WITH, "primary")}, **_segment_options(info, len(rulings.a)),
             "thin": True}
     try:
         other = _round(rulings, _mesh(rulings, opts))
@@ -473,8 +476,7 @@ def _other_rows(kept: tuple, options: dict, free: tuple[bool, bool, bool, bool])
     """
     goal = _goal(options)
     best, rulings, mesh = kept, kept[3], kept[4]
-    options = {**options, **{k: mesh.info[k] for k in ("planarity_tolerance", "extend", "respace",
-                                                        "division")}}
+    options = {**options, **{k: mesh.info[k] for k in _MADE_WITH}}
     through = free[2] and options["trim"]      # untrimmed, a mesh has no border to cut teeth along
     other = None
     if (any(free[:2]) or free[3]) and sum(_goals_met(best, goal)) < 2:

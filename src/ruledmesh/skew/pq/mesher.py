@@ -222,8 +222,8 @@ def _past_hopeless(plan: _Plan, run: Run, lo: int, hi: int, primary: int, div: D
     With ``plan.thin`` the rest keeps rows where it can.  Rows fail towards a torsal
     generator because its faces grow slender there (:mod:`ruledmesh.analysis.asymptotic`),
     and with every other row left out they are twice as long along the generators.  So
-    the rest restarts with the rows thinned from the farthest generator of that part
-    where the seam makes no splinter (:func:`_thinned`), as a segment of its own, which
+    the rest restarts with the rows thinned (:func:`_thinned`) from the farthest generator
+    of that part where a seam may lie (:func:`_thinnable`), as a segment of its own, which
     thins them again where they fail again.
     """
     a, d = plan.a, plan.d
@@ -235,21 +235,20 @@ def _past_hopeless(plan: _Plan, run: Run, lo: int, hi: int, primary: int, div: D
         return [run]
     reach = int(dist.min())
     # The seams tried, farthest first: generators of the part kept, or ``shared`` itself.
-    for j in [0] if reach < 3 else [*range(reach, 1, -1), 0]:
+    first = _thinned(div)
+    for j in [] if first is None else [0] if reach < 3 else [*range(reach, 1, -1), 0]:
         seam = shared + outward * j
-        if not _thinnable(plan, seam) or div.matched is None or len(div.matched) < 2 * _MIN_THINNED:
+        if not _thinnable(plan, seam):
             continue
         if not plan.thin:
             plan.unthinned.append(seam)
             break
-        if j == 0:
-            if (thin := _thinned(plan, div, seam)) is not None:
-                return _build_segment(plan, lo, hi, primary, thin, budget, shared)
-            continue
+        if j == 0 and first is not None:
+            return _build_segment(plan, lo, hi, primary, first, budget, shared)
         r0, r1 = (lo, seam) if shared == lo else (seam, hi)
         near = mesh_run(a[r0:r1 + 1], d[r0:r1 + 1], r0, shared - r0, div, plan.tol, plan.scale,
                         plan.warnings, plan.hops)
-        if (thin := _thinned(plan, matched(div, _handed_on(plan, near, seam, div)), seam)) is None:
+        if (thin := _thinned(matched(div, _handed_on(plan, near, seam, div)))) is None:
             continue
         rest = _build_segment(plan, seam, hi, 0, thin, budget, shared=seam) if shared == lo else \
             _build_segment(plan, lo, seam, seam - lo, thin, budget, shared=seam)
@@ -266,8 +265,7 @@ def _past_hopeless(plan: _Plan, run: Run, lo: int, hi: int, primary: int, div: D
 
 def _thinnable(plan: _Plan, g: int) -> bool:
     """Whether the hop lines cross generator ``g`` at :data:`_THIN_MIN_DEG` or more all over
-    the patch (and ``g`` has neighbours on both sides): a seam of thinned rows there makes
-    no splinter."""
+    the patch (and ``g`` has neighbours on both sides): a seam of thinned rows may lie there."""
     if not 0 < g < len(plan.a) - 1:
         return False
     near = slice(g - 1, g + 2)
@@ -275,11 +273,10 @@ def _thinnable(plan: _Plan, g: int) -> bool:
     return bool(angles.min() >= _THIN_MIN_DEG)
 
 
-def _thinned(plan: _Plan, div: Division, g: int) -> Division | None:
+def _thinned(div: Division) -> Division | None:
     """``div``'s matched division with every other row left out (its end rows kept), or None
-    where it would keep fewer than :data:`_MIN_THINNED` rows or the seam on generator ``g``,
-    where the thinned rows meet the others, could make splinters (:func:`_thinnable`)."""
-    if div.matched is None or len(div.matched) < 2 * _MIN_THINNED or not _thinnable(plan, g):
+    where it would keep fewer than :data:`_MIN_THINNED` rows."""
+    if div.matched is None or len(div.matched) < 2 * _MIN_THINNED:
         return None
     t = div.matched[::2] if len(div.matched) % 2 else np.r_[div.matched[:-1:2], div.matched[-1]]
     return replace(div, matched=t)
