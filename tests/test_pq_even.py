@@ -145,6 +145,10 @@ def test_tolerance_mode_keeps_rows_where_the_mesh_without_them_is_mostly_triangl
     assert area_shares(mesh)["triangles"] <= 0.15
     assert face_min_angles(mesh).min() >= 2.7
     assert face_planarity(mesh).max() <= 1e-3
+    # The splinters are told apart as the lines' own angle where they meet, with the remedy.
+    said = [w for w in mesh.info["warnings"] if "faces have an angle below" in w]
+    assert len(said) == 1 and "where two generators meet at 2.7 deg" in said[0], said
+    assert said[0].endswith("generators at least 3 deg apart where they meet give fatter ones")
 
 
 def test_rows_from_none_in_a_design_file():

@@ -16,7 +16,7 @@ from ...errors import GeometryError, ParameterError
 from ...hop import coplanarity, sense_changes
 from ...mesh import Mesh
 from ...normalise import normalised
-from ...tolerances import DEFAULT, NEARLY_DEVELOPABLE, PARAMETER_SLACK, Tolerances
+from ...tolerances import DEFAULT, NEARLY_DEVELOPABLE, PARAMETER_SLACK, TINY, Tolerances
 from .assemble import assemble
 from .collapses import _border_vertices, _touching, collapse_splinters
 from .flips import flip_splinters, flip_triangles
@@ -475,7 +475,7 @@ def pq_mesh(a, b, rows: int = 20, primary: int | str = "middle", option: int = 0
     mesh, fattening, measured = _fattened(assemble(parts, a, d, args.trim, tol, ptol, warnings, scale, meet,
                                                    rows=rows), ptol, tol)
     _warn_share(mesh, warnings, known, m, rows, (a, d, ptol), measured)
-    _warn_splinters(mesh, warnings, torsal, measured)
+    _warn_splinters(mesh, warnings, torsal, measured, d)
     if kept.size < m_given:
         mesh = _renumbered(mesh, kept)
     return mesh.with_info(runs=runs, restarts=known.restarts, **_options_info(plan, args, kept), **fattening)
@@ -941,10 +941,12 @@ def _pairing_tolerance(ptol: float, tol: Tolerances) -> float:
 
 
 def _warn_splinters(mesh: Mesh, warnings: list[str], torsal: np.ndarray,
-                    measured: tuple | None = None) -> None:
+                    measured: tuple | None = None, d: np.ndarray | None = None) -> None:
     """Say how many faces are splinters for fabrication, where, and next to what.
 
-    ``measured``: the (F,) smallest angles and areas of the faces, if known.
+    ``measured``: the (F,) smallest angles and areas of the faces, if known; ``d``: the
+    (m, 3) directions of the generators, if known (then splinters whose smallest angle is
+    that between the two generators of their strip are told apart, see :func:`_at_meetings`).
     """
     from ...analysis.faces import SPLINTER_DEG, face_min_angles
 
@@ -968,12 +970,19 @@ def _warn_splinters(mesh: Mesh, warnings: list[str], torsal: np.ndarray,
         near_torsal |= np.abs(g0 - k) <= 2
     border = (t_lo <= PARAMETER_SLACK) | (t_hi >= 1 - PARAMETER_SLACK)
     quads = mesh.valences[bad] == 4
+    meeting = _at_meetings(ang[bad], g0, d)
     where = []
+    if meeting.any():
+        where.append(f"{meeting.sum()} with their corner where two generators meet at "
+                     f"{ang[bad][meeting].min():.2g} deg (no face there can be fatter)")
+    near_torsal &= ~meeting
+    border &= ~meeting
+    quads &= ~meeting
     for count, label in ((near_torsal.sum(), "next to torsal generators"),
                          ((border & ~near_torsal).sum(), "at the border"),
                          ((quads & ~border & ~near_torsal).sum(),
                           "thin quads where the rows run nearly along the generators"),
-                         ((~quads & ~border & ~near_torsal).sum(), "between runs of rows")):
+                         ((~quads & ~border & ~near_torsal & ~meeting).sum(), "between runs of rows")):
         if count:
             where.append(f"{count} {label}")
     gs = unique(g0)
@@ -983,8 +992,34 @@ def _warn_splinters(mesh: Mesh, warnings: list[str], torsal: np.ndarray,
     warnings.append(
         f"{bad.size} faces have an angle below {SPLINTER_DEG:g} deg (smallest {ang[bad].min():.2g} deg; "
         f"{', '.join(where)}; generators {', '.join(spans[:6])}{' ...' if len(spans) > 6 else ''}): "
-        "strips narrow against the row step make thin panels; fewer rows, other generators "
-        "(rulings.count, distribution) or [mesh] planarity_tolerance = 1e-3 give fatter ones")
+        + (f"generators at least {SPLINTER_DEG:g} deg apart where they meet give fatter ones"
+           if meeting.all() else
+           "strips narrow against the row step make thin panels; fewer rows, other generators "
+           "(rulings.count, distribution) or [mesh] planarity_tolerance = 1e-3 give fatter ones"))
+
+
+# A splinter's smallest angle within this share of the angle between its strip's generators
+# is that angle: its corner is where they meet (_at_meetings).
+_MEETING_ANGLE_SHARE = 0.01
+
+
+def _at_meetings(angles: np.ndarray, g0: np.ndarray, d: np.ndarray | None) -> np.ndarray:
+    """(k,) bool: which of ``k`` splinters (smallest angles ``angles``, lowest generators
+    ``g0``) have the angle between generators ``g0`` and ``g0 + 1`` (directions ``d``) as
+    their smallest angle.
+
+    Where two consecutive generators meet (a Plücker conoid's pinch points, a cone's apex)
+    a face with its corner there has their angle, whatever the rows: lines 2.7 degrees
+    apart make 2.7-degree corners.
+    """
+    if d is None or len(d) < 2:
+        return np.zeros(angles.shape, bool)
+    i = np.clip(g0, 0, len(d) - 2)
+    u0, u1 = d[i], d[i + 1]
+    cos = np.einsum("ij,ij->i", u0, u1) / np.maximum(
+        np.linalg.norm(u0, axis=1) * np.linalg.norm(u1, axis=1), TINY)
+    between = np.degrees(np.arccos(np.clip(np.abs(cos), 0.0, 1.0)))
+    return np.abs(angles - between) <= _MEETING_ANGLE_SHARE * between
 
 
 def _nearly_flat(a: np.ndarray, d: np.ndarray, rows: int, ptol: float) -> np.ndarray:
