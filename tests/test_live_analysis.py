@@ -112,3 +112,34 @@ def test_cli_analyze_quick_refuses_full_report_options(option, capsys):
 def test_top_level_build_and_live_analysis_agree_on_planarity():
     mesh = ruledmesh.build("examples/skew.toml")
     assert LiveAnalysis(mesh).figures["planarity"]["max"] == ruledmesh.analyze(mesh)["planarity"]["max"]
+
+
+def test_faces_far_from_the_origin_are_planar_to_their_coordinates_rounding():
+    """examples/skew moved 5e6 m out (building coordinates): each corner is stored to about
+    5e-10 m, so panels built exact measure up to about 1e-9.  They count as exact to that
+    rounding (the report and the live figures say so, with no warning) and fabricate cuts
+    them; a panel bent by a millimetre is still bent."""
+    from ruledmesh.analysis.planar import bent_faces, rounding_allowance
+    from ruledmesh.fabricate.unroll import unroll
+
+    mesh = build_full("examples/skew.toml").mesh
+    far = mesh.with_vertices(mesh.vertices + np.array([5e6, 5e6, 100.0]))
+    plan = face_planarity(far)
+    assert plan.max() > 1e-11 >= face_planarity(mesh).max() * 100   # the coordinates' rounding
+    assert np.all(plan <= rounding_allowance(far) + 1e-12)
+    assert rounding_allowance(mesh).max() < 1e-12                     # near the origin: none
+    report, live = analyze(far), live_figures(far)
+    assert live["planarity"] == report["planarity"]
+    assert report["planarity"]["above_tolerance"] == 0
+    assert report["planarity"]["exact"] == far.n_faces
+    assert report["planarity"]["exact_to_rounding"] == np.count_nonzero(plan > 1e-12) > 0
+    assert not any("not planar" in w for w in report["warnings"])
+    assert not bent_faces(far)[0].any()
+    unroll(far)
+    quad = int(np.flatnonzero(far.valences == 4)[0])
+    v = far.vertices.copy()
+    v[far.face(quad)[0], 2] += 1e-3
+    bent = far.with_vertices(v)
+    assert analyze(bent)["planarity"]["above_tolerance"] >= 1
+    with pytest.raises(GeometryError, match="not planar"):
+        unroll(bent)

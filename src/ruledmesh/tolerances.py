@@ -24,7 +24,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 __all__ = ["BORDER_TRIM_MAX_GAP", "BRENTQ_XTOL", "CLOSENESS_SEARCH", "COLLAPSE_MAX_SAG",
-           "COLLINEAR", "COLLINEAR_SQ", "CONGRUENCE_ANGLE_DEG", "CONVERGED", "DEFAULT",
+           "COLLINEAR", "COLLINEAR_SQ", "CONGRUENCE_ANGLE_DEG", "CONVERGED", "COORDINATE_ROUNDING", "DEFAULT",
            "DEPTH_BIAS", "EVEN_MAX_ADDED", "EVEN_MAX_HALVINGS", "EVEN_PINCH_SHARE", "EVEN_PINCH_STEP_PER_WIDTH",
            "EVEN_STEP_PER_WIDTH", "FLAT_PAIR_MAX_SAG", "FLIP_ACTIVE_DEG", "FLIP_MAX_BEND_DEG",
            "FLIP_MAX_SAG", "FLIP_MIN_GAIN_DEG", "FLOAT32_WARNING", "INTERIOR", "KKT_REGULARISATION", "MIN_EXTENT",
@@ -91,6 +91,13 @@ ROUNDING = 1e-12
 #: :data:`ROUNDING` squared, for tests on products of two squared lengths
 #: (``|u x w|**2 <= ROUNDING_SQ * |u|**2 |w|**2`` is ``sin(angle) <= ROUNDING``).
 ROUNDING_SQ = 1e-24
+#: What the rounding of its stored corners alone can make of a face's planarity, per unit of
+#: (largest absolute coordinate / longest edge): each coordinate is stored to half an ulp
+#: (2**-53 of it), a corner moves by up to sqrt(3) times that, the gap between the diagonals by
+#: twice that, and a convex quad's mean diagonal is at least half its longest edge:
+#: 4 sqrt(3) 2**-53 = 7.7e-16, rounded up.  Near the origin far below PLANARITY; building
+#: coordinates 5e6 m out store a 1 m panel's corners to 9e-10 m (analysis.planar).
+COORDINATE_ROUNDING = 1e-15
 #: A few ulps of a unit-size number: values that differ only in their last digits
 #: (a unit vector's component against 1, two sorted candidates, a Newton step).
 ULPS = 1e-15

@@ -48,11 +48,15 @@ class FaceMeasures:
         :func:`.faces.convexity` in the same frame.
     area : (F,) float64
         Newell areas in the mesh's units (:func:`.faces.face_normals`).
+    rounding : (F,) float64
+        :func:`.planar.rounding_allowance`: the planarity the rounding of each face's
+        stored coordinates alone can give it.
     """
 
     planarity: np.ndarray
     convex: np.ndarray
     area: np.ndarray
+    rounding: np.ndarray
 
 
 def unit_copy(mesh: Mesh) -> tuple[Mesh, float]:
@@ -74,7 +78,7 @@ def unit_copy(mesh: Mesh) -> tuple[Mesh, float]:
     return mesh.with_vertices((v - centre) / scale), scale
 
 
-def face_measures(mesh: Mesh, tol: Tolerances = DEFAULT) -> FaceMeasures:
+def face_measures(mesh: Mesh, tol: Tolerances = DEFAULT, rounding: np.ndarray | None = None) -> FaceMeasures:
     """Planarity, convexity and area of every face, the quads' diagonals crossed once.
 
     Parameters
@@ -82,6 +86,9 @@ def face_measures(mesh: Mesh, tol: Tolerances = DEFAULT) -> FaceMeasures:
     mesh : Mesh
     tol : Tolerances
         ``tol.convexity`` is the margin of the convexity test.
+    rounding : (F,) float64, optional
+        :func:`.planar.rounding_allowance` of the mesh where it was stored, when ``mesh`` is
+        a copy moved to its unit frame (:func:`unit_copy`); default: that of ``mesh``.
 
     Returns
     -------
@@ -105,7 +112,10 @@ def face_measures(mesh: Mesh, tol: Tolerances = DEFAULT) -> FaceMeasures:
             plan[other] = F.polygon_planarity(framed, other)
             normals = F.face_normals(framed)[0][other]
             convex[other] = F.polygon_convexity(framed, other, normals, tol.convexity)
-    return FaceMeasures(plan, convex, F.face_normals(mesh)[1])
+    from .planar import rounding_allowance
+
+    return FaceMeasures(plan, convex, F.face_normals(mesh)[1],
+                        rounding_allowance(mesh) if rounding is None else rounding)
 
 
 def unit_figures(work: Mesh, measures: FaceMeasures, tol: Tolerances = DEFAULT) -> dict[str, Any]:
@@ -121,8 +131,11 @@ def unit_figures(work: Mesh, measures: FaceMeasures, tol: Tolerances = DEFAULT) 
 
     plan, area = measures.planarity, measures.area
     ptol = planarity_tolerance(work, tol)
-    exact = plan <= tol.planarity
-    within = ~exact & (plan <= ptol)
+    # Far from the origin the stored coordinates' rounding bends faces beyond 1e-12: exact to
+    # that rounding is exact (analysis.planar).
+    rounding = measures.rounding
+    exact = plan <= np.maximum(tol.planarity, rounding)
+    within = ~exact & (plan <= np.maximum(ptol, rounding))
     total = float(area.sum())
     return {
         "vertices": work.n_vertices,
@@ -134,7 +147,8 @@ def unit_figures(work: Mesh, measures: FaceMeasures, tol: Tolerances = DEFAULT) 
         "planarity": {
             **min_max_mean(plan),
             "tolerance": ptol,
-            "above_tolerance": int(np.count_nonzero(plan > ptol)),
+            "above_tolerance": int(np.count_nonzero(plan > np.maximum(ptol, rounding))),
+            "exact_to_rounding": int(np.count_nonzero(exact & (plan > tol.planarity))),
             "exact": int(np.count_nonzero(exact)),
             "within_tolerance": int(np.count_nonzero(within)),
             "max_exact": float(plan[exact].max()) if exact.any() else 0.0,
@@ -200,11 +214,13 @@ def live_figures(mesh: Mesh, tol: Tolerances = DEFAULT) -> dict[str, Any]:
     GeometryError
         If the mesh has no faces, as :func:`.report.analyze`.
     """
+    from .planar import rounding_allowance
     from .report import strict_json
 
     work, scale = _checked_unit_copy(mesh)
     with np.errstate(all="ignore"):
-        figures = scaled_back(unit_figures(work, face_measures(work, tol), tol), scale)
+        figures = scaled_back(unit_figures(work, face_measures(work, tol, rounding_allowance(mesh)), tol),
+                              scale)
     said = [w for w in figure_warnings(figures) if w]
     figures["warnings"] = [str(w) for w in mesh.info.get("warnings", [])] + said
     return strict_json(figures)

@@ -36,6 +36,7 @@ from ..progress import Progress, stages
 from ..tolerances import CLOSENESS_SEARCH, DEFAULT, Tolerances
 from . import faces as F
 from .live import face_measures, figure_warnings, min_max_mean, scaled_back, unit_copy, unit_figures
+from .planar import rounding_allowance
 
 __all__ = ["KIND_NOUNS", "METRIC_HOOKS", "MISMATCH", "analyze", "format_summary", "format_table",
            "kind_counts", "require_faces", "strict_json"]
@@ -154,7 +155,7 @@ def analyze(mesh: Mesh, reference=None, extras: Mapping[str, Any] | None = None,
     work, scale = unit_copy(mesh)
     names = ["faces"] + ["closeness"] * (reference is not None) + list(METRIC_HOOKS)
     with stages(progress, "analyse", names) as task, np.errstate(all="ignore"):
-        report = scaled_back(_figures(work, tol), scale)
+        report = scaled_back(_figures(work, tol, rounding_allowance(mesh)), scale)
         task.advance(note=names[1] if len(names) > 1 else None)
         if reference is not None:
             report.update(_closeness(mesh, reference, report["area"]["total"]))
@@ -210,9 +211,10 @@ def strict_json(report: dict[str, Any]) -> dict[str, Any]:
     return out
 
 
-def _figures(mesh: Mesh, tol: Tolerances) -> dict[str, Any]:
-    """The figures every mesh has: counts, planarity, convexity, sizes, angles."""
-    live = unit_figures(mesh, face_measures(mesh, tol), tol)
+def _figures(mesh: Mesh, tol: Tolerances, rounding: np.ndarray) -> dict[str, Any]:
+    """The figures every mesh has: counts, planarity, convexity, sizes, angles (``mesh`` in its
+    unit frame; ``rounding``: the planarity its stored coordinates' rounding allows each face)."""
+    live = unit_figures(mesh, face_measures(mesh, tol, rounding), tol)
     angles = F.corner_angles(mesh)
     edges = mesh.edges()
     lengths = np.linalg.norm(mesh.vertices[edges[:, 1]] - mesh.vertices[edges[:, 0]], axis=1)
@@ -345,6 +347,10 @@ def format_summary(report: Mapping[str, Any]) -> str:
     if pl.get("within_tolerance"):
         text += (f" ({pl['exact']} faces exact, {pl['within_tolerance']} within "
                  f"{pl['tolerance']:g})")
+    if pl.get("exact_to_rounding"):
+        # Far from the origin: the coordinates themselves cannot hold 1e-12 (analysis.planar).
+        text += (f" ({pl['exact_to_rounding']} faces planar to the rounding of their "
+                 "coordinates, which lie far from the origin)")
     q = report.get("quality")
     if q:
         text += (f", {q['area_share']['quads']:.0%} of the area in quads, smallest angle "
