@@ -119,6 +119,7 @@ def test_faces_far_from_the_origin_are_planar_to_their_coordinates_rounding():
     5e-10 m, so panels built exact measure up to about 1e-9.  They count as exact to that
     rounding (the report and the live figures say so, with no warning) and fabricate cuts
     them; a panel bent by a millimetre is still bent."""
+    from ruledmesh.analysis.guarantees import check_guarantee
     from ruledmesh.analysis.planar import bent_faces, rounding_allowance
     from ruledmesh.fabricate.unroll import unroll
 
@@ -135,11 +136,13 @@ def test_faces_far_from_the_origin_are_planar_to_their_coordinates_rounding():
     assert report["planarity"]["exact_to_rounding"] == np.count_nonzero(plan > 1e-12) > 0
     assert not any("not planar" in w for w in report["warnings"])
     assert not bent_faces(far)[0].any()
+    assert check_guarantee("planar", far)["met"]
     unroll(far)
     quad = int(np.flatnonzero(far.valences == 4)[0])
     v = far.vertices.copy()
     v[far.face(quad)[0], 2] += 1e-3
     bent = far.with_vertices(v)
     assert analyze(bent)["planarity"]["above_tolerance"] >= 1
+    assert not check_guarantee("planar", bent)["met"]
     with pytest.raises(GeometryError, match="not planar"):
         unroll(bent)
