@@ -1374,3 +1374,86 @@ def test_a_design_that_refines_shows_its_quick_mesh_then_the_full_one(page, desi
     assert page.inner_text("[data-fig=faces]") == str(full.n_faces)
     assert page.evaluate(DRAWN_JS)["faces"] == full.n_faces
     assert designer.session.built.mesh.n_faces == full.n_faces
+
+
+def refused(pg, action, field: str) -> str:
+    """Do ``action``; wait for the error it shows (naming ``field``) and the page to settle."""
+    pg.evaluate("document.querySelector('#error').hidden = true")
+    action()
+    pg.wait_for_selector("#error:not([hidden])")
+    pg.wait_for_function("!window.designer.busy()")
+    text = pg.inner_text("#error")
+    assert field in text, text
+    return text
+
+
+def test_refused_input_changes_neither_the_design_nor_the_selection(page, designer):
+    """What a refused value leaves behind: the design, the fields, the selection, the figures.
+
+    ``Infinity`` and ``1e400`` are numbers to the page that JSON writes as null, which deletes
+    a field; a cleared coordinate is 0 to ``Number``; a refused delete moved the selection to
+    the point before; a grey default field kept the refused value; a refused edit wiped the
+    figures computed for the design still shown."""
+    design = designer.session.design
+    page.click("#slow-figures")
+    page.wait_for_function("document.querySelector('[data-fig=panels]').textContent.match(/^\\d+$/)",
+                           timeout=60_000)
+    panels = page.inner_text("[data-fig=panels]")
+    for text in ("Infinity", "-Infinity", "1e400"):
+        field = page.locator('[data-path="mesh.rows"] input.val')
+        said = refused(page, lambda t=text, f=field: (f.fill(t), f.press("Enter")), "mesh.rows")
+        assert text in said
+        page.wait_for_function(
+            "document.querySelector('[data-path=\"mesh.rows\"] input.val').value === '12'")
+    # a field left at its default shows the default again
+    field = page.locator('[data-path="mesh.max_extend"] input.val')
+    refused(page, lambda: (field.fill("-5"), field.press("Enter")), "mesh.max_extend")
+    page.wait_for_function(
+        "document.querySelector('[data-path=\"mesh.max_extend\"] input.val').value === '20'")
+    # the figures computed for this version stay
+    assert page.inner_text("[data-fig=panels]") == panels
+    # a cleared or junk coordinate is refused, the point stays where it was
+    click_handle(page, "c2.points[2]")
+    page.wait_for_function("window.designer.selection().join() === 'c2.points[2]'")
+    for text in ("", "abc"):
+        said = refused(page, lambda t=text: (page.fill("#sel-x", t), page.press("#sel-x", "Enter")),
+                       "c2.points[2] x")
+        assert "expected a finite number" in said
+        assert page.input_value("#sel-x") == "6"
+    # a refused delete keeps the point chosen (a degree-3 B-spline keeps four points)
+    click_handle(page, "c1.points[3]")
+    page.wait_for_function("window.designer.selection().join() === 'c1.points[3]'")
+    refused(page, lambda: page.click("#pt-delete"), "curves.c1.points")
+    assert page.evaluate("window.designer.selection()") == ["c1.points[3]"]
+    assert page.input_value("#sel-x") == "10"
+    assert designer.session.design == design
+    assert page.evaluate("window.designer.version") == designer.session.version
+
+
+def test_the_toml_pane_says_when_the_design_moved_on(page, designer):
+    """Text typed in the pane stays while the design changes, and the pane says it is behind
+    (Apply would replace the newer design); a kind's template the page wrote gives way to the
+    design once a kind builds; a catalogue surface lists no fields of the ruled methods."""
+    page.click("#toml-pane summary")
+    page.locator("#toml").press("End")
+    page.keyboard.type("\n# a note\n")
+    assert page.is_hidden("#toml-stale")
+    set_field(page, "mesh.rows", 11)
+    page.wait_for_selector("#toml-stale:not([hidden])")
+    assert "rows = 12" in page.input_value("#toml") and "# a note" in page.input_value("#toml")
+    shot(page, "toml-pane-behind")
+    page.click("#toml-revert")
+    assert page.is_hidden("#toml-stale")
+    assert page.input_value("#toml") == designer.session.toml()
+    # a kind that needs fields: its template; another kind that builds: the design
+    page.select_option("#kind", "torus")
+    page.wait_for_selector("#error:not([hidden])")
+    assert 'kind = "torus"' in page.input_value("#toml")
+    v = page.evaluate("window.designer.version")
+    page.select_option("#kind", "hyperboloid")
+    wait_version(page, v)
+    page.wait_for_function("!window.designer.busy()")
+    assert designer.session.design["surface"] == {"kind": "hyperboloid"}
+    assert page.input_value("#toml") == designer.session.toml()
+    assert page.is_hidden("#toml-stale")
+    assert page.locator('.ctl[data-path^="mesh."]').count() == 0

@@ -720,8 +720,15 @@ function showSelection() {
 // Typing one coordinate of the typed point moves every selected point by the same amount.
 function typeCoordinate(axis) {
   const h = primaryLabel && handleByLabel(primaryLabel);
-  const v = Number($(`sel-${'xyz'[axis]}`).value);
-  if (!h || !Number.isFinite(v)) { showSelection(); return; }
+  const input = $(`sel-${'xyz'[axis]}`);
+  const text = input.value.trim();
+  const v = text === '' ? NaN : Number(text);   // Number('') is 0: a cleared field is no value
+  if (!h) { showSelection(); return; }
+  if (!Number.isFinite(v)) {
+    showError(`${h.label} ${'xyz'[axis]}: expected a finite number, got ${text ? JSON.stringify(text) : 'nothing'}`);
+    input.value = +h.position[axis].toFixed(6);
+    return;
+  }
   const delta = v - h.position[axis];
   const changes = [];
   for (const label of selection) {
@@ -757,11 +764,11 @@ function editPoints(action) {
     pts.push(beyond(pts[n - 2] || pts[n - 1], pts[n - 1]));
     chosen = n;
   }
-  const base = h.label.replace(/\[\d+\]$/, '');
-  selection.clear();
-  selection.add(`${base}[${chosen}]`);
-  primaryLabel = `${base}[${chosen}]`;
-  queueEdit([[list.listPath, pts]]);
+  // The new selection once the server has the edit: a refused delete keeps the point chosen.
+  const label = `${h.label.replace(/\[\d+\]$/, '')}[${chosen}]`;
+  queueEdit([[list.listPath, pts]], null, (ok) => {
+    if (ok && handleByLabel(label)) { select(label, false); showSelection(); }
+  });
 }
 
 // Snapping while dragging: to the grid (its step) and to the other points (within 10 px).
@@ -1104,8 +1111,8 @@ function showFigures(fig, quick = false) {
   setFig('non_convex', fig.non_convex);
   // Coverage, closeness and the panel count are computed on request (a button, or a
   // colouring that needs them): during edits they would compete with the builds.
-  for (const k of ['coverage', 'closeness', 'panels']) setFig(k, '-', true);
   if (window.designer.figuresVersion !== current?.header.version) {
+    for (const k of ['coverage', 'closeness', 'panels']) setFig(k, '-', true);
     $('report').textContent = 'not computed for this version';
   }
   $('warnings').innerHTML = '';
@@ -1207,8 +1214,9 @@ function numberControl(row, path, name, value, send) {
     field.dataset.synced = field.value;
     const text = field.value.trim();
     const num = Number(text);
-    const v = text !== '' && !Number.isNaN(num) ? num
-      : (name in NUMERIC_OR_WORD ? text : text);
+    // Only finite numbers travel as numbers: Infinity and 1e400 would become JSON null, which
+    // deletes the field. As text, the server refuses them with a line naming the field.
+    const v = text !== '' && Number.isFinite(num) ? num : text;
     // A typed value past the slider's ends widens it.
     if (typeof v === 'number') {
       if (v > +slider.max) slider.max = v;
@@ -1366,7 +1374,7 @@ function buildControls() {
   if (Array.isArray(design.rulings?.between)) betweenControl(box, design);
   section('[mesh]', design.mesh, ['mesh']);
   // Every numeric (and boolean) field of the method, also those left at their defaults.
-  const defaults = METHOD_FIELDS[design.mesh?.method || 'pq'] || {};
+  const defaults = design.surface ? {} : METHOD_FIELDS[design.mesh?.method || 'pq'] || {};
   for (const [k, v] of Object.entries(defaults)) {
     if (design.mesh && k in design.mesh) continue;
     control(box, ['mesh', k], k, v);
@@ -1429,7 +1437,11 @@ function syncControls() {
     // value last shown or sent; once sent, the server's answers (and other tabs') show again.
     if (!force && (el === activeInput || (el === document.activeElement && el.type === 'text'
                                           && el.value !== el.dataset.synced))) continue;
-    const v = valueAt(el.dataset.path.split('.'));
+    const path = el.dataset.path.split('.');
+    let v = valueAt(path);
+    if (v === undefined && path.length === 2 && path[0] === 'mesh' && !current.header.design.surface) {
+      v = (METHOD_FIELDS[current.header.design.mesh?.method || 'pq'] || {})[path[1]];
+    }
     if (v === undefined) continue;
     if (el.type === 'checkbox') el.checked = v;
     else if (el.type === 'range') { if (typeof v === 'number') el.value = v; }
@@ -1456,16 +1468,20 @@ $('kind').addEventListener('change', async () => {
   const design = current.header.design;
   if (!design.surface) lastRuled = design;
   if (!kind) {
-    await send('design', lastRuled ? { design: lastRuled } : { default: true });
+    if (await sendNow('design', lastRuled ? { design: lastRuled } : { default: true }) && tomlTemplate) {
+      showDesignToml();
+    }
     return;
   }
   const candidate = { name: kind, surface: { kind }, mesh: {} };
-  const ok = await send('design', { design: candidate });
+  const ok = await sendNow('design', { design: candidate });
+  if (ok && tomlTemplate) showDesignToml();
   if (!ok) {
     // The kind needs fields: offer a template in the TOML pane to fill in.
     $('toml').value = `name = "${kind}"\n\n[surface]\nkind = "${kind}"\n# add the fields the ` +
       `message above asks for, then Apply\n\n[mesh]\n`;
     tomlDirty = true;
+    tomlTemplate = true;
     $('toml-pane').open = true;
     buildKindChooser();
   }
@@ -1485,14 +1501,15 @@ let shown = { version: -1, at: 0, received: 0 };  // the last state drawn and it
 // Edits go one at a time. While one is on its way, later values of the same fields replace
 // the waiting ones (the newest wins: a slider moved on, a point dragged further), so fast
 // input never builds a backlog of designs nobody will see.
-function queueEdit(changes, coalesce = null) {
+function queueEdit(changes, coalesce = null, after = null) {
   const keys = changes.map(([path]) => keyOf(path));
   let job = jobs[jobs.length - 1];
   const sameFields = job && job.changes.size === keys.length && keys.every((k) => job.changes.has(k));
   if (!job || !(sameFields || (coalesce !== null && job.coalesce === coalesce))) {
-    job = { changes: new Map(), coalesce, t: 0 };
+    job = { changes: new Map(), coalesce, t: 0, after: [] };
     jobs.push(job);
   }
+  if (after) job.after.push(after);  // told whether the server accepted the edit
   if (coalesce !== null) job.coalesce = coalesce;
   for (const [path, value] of changes) job.changes.set(keyOf(path), [path, value]);
   job.t = performance.now();  // the input whose value the frame will show
@@ -1503,7 +1520,8 @@ async function flush() {
   inFlight = true;
   while (jobs.length) {
     const job = jobs.shift();
-    await send('edit', { changes: [...job.changes.values()], coalesce: job.coalesce }, job.t);
+    const ok = await send('edit', { changes: [...job.changes.values()], coalesce: job.coalesce }, job.t);
+    for (const f of job.after) f(ok);
   }
   inFlight = false;
   catchUp();
@@ -1570,6 +1588,20 @@ async function send(name, body, inputAt = null) {
     forceSync = true;  // even the field just typed in shows the server's value again
     await refresh();  // show the design as the server has it (the edit was refused)
     return false;
+  }
+}
+
+// Actions sent outside the edit queue (Apply, the kind menu): the page is busy while they
+// build, and an error left from an earlier action goes at once.
+let direct = 0;
+async function sendNow(name, body) {
+  direct += 1;
+  showError('');
+  status('building...');
+  try {
+    return await send(name, body);
+  } finally {
+    direct -= 1;
   }
 }
 
@@ -1665,6 +1697,14 @@ async function goTo(steps) {
 }
 
 let tomlDirty = false;
+let tomlBase = null;       // the design's TOML when the text in the pane began to differ from it
+let tomlTemplate = false;  // the text is a kind's template the page put there (not the user's)
+// Typed text is kept while the design changes (another tab, an edit here), but said to be
+// behind it: Apply would replace the newer design with it.
+function showTomlStale() {
+  $('toml-stale').hidden = !(tomlDirty && !tomlTemplate && tomlBase !== null
+                             && current && current.header.toml !== tomlBase);
+}
 let firstState = true;
 const FACE_ARRAYS = ['triangles', 'triangle_face', 'kind', 'edges', 'face_offsets', 'face_indices'];
 function applyState(msg) {
@@ -1696,7 +1736,9 @@ function applyState(msg) {
     for (const f of h.choices.formats) fmtSel.add(new Option(f, f, false, f === '.obj'));
     updateDownload();
   }
+  if (tomlDirty && $('toml').value === h.toml) tomlDirty = false;  // typed back to the design
   if (!tomlDirty) $('toml').value = h.toml;
+  showTomlStale();
   showRefining(h);
   showFigures(h.figures, !!h.refining || !!h.refine_error);
   if (h.history) showHistory(h.history);
@@ -2028,12 +2070,21 @@ $('export').addEventListener('click', async () => {
     window.designer.lastExport = r.path;
   } catch (err) { showError(err.message); }
 });
-$('toml').addEventListener('input', () => { tomlDirty = true; });
+$('toml').addEventListener('input', () => {
+  if (!tomlDirty || tomlTemplate) tomlBase = current.header.toml;
+  tomlDirty = true;
+  tomlTemplate = false;
+  showTomlStale();
+});
+function showDesignToml() {
+  tomlDirty = false;
+  tomlTemplate = false;
+  $('toml').value = current.header.toml;
+  showTomlStale();
+}
+$('toml-revert').addEventListener('click', showDesignToml);
 $('apply-toml').addEventListener('click', async () => {
-  if (await send('design', { toml: $('toml').value })) {
-    tomlDirty = false;
-    $('toml').value = current.header.toml;
-  }
+  if (await sendNow('design', { toml: $('toml').value })) showDesignToml();
 });
 window.addEventListener('keydown', (event) => {
   const tag = document.activeElement?.tagName;
@@ -2059,7 +2110,7 @@ window.addEventListener('keydown', (event) => {
 window.designer = {
   version: null, renders: 0, frames: 0, figuresVersion: null, lastExport: null, timings,
   breakdown, frameTimes, frameLog, liveFrames: 0, refineNotes: 0, kept: {}, sameTopology: 0, legend: null, panelFigures: null, hover: null, readoutSide: null, panel: null, panelsDropped: 0, reused: false, view: null,
-  busy: () => inFlight || jobs.length > 0,
+  busy: () => inFlight || jobs.length > 0 || direct > 0,
   softwareGL: SOFTWARE_GL,
   // The page's own part of an update, without the server: decode the last state message
   // again, draw it, and wait for the frame; resolves to the milliseconds it took.
