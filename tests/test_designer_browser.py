@@ -1247,6 +1247,9 @@ def test_catalogue_surface_handles_drag_its_radius(browser, tmp_path):
         handles = open_in_top_view(pg, server)
         assert {"R", "r"} <= set(handles)
         R0 = server.session.design["surface"]["R"]
+        # R = 3.0 is a decimal field (JSON writes it 3): its slider moves in fractions
+        step = pg.evaluate("document.querySelector('input[type=range][data-path=\"surface.R\"]').step")
+        assert 0 < float(step) < 1, step
         drag(pg, handles["R"], 48, 18)   # mostly along +x: a larger R
         R1 = server.session.design["surface"]["R"]
         assert R1 > R0 + 0.2

@@ -1021,6 +1021,9 @@ class Session:
             "refine_note": self._note[1] if self._note is not None and self._note[0] is self._current
             and self._current.refining else None,
             "design": self._current.design,
+            # JSON has one number type: the page reads 3.0 as 3 and would give it an integer
+            # slider; these fields are decimal in the design (dotted paths).
+            "decimal_fields": _decimal_fields(self._current.design),
             "toml": self.toml(),
             "path": str(self.path) if self.path else None,
             "folder": str(self.base_dir),
@@ -1131,6 +1134,18 @@ class Session:
                for k, v in table.items()}
         return {"version": snap.version, "topology": key, "face": face,
                 "outline": unrolled.polygon(face).tolist(), "row": row}
+
+
+def _decimal_fields(design: Mapping, prefix: str = "") -> list[str]:
+    """The dotted paths of the fields of ``design``'s tables whose values are floats."""
+    out = []
+    for key, value in design.items():
+        path = f"{prefix}{key}"
+        if isinstance(value, float):
+            out.append(path)
+        elif isinstance(value, Mapping):
+            out += _decimal_fields(value, path + ".")
+    return out
 
 
 def _torsal(gens: np.ndarray, mesh: Mesh) -> np.ndarray:

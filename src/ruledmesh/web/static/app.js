@@ -1185,7 +1185,8 @@ function numberRange(name, v, isInt) {
 // A slider with a number field (and a button widening its range) for a numeric field.
 function numberControl(row, path, name, value, send) {
   const k = keyOf(path);
-  const isInt = Number.isInteger(value) && !(name === 'extend');
+  const isInt = Number.isInteger(value) && !(name === 'extend')
+    && !(current.header.decimal_fields || []).includes(path.join('.'));
   let numeric = typeof value === 'number' ? value : 0;
   let [lo, hi, step] = numberRange(name, numeric, isInt);
   if (name === 'primary') { lo = 0; hi = Math.max((current.header.design.rulings?.count || 3) - 1, 1); step = 1;
