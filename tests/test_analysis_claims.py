@@ -173,3 +173,17 @@ def test_designer_figures_use_the_same_words():
     figures = fast_figures(mesh)[0]
     assert figures["kinds_text"] == kind_counts(mesh.count_kinds())
     assert figures["kinds_text"].startswith(f"{figures['kinds']['quad']} quads, ")
+
+
+def test_designer_planarity_counts_are_analyze_s_also_far_from_the_origin():
+    """The designer's legend counts exact faces by analyze's rule: examples/skew moved 5e6 m
+    out has every face exact to the rounding of its coordinates in both."""
+    from ruledmesh.web.session import fast_figures
+
+    mesh = build_file(EXAMPLES / "skew.toml").mesh
+    for m in (mesh, mesh.with_vertices(mesh.vertices + np.array([5e6, 5e6, 100.0]))):
+        counts = fast_figures(m)[0]["planarity_counts"]
+        report = analyze(m)["planarity"]
+        shown = int(np.count_nonzero(m.valences > 3))
+        assert counts == {"exact": shown, "over": report["above_tolerance"], "faces": shown}
+        assert report["exact"] == m.n_faces

@@ -10,7 +10,7 @@ import numpy as np
 import pytest
 
 from ruledmesh.cli import main
-from ruledmesh.errors import ExportError
+from ruledmesh.errors import ExportError, RuledMeshWarning
 from ruledmesh.io import READERS, WRITERS, formats, load, save
 from ruledmesh.mesh import FaceKind
 from ruledmesh.triangulate import recover_polygons, triangulate
@@ -37,7 +37,11 @@ def test_stl_numpy_stl_and_meshio(tmp_path, name):
     stl_mesh = pytest.importorskip("stl.mesh")
     meshio = pytest.importorskip("meshio")
     mesh = MESHES[name]
-    save(tmp_path / "m.stl", mesh)
+    if name == "far":  # STL's float32 rounds these coordinates: the writer says so
+        with pytest.warns(RuledMeshWarning, match="STL stores float32"):
+            save(tmp_path / "m.stl", mesh)
+    else:
+        save(tmp_path / "m.stl", mesh)
     tri = triangulate(mesh)
     # calculate_normals=False: keep the normals stored in the file.
     got = stl_mesh.Mesh.from_file(str(tmp_path / "m.stl"), calculate_normals=False)

@@ -284,7 +284,9 @@ def fast_figures(mesh: Mesh) -> tuple[dict[str, Any], np.ndarray, np.ndarray]:
     -------
     figures : dict
         Counts, ``planarity_max`` and the face it is at (``planarity_face``), the
-        mesh's ``planarity_tolerance`` and the ``planarity_exact`` of rounding,
+        mesh's ``planarity_tolerance`` and the ``planarity_exact`` of rounding, the
+        ``planarity_counts`` of faces (not triangles) exact, over the tolerance and in all,
+        by :mod:`ruledmesh.analysis.planar`'s rule,
         ``min_angle_deg`` and its face (``min_angle_face``), ``splinters``
         (faces with an angle below ``splinter_deg``), ``area_share`` (as in the
         report's ``quality.area_share``), convexity and the mesher's warnings.
@@ -295,12 +297,19 @@ def fast_figures(mesh: Mesh) -> tuple[dict[str, Any], np.ndarray, np.ndarray]:
         Per-face smallest interior angle in degrees (:func:`~ruledmesh.analysis.faces.face_min_angles`).
     """
     from ..analysis import faces as F
-    from ..analysis.planar import face_planarity, planarity_tolerance
+    from ..analysis.planar import face_planarity, planarity_tolerance, rounding_allowance
     from ..analysis.report import kind_counts
     from ..tolerances import DEFAULT
 
     plan = face_planarity(mesh)
     angle = F.face_min_angles(mesh)
+    # Exact, within the tolerance, over it: analyze's rule (far from the origin, within what
+    # the stored coordinates' rounding explains too), over the faces the legend shows (no
+    # triangles: flat by definition).
+    rounding = rounding_allowance(mesh)
+    shown = mesh.valences > 3
+    exact = plan <= np.maximum(DEFAULT.planarity, rounding)
+    over = plan > np.maximum(planarity_tolerance(mesh), rounding)
     convex = F.convexity(mesh, DEFAULT.convexity)
     worst = int(np.argmax(plan)) if plan.size else None
     sharpest = int(np.argmin(angle)) if angle.size else None
@@ -316,6 +325,9 @@ def fast_figures(mesh: Mesh) -> tuple[dict[str, Any], np.ndarray, np.ndarray]:
         # The design's own ([mesh] planarity_tolerance) where it has one, as analyze says.
         "planarity_tolerance": planarity_tolerance(mesh),
         "planarity_exact": DEFAULT.planarity,
+        "planarity_counts": {"exact": int(np.count_nonzero(exact & shown)),
+                             "over": int(np.count_nonzero(over & shown)),
+                             "faces": int(np.count_nonzero(shown))},
         "min_angle_deg": float(angle.min()) if angle.size else None,
         "min_angle_face": sharpest,
         "splinters": int(np.count_nonzero(angle < F.SPLINTER_DEG)),
