@@ -475,7 +475,7 @@ def pq_mesh(a, b, rows: int = 20, primary: int | str = "middle", option: int = 0
     mesh, fattening, measured = _fattened(assemble(parts, a, d, args.trim, tol, ptol, warnings, scale, meet,
                                                    rows=rows), ptol, tol)
     _warn_share(mesh, warnings, known, m, rows, (a, d, ptol), measured)
-    _warn_splinters(mesh, warnings, torsal, measured, d)
+    _warn_splinters(mesh, warnings, torsal, measured, (a, d))
     if kept.size < m_given:
         mesh = _renumbered(mesh, kept)
     return mesh.with_info(runs=runs, restarts=known.restarts, **_options_info(plan, args, kept), **fattening)
@@ -941,12 +941,13 @@ def _pairing_tolerance(ptol: float, tol: Tolerances) -> float:
 
 
 def _warn_splinters(mesh: Mesh, warnings: list[str], torsal: np.ndarray,
-                    measured: tuple | None = None, d: np.ndarray | None = None) -> None:
+                    measured: tuple | None = None, lines: tuple | None = None) -> None:
     """Say how many faces are splinters for fabrication, where, and next to what.
 
-    ``measured``: the (F,) smallest angles and areas of the faces, if known; ``d``: the
-    (m, 3) directions of the generators, if known (then splinters whose smallest angle is
-    that between the two generators of their strip are told apart, see :func:`_at_meetings`).
+    ``measured``: the (F,) smallest angles and areas of the faces, if known; ``lines``: the
+    generators ``(a, d)`` (each (m, 3): a point and the direction to the other end), if known
+    (then splinters whose smallest angle is that of the two generators of their strip where
+    they meet are told apart, see :func:`_at_meetings`).
     """
     from ...analysis.faces import SPLINTER_DEG, face_min_angles
 
@@ -970,7 +971,7 @@ def _warn_splinters(mesh: Mesh, warnings: list[str], torsal: np.ndarray,
         near_torsal |= np.abs(g0 - k) <= 2
     border = (t_lo <= PARAMETER_SLACK) | (t_hi >= 1 - PARAMETER_SLACK)
     quads = mesh.valences[bad] == 4
-    meeting = _at_meetings(ang[bad], g0, d)
+    meeting = _at_meetings(ang[bad], g0, lines)
     where = []
     if meeting.any():
         where.append(f"{meeting.sum()} with their corner where two generators meet at "
@@ -999,27 +1000,34 @@ def _warn_splinters(mesh: Mesh, warnings: list[str], torsal: np.ndarray,
 
 
 # A splinter's smallest angle within this share of the angle between its strip's generators
-# is that angle: its corner is where they meet (_at_meetings).
+# is that angle, where the two lines pass within this share of their length of each other:
+# its corner is where they meet (_at_meetings).
 _MEETING_ANGLE_SHARE = 0.01
+_MEETING_GAP = 0.01
 
 
-def _at_meetings(angles: np.ndarray, g0: np.ndarray, d: np.ndarray | None) -> np.ndarray:
+def _at_meetings(angles: np.ndarray, g0: np.ndarray, lines: tuple | None) -> np.ndarray:
     """(k,) bool: which of ``k`` splinters (smallest angles ``angles``, lowest generators
-    ``g0``) have the angle between generators ``g0`` and ``g0 + 1`` (directions ``d``) as
-    their smallest angle.
+    ``g0``) have as their smallest angle that of generators ``g0`` and ``g0 + 1``
+    (``lines``: ``(a, d)``) where those two (nearly) meet.
 
     Where two consecutive generators meet (a Plücker conoid's pinch points, a cone's apex)
     a face with its corner there has their angle, whatever the rows: lines 2.7 degrees
     apart make 2.7-degree corners.
     """
-    if d is None or len(d) < 2:
+    if lines is None or len(lines[1]) < 2:
         return np.zeros(angles.shape, bool)
+    a, d = lines
     i = np.clip(g0, 0, len(d) - 2)
     u0, u1 = d[i], d[i + 1]
-    cos = np.einsum("ij,ij->i", u0, u1) / np.maximum(
-        np.linalg.norm(u0, axis=1) * np.linalg.norm(u1, axis=1), TINY)
+    n0, n1 = np.linalg.norm(u0, axis=1), np.linalg.norm(u1, axis=1)
+    cos = np.einsum("ij,ij->i", u0, u1) / np.maximum(n0 * n1, TINY)
     between = np.degrees(np.arccos(np.clip(np.abs(cos), 0.0, 1.0)))
-    return np.abs(angles - between) <= _MEETING_ANGLE_SHARE * between
+    normal = np.cross(u0, u1)
+    gap = np.abs(np.einsum("ij,ij->i", a[i + 1] - a[i], normal)) / np.maximum(
+        np.linalg.norm(normal, axis=1), TINY)
+    return (np.abs(angles - between) <= _MEETING_ANGLE_SHARE * between) & \
+        (gap <= _MEETING_GAP * np.minimum(n0, n1))
 
 
 def _nearly_flat(a: np.ndarray, d: np.ndarray, rows: int, ptol: float) -> np.ndarray:
