@@ -32,7 +32,7 @@ from ..mesh import FaceKind, Mesh
 from ..tolerances import DEFAULT, Tolerances
 from ..tolerances import TINY as _TINY
 from .circularity import quad_circularity, quad_parallelogram
-from .planar import rounding_allowance
+from .planar import planarity_bounds, rounding_allowance
 
 __all__ = ["check_guarantee", "format_guarantee", "quad_trapezoid"]
 
@@ -154,7 +154,7 @@ def check_guarantee(text: str, mesh: Mesh, tol: Tolerances = DEFAULT) -> dict[st
         worst = float(values.max()) if values.size else 0.0
         # Planar as analyze and fabricate say: within what the stored coordinates' rounding
         # explains too (far from the origin, analysis.planar).
-        allowed = np.maximum(bound, rounding_allowance(mesh)) if prop == "planar" else bound
+        allowed = planarity_bounds(mesh, rounding_allowance(mesh), tol)[1] if prop == "planar" else bound
         above = int(np.count_nonzero(~(values <= allowed)))      # NaN (non-finite corners) too
         rows.append({"property": prop, "status": "not met" if above else "met",
                      "figure": figure, "max": worst, "tolerance": bound, "faces_above": above})

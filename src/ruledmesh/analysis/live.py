@@ -127,15 +127,15 @@ def unit_figures(work: Mesh, measures: FaceMeasures, tol: Tolerances = DEFAULT) 
     ``non_convex``, ``area``; and ``quad_area_share``, the report's
     ``quality.area_share.quads``.
     """
-    from .planar import planarity_tolerance
+    from .planar import planarity_bounds, planarity_tolerance
 
     plan, area = measures.planarity, measures.area
     ptol = planarity_tolerance(work, tol)
     # Far from the origin the stored coordinates' rounding bends faces beyond 1e-12: exact to
     # that rounding is exact (analysis.planar).
-    rounding = measures.rounding
-    exact = plan <= np.maximum(tol.planarity, rounding)
-    within = ~exact & (plan <= np.maximum(ptol, rounding))
+    exact_bound, allowed = planarity_bounds(work, measures.rounding, tol)
+    exact = plan <= exact_bound
+    within = ~exact & (plan <= allowed)
     total = float(area.sum())
     return {
         "vertices": work.n_vertices,
@@ -147,7 +147,7 @@ def unit_figures(work: Mesh, measures: FaceMeasures, tol: Tolerances = DEFAULT) 
         "planarity": {
             **min_max_mean(plan),
             "tolerance": ptol,
-            "above_tolerance": int(np.count_nonzero(plan > np.maximum(ptol, rounding))),
+            "above_tolerance": int(np.count_nonzero(plan > allowed)),
             "exact_to_rounding": int(np.count_nonzero(exact & (plan > tol.planarity))),
             "exact": int(np.count_nonzero(exact)),
             "within_tolerance": int(np.count_nonzero(within)),

@@ -19,7 +19,7 @@ import numpy as np
 from ..mesh import Mesh
 from ..tolerances import COORDINATE_ROUNDING, DEFAULT, TINY, Tolerances
 
-__all__ = ["bent_faces", "face_planarity", "planarity_tolerance", "rounding_allowance"]
+__all__ = ["bent_faces", "face_planarity", "planarity_bounds", "planarity_tolerance", "rounding_allowance"]
 
 
 def face_planarity(mesh: Mesh) -> np.ndarray:
@@ -65,6 +65,15 @@ def rounding_allowance(mesh: Mesh) -> np.ndarray:
     return COORDINATE_ROUNDING * float(np.abs(v).max()) / np.maximum(longest, TINY)
 
 
+def planarity_bounds(mesh: Mesh, rounding: np.ndarray,
+                     tol: Tolerances = DEFAULT) -> tuple[np.ndarray, np.ndarray]:
+    """(F,) float64 each: the planarity up to which each face of ``mesh`` is exact, and up to
+    which it is planar (within :func:`planarity_tolerance`); both at least ``rounding``
+    (:func:`rounding_allowance` of the mesh as stored: ``mesh`` may be its unit-frame copy).
+    """
+    return np.maximum(tol.planarity, rounding), np.maximum(planarity_tolerance(mesh, tol), rounding)
+
+
 def bent_faces(mesh: Mesh, tol: Tolerances = DEFAULT) -> tuple[np.ndarray, np.ndarray]:
     """Faces that are not planar within :func:`planarity_tolerance`, nor within what the
     rounding of their coordinates can explain (:func:`rounding_allowance`).
@@ -76,4 +85,4 @@ def bent_faces(mesh: Mesh, tol: Tolerances = DEFAULT) -> tuple[np.ndarray, np.nd
         The measure of every face (:func:`face_planarity`).
     """
     plan = face_planarity(mesh)
-    return ~(plan <= np.maximum(planarity_tolerance(mesh, tol), rounding_allowance(mesh))), plan
+    return ~(plan <= planarity_bounds(mesh, rounding_allowance(mesh), tol)[1]), plan

@@ -297,7 +297,7 @@ def fast_figures(mesh: Mesh) -> tuple[dict[str, Any], np.ndarray, np.ndarray]:
         Per-face smallest interior angle in degrees (:func:`~ruledmesh.analysis.faces.face_min_angles`).
     """
     from ..analysis import faces as F
-    from ..analysis.planar import face_planarity, planarity_tolerance, rounding_allowance
+    from ..analysis.planar import face_planarity, planarity_bounds, planarity_tolerance, rounding_allowance
     from ..analysis.report import kind_counts
     from ..tolerances import DEFAULT
 
@@ -306,10 +306,10 @@ def fast_figures(mesh: Mesh) -> tuple[dict[str, Any], np.ndarray, np.ndarray]:
     # Exact, within the tolerance, over it: analyze's rule (far from the origin, within what
     # the stored coordinates' rounding explains too), over the faces the legend shows (no
     # triangles: flat by definition).
-    rounding = rounding_allowance(mesh)
+    exact_bound, allowed = planarity_bounds(mesh, rounding_allowance(mesh))
     shown = mesh.valences > 3
-    exact = plan <= np.maximum(DEFAULT.planarity, rounding)
-    over = plan > np.maximum(planarity_tolerance(mesh), rounding)
+    exact = plan <= exact_bound
+    over = plan > allowed
     convex = F.convexity(mesh, DEFAULT.convexity)
     worst = int(np.argmax(plan)) if plan.size else None
     sharpest = int(np.argmin(angle)) if angle.size else None

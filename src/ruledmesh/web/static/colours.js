@@ -165,9 +165,9 @@ export function legend(state, mode) {
       const { planarity_tolerance: tol, planarity_exact: exact, planarity_counts: counts }
         = state.header.figures;
       // The server's counts (analyze's rule: far from the origin a face is exact within what
-      // its stored coordinates' rounding explains); an older message: the bounds alone.
-      stats.exact = counts ? counts.exact : values.reduce((n, v) => n + (v <= exact), 0);
-      stats.over = counts ? counts.over : values.reduce((n, v) => n + (v > tol), 0);
+      // its stored coordinates' rounding explains).
+      stats.exact = counts.exact;
+      stats.over = counts.over;
       stats.within = values.length - stats.exact - stats.over;
       figures += `<br>exact <b data-legend="exact">${stats.exact}</b>${tol > exact
         ? ` · within the tolerance <b data-legend="within">${stats.within}</b>` : ''}` +
