@@ -381,11 +381,8 @@ def test_fast_slider_input_builds_only_the_newest_value(browser, tmp_path):
     server builds far fewer designs than there were presses (no backlog of values
     already passed), and the last frame shows the last value.
     """
-    text = DESIGN.replace("count = 15", "count = 101").replace("rows = 12", "rows = 100")
-    path = tmp_path / "big.toml"
-    path.write_text(text)
-    server = make_server(Session(text, path), port=0)
-    threading.Thread(target=server.serve_forever, daemon=True).start()
+    server = serve_text(DESIGN.replace("count = 15", "count = 101").replace("rows = 12", "rows = 100"),
+                        tmp_path / "big.toml")
     pg = browser.new_page()
     try:
         pg.goto(server.url)
@@ -1263,9 +1260,47 @@ def test_catalogue_surface_handles_drag_its_radius(browser, tmp_path):
         server.server_close()
 
 
+def test_a_catalogue_kind_built_from_its_defaults_has_fields_to_edit(browser, tmp_path):
+    """A ``[surface]`` with nothing but its kind shows the kind's fields at their defaults
+    (grey, decimal sliders for decimal defaults) and an edit of one writes it into the design."""
+    server = serve_text('[surface]\nkind = "hyperboloid"\n', tmp_path / "plain.toml")
+    pg = browser.new_page()
+    try:
+        pg.goto(server.url)
+        pg.wait_for_selector("body[data-version]", timeout=20_000)
+        grey = pg.evaluate("[...document.querySelectorAll('#controls .ctl.default')]"
+                           ".map(r => [r.dataset.path, r.querySelector('input.val, select, input')?.value])")
+        shown = dict(grey)
+        # the builder's own defaults (a = 1, c = 1, height = 2; 32 x 16 faces)
+        assert {"surface.a", "surface.c", "surface.height", "surface.style", "mesh.u", "mesh.v"} <= set(shown)
+        assert float(shown["surface.height"]) == 2 and shown["surface.style"] == "circular"
+        assert int(shown["mesh.u"]) == 32 and int(shown["mesh.v"]) == 16
+        # height = 2.0 is decimal (JSON writes it 2): its slider moves in fractions
+        step = pg.evaluate("document.querySelector('input[type=range][data-path=\"surface.height\"]').step")
+        assert 0 < float(step) < 1, step
+        z0 = float(np.ptp(server.session.built.mesh.vertices[:, 2]))
+        assert z0 == pytest.approx(4.0)
+        set_field(pg, "surface.height", 3.5)
+        assert server.session.design["surface"]["height"] == 3.5
+        assert float(np.ptp(server.session.built.mesh.vertices[:, 2])) == pytest.approx(7.0)
+        # the field is the design's now, no longer a grey default; the others stay grey
+        assert pg.evaluate("document.querySelector('.ctl[data-path=\"surface.height\"]').classList"
+                           ".contains('default')") is False
+        assert pg.evaluate("document.querySelector('.ctl[data-path=\"surface.c\"]').classList"
+                           ".contains('default')") is True
+        shot(pg, "catalogue-defaults")
+    finally:
+        pg.close()
+        server.shutdown()
+        server.server_close()
+
+
 def serve_example(name: str, tmp_path):
-    text = (Path(__file__).resolve().parents[1] / "examples" / name).read_text()
-    path = tmp_path / name
+    return serve_text((Path(__file__).resolve().parents[1] / "examples" / name).read_text(), tmp_path / name)
+
+
+def serve_text(text: str, path: Path):
+    """A designer server of the design ``text``, saved as ``path``, serving in a thread."""
     path.write_text(text)
     server = make_server(Session(text, path), port=0)
     threading.Thread(target=server.serve_forever, daemon=True).start()
@@ -1459,4 +1494,6 @@ def test_the_toml_pane_says_when_the_design_moved_on(page, designer):
     assert designer.session.design["surface"] == {"kind": "hyperboloid"}
     assert page.input_value("#toml") == designer.session.toml()
     assert page.is_hidden("#toml-stale")
-    assert page.locator('.ctl[data-path^="mesh."]').count() == 0
+    # the kind's own [mesh] fields at their defaults, none of the ruled methods'
+    assert page.evaluate("[...document.querySelectorAll('.ctl[data-path^=\"mesh.\"]')]"
+                         ".map(r => r.dataset.path).sort()") == ["mesh.u", "mesh.v"]

@@ -20,13 +20,14 @@ from __future__ import annotations
 
 import ast
 import enum
+import functools
 import importlib
 import inspect
 import sys
 from collections.abc import Iterable
 from typing import Any
 
-__all__ = ["SCHEMA_DRAFT", "design_schema", "main"]
+__all__ = ["SCHEMA_DRAFT", "design_schema", "kind_defaults", "main"]
 
 SCHEMA_DRAFT = "https://json-schema.org/draft/2020-12/schema"
 
@@ -71,7 +72,38 @@ def _bounds(call: ast.Call, module: Any, schema: dict) -> dict:
 
 
 def _value_schema(accessor: str, call: ast.Call, module: Any) -> dict:
-    """The schema of one value read by ``accessor`` (a Fields method or a check_* helper)."""
+    """The schema of one value read by ``accessor`` (a Fields method or a check_* helper),
+    with the default a Fields method reads where it is a literal."""
+    schema = _value_type(accessor, call, module)
+    default = _default(accessor, call, module) if schema else None
+    return {**schema, "default": default} if default is not None else schema
+
+
+def _default(accessor: str, call: ast.Call, module: Any) -> Any:
+    """The literal default of a ``Fields`` read (``f.number("a", 1.0)``), else None: none given,
+    ``Fields.REQUIRED``, or one computed from other values (``f.number("b", a)``)."""
+    at = {"number": 1, "integer": 1, "boolean": 1, "choice": 2}.get(accessor)
+    if at is None:
+        return None
+    given = {k.arg: k.value for k in call.keywords if k.arg}
+    node = call.args[at] if len(call.args) > at else given.get("default")
+    if node is None:
+        return None
+    literal = isinstance(node, ast.Constant) or (
+        isinstance(node, ast.UnaryOp) and isinstance(node.op, ast.USub) and isinstance(node.operand, ast.Constant)
+    ) or (isinstance(node, ast.Name) and node.id.isupper())
+    value = _constant(node, module) if literal else None
+    if accessor == "choice":
+        kind = _constant(call.args[1], module)
+        values = [m.value for m in kind] if isinstance(kind, type) and issubclass(kind, enum.Enum) else []
+        return value if value in values else None
+    if accessor == "boolean":
+        return value if isinstance(value, bool) else None
+    return value if isinstance(value, (int, float)) and not isinstance(value, bool) else None
+
+
+def _value_type(accessor: str, call: ast.Call, module: Any) -> dict:
+    """The type and bounds of one value read by ``accessor``."""
     kw = {k.arg: _constant(k.value, module) for k in call.keywords if k.arg}
     if accessor in ("number", "check_float"):
         return _bounds(call, module, _NUMBER)
@@ -180,7 +212,7 @@ def _read_function(fn: ast.FunctionDef | ast.Module, module: Any, tables: dict[s
             for key, default in zip(("u", "v"), defaults):
                 if default is not None:
                     mesh.allow([key])
-                    mesh.value(key, {"type": "integer", "minimum": kw.get(f"min_{key}", 1)})
+                    mesh.value(key, {"type": "integer", "minimum": kw.get(f"min_{key}", 1), "default": default})
         elif name and name.startswith("check_") and len(node.args) >= 2:
             where = _constant(node.args[1] if name != "check_choice" else node.args[2], module)
             if isinstance(where, str) and "." in where and _direct(node.args[0]):
@@ -458,6 +490,25 @@ def design_schema() -> dict:
         "allOf": mesh_branches,
         "$defs": {"curve": _curve_schema(), "profile": _profile_schema()},
     }
+
+
+@functools.cache
+def kind_defaults() -> dict[str, dict[str, dict[str, Any]]]:
+    """The defaults of each catalogue kind's numeric, boolean and choice fields, as its builder
+    reads them: ``{kind: {"surface": {key: default}, "mesh": {key: default}}}``.
+
+    Only literal defaults: a key whose default follows from another value (the hyperboloid's
+    ``b``, ``a`` unless given) or that the design must give is not listed.  The designer
+    shows these as grey fields, so that a kind built from its defaults can be edited.
+    """
+    found = _found()
+    out: dict[str, dict[str, dict[str, Any]]] = {}
+    for kind, tables in sorted(found["surface"].items()):
+        out[kind] = {
+            table: {key: value["default"] for key, value in tables[table].values.items()
+                    if "default" in value and isinstance(value["default"], (bool, int, float, str))}
+            for table in ("surface", "mesh") if table in tables}
+    return out
 
 
 def _reads_profile(kind: str, key: str) -> bool:

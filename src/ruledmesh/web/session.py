@@ -1020,6 +1020,7 @@ class Session:
         """State for the page besides the mesh: design, undo flags, choices."""
         from .. import io
         from ..curves import CurveType
+        from ..design.schema import kind_defaults
         from ..registry import MESH_METHODS, SURFACE_KINDS, load_plugins
         from ..rulings import Distribution
 
@@ -1035,7 +1036,8 @@ class Session:
             "design": self._current.design,
             # JSON has one number type: the page reads 3.0 as 3 and would give it an integer
             # slider; these fields are decimal in the design (dotted paths).
-            "decimal_fields": _decimal_fields(self._current.design),
+            "decimal_fields": _decimal_fields(self._current.design) + _decimal_fields(
+                kind_defaults().get(_kind(self._current.design) or "", {})),
             "toml": self.toml(),
             "path": str(self.path) if self.path else None,
             "folder": str(self.base_dir),
@@ -1045,6 +1047,8 @@ class Session:
             "history": self.history(),
             "choices": {
                 "kinds": sorted(SURFACE_KINDS),
+                # Each kind's fields at their defaults, shown while the design leaves them out.
+                "kind_fields": kind_defaults(),
                 "methods": sorted(MESH_METHODS),
                 "formats": io.formats(),
                 "distributions": [d.value for d in Distribution],
@@ -1146,6 +1150,13 @@ class Session:
                for k, v in table.items()}
         return {"version": snap.version, "topology": key, "face": face,
                 "outline": unrolled.polygon(face).tolist(), "row": row}
+
+
+def _kind(design: Mapping) -> str | None:
+    """The catalogue kind of ``design``, or None (a ruled design)."""
+    surface = design.get("surface")
+    kind = surface.get("kind") if isinstance(surface, Mapping) else None
+    return kind if isinstance(kind, str) else None
 
 
 def _decimal_fields(design: Mapping, prefix: str = "") -> list[str]:

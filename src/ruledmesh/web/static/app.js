@@ -1374,18 +1374,40 @@ function buildControls() {
   if (design.rulings?.conoid) section('[rulings.conoid]', design.rulings.conoid, ['rulings', 'conoid']);
   if (Array.isArray(design.rulings?.between)) betweenControl(box, design);
   section('[mesh]', design.mesh, ['mesh']);
-  // Every numeric (and boolean) field of the method, also those left at their defaults.
-  const defaults = design.surface ? {} : METHOD_FIELDS[design.mesh?.method || 'pq'] || {};
-  for (const [k, v] of Object.entries(defaults)) {
-    if (design.mesh && k in design.mesh) continue;
-    control(box, ['mesh', k], k, v);
-    box.lastElementChild?.classList.add('default');
+  // Every numeric (and boolean) field of the method, also those left at their defaults; for
+  // a catalogue kind its [surface] and [mesh] fields with literal defaults (the server's).
+  const grey = (table, defaults) => {
+    for (const [k, v] of Object.entries(defaults || {})) {
+      if (design[table] && k in design[table]) continue;
+      control(box, [table, k], k, v);
+      box.lastElementChild?.classList.add('default');
+    }
+  };
+  if (design.surface) {
+    const kinds = kindDefaults(design);
+    grey('surface', kinds.surface);
+    grey('mesh', kinds.mesh);
+  } else {
+    grey('mesh', METHOD_FIELDS[design.mesh?.method || 'pq']);
   }
   for (const [name, spec] of Object.entries(design.curves || {})) section(`[curves.${name}]`, spec, ['curves', name]);
   // the primary slider's range follows the generator count
   const count = design.rulings?.count;
   const prim = box.querySelector('input[type=range][data-path="mesh.primary"]');
   if (prim && count) prim.max = count - 1;
+}
+
+// The defaults of the design's catalogue kind, by table ({} for a kind without any).
+function kindDefaults(design) {
+  return current.header.choices.kind_fields?.[design.surface?.kind] || {};
+}
+
+// The default shown for a field the design leaves out, or undefined.
+function defaultAt(path) {
+  const design = current.header.design;
+  if (path.length !== 2) return undefined;
+  if (design.surface) return kindDefaults(design)[path[0]]?.[path[1]];
+  return path[0] === 'mesh' ? (METHOD_FIELDS[design.mesh?.method || 'pq'] || {})[path[1]] : undefined;
 }
 
 // The fields of each mesh method with their defaults (as the builders read them), so every
@@ -1440,9 +1462,7 @@ function syncControls() {
                                           && el.value !== el.dataset.synced))) continue;
     const path = el.dataset.path.split('.');
     let v = valueAt(path);
-    if (v === undefined && path.length === 2 && path[0] === 'mesh' && !current.header.design.surface) {
-      v = (METHOD_FIELDS[current.header.design.mesh?.method || 'pq'] || {})[path[1]];
-    }
+    if (v === undefined) v = defaultAt(path);
     if (v === undefined) continue;
     if (el.type === 'checkbox') el.checked = v;
     else if (el.type === 'range') { if (typeof v === 'number') el.value = v; }
