@@ -1289,6 +1289,15 @@ def test_a_catalogue_kind_built_from_its_defaults_has_fields_to_edit(browser, tm
         assert pg.evaluate("document.querySelector('.ctl[data-path=\"surface.c\"]').classList"
                            ".contains('default')") is True
         shot(pg, "catalogue-defaults")
+        # the kind's choice fields are menus of the words its builder takes
+        style = 'select[data-path="surface.style"]'
+        assert pg.evaluate(f"[...document.querySelector('{style}').options].map(o => o.value)") == \
+            ["circular", "generators"]
+        v = pg.evaluate("window.designer.version")
+        pg.select_option(style, "generators")
+        wait_version(pg, v)
+        pg.wait_for_function("!window.designer.busy()")
+        assert server.session.design["surface"]["style"] == "generators"
     finally:
         pg.close()
         server.shutdown()

@@ -27,7 +27,7 @@ import sys
 from collections.abc import Iterable
 from typing import Any
 
-__all__ = ["SCHEMA_DRAFT", "design_schema", "kind_defaults", "main"]
+__all__ = ["SCHEMA_DRAFT", "design_schema", "kind_choices", "kind_defaults", "main"]
 
 SCHEMA_DRAFT = "https://json-schema.org/draft/2020-12/schema"
 
@@ -508,6 +508,18 @@ def kind_defaults() -> dict[str, dict[str, dict[str, Any]]]:
             table: {key: value["default"] for key, value in tables[table].values.items()
                     if "default" in value and isinstance(value["default"], (bool, int, float, str))}
             for table in ("surface", "mesh") if table in tables}
+    return out
+
+
+@functools.cache
+def kind_choices() -> dict[str, dict[str, list[str]]]:
+    """The words each catalogue kind's ``[surface]`` choice fields take, as its builder reads
+    them: ``{kind: {key: [word, ...]}}`` (the hyperboloid's ``style``); the designer's menus."""
+    out: dict[str, dict[str, list[str]]] = {}
+    for kind, tables in sorted(_found()["surface"].items()):
+        values = tables["surface"].values if "surface" in tables else {}
+        out[kind] = {key: list(value["enum"]) for key, value in values.items()
+                     if isinstance(value.get("enum"), list) and all(isinstance(w, str) for w in value["enum"])}
     return out
 
 

@@ -1020,7 +1020,7 @@ class Session:
         """State for the page besides the mesh: design, undo flags, choices."""
         from .. import io
         from ..curves import CurveType
-        from ..design.schema import kind_defaults
+        from ..design.schema import kind_choices, kind_defaults
         from ..registry import MESH_METHODS, SURFACE_KINDS, load_plugins
         from ..rulings import Distribution
 
@@ -1049,6 +1049,7 @@ class Session:
                 "kinds": sorted(SURFACE_KINDS),
                 # Each kind's fields at their defaults, shown while the design leaves them out.
                 "kind_fields": kind_defaults(),
+                "kind_choices": kind_choices(),
                 "methods": sorted(MESH_METHODS),
                 "formats": io.formats(),
                 "distributions": [d.value for d in Distribution],
