@@ -44,6 +44,8 @@ _PER_ROW = 8
 # ... within these bounds, and generator x point evaluations held at a time.
 _MIN_POINTS, _MAX_POINTS = 4097, 131_073
 _CHUNK = 1 << 21
+# Generator x point landing masks kept between the two passes of graded_rows (bytes).
+_KEPT_MASKS = 1 << 24
 # Where no generator's patch is reached, the rows step by at most this many times their
 # smallest step elsewhere: they are the margin, and are thinned out later anyway.
 _EMPTY = 1e3
@@ -101,17 +103,22 @@ def graded_rows(a: np.ndarray, d: np.ndarray, M: np.ndarray, lo: float, hi: floa
     reached = np.zeros(len(a))
     width = np.gradient(g)
     chunk = max(1, _CHUNK // n)
+    # The landing masks of the first pass serve the second where they fit in _KEPT_MASKS
+    # (most builds: a design's refinement grades dozens of runs), else they are made again.
+    masks: list[np.ndarray] | None = [] if len(a) * n <= _KEPT_MASKS else None
     for k in range(0, len(a), chunk):
         dens, inside = _density(M[k:k + chunk], steps[k:k + chunk], g)
         rho = np.maximum(rho, dens.max(axis=0))
         reached[k:k + chunk] = (inside * width).sum(axis=1)
+        if masks is not None:
+            masks.append(inside)
     if not (rho > 0).any():             # no generator reached: an even division
         rho[:] = rows
     rho = np.maximum(rho, rho.max() / _EMPTY)
     # Each generator's rows over its patch: the density integrated where its rows land there.
     counts = np.zeros(len(a))
-    for k in range(0, len(a), chunk):
-        _, inside = _density(M[k:k + chunk], steps[k:k + chunk], g)
+    for i, k in enumerate(range(0, len(a), chunk)):
+        inside = masks[i] if masks is not None else _density(M[k:k + chunk], steps[k:k + chunk], g)[1]
         counts[k:k + chunk] = (inside * rho * width).sum(axis=1)
     counts = counts[reached > 0]
     rho *= rows / max(float(median(counts)), TINY) if counts.size else 1.0
