@@ -492,7 +492,6 @@ def design_schema() -> dict:
     }
 
 
-@functools.cache
 def kind_defaults() -> dict[str, dict[str, dict[str, Any]]]:
     """The defaults of each catalogue kind's numeric, boolean and choice fields, as its builder
     reads them: ``{kind: {"surface": {key: default}, "mesh": {key: default}}}``.
@@ -501,26 +500,30 @@ def kind_defaults() -> dict[str, dict[str, dict[str, Any]]]:
     ``b``, ``a`` unless given) or that the design must give is not listed.  The designer
     shows these as grey fields, so that a kind built from its defaults can be edited.
     """
-    found = _found()
-    out: dict[str, dict[str, dict[str, Any]]] = {}
-    for kind, tables in sorted(found["surface"].items()):
-        out[kind] = {
-            table: {key: value["default"] for key, value in tables[table].values.items()
-                    if "default" in value and isinstance(value["default"], (bool, int, float, str))}
-            for table in ("surface", "mesh") if table in tables}
-    return out
+    return _kind_fields()[0]
 
 
-@functools.cache
 def kind_choices() -> dict[str, dict[str, list[str]]]:
     """The words each catalogue kind's ``[surface]`` choice fields take, as its builder reads
     them: ``{kind: {key: [word, ...]}}`` (the hyperboloid's ``style``); the designer's menus."""
-    out: dict[str, dict[str, list[str]]] = {}
+    return _kind_fields()[1]
+
+
+@functools.cache
+def _kind_fields() -> tuple[dict[str, dict[str, dict[str, Any]]], dict[str, dict[str, list[str]]]]:
+    """:func:`kind_defaults` and :func:`kind_choices`, from one reading of the builders (about
+    half a second: a server warms it up at start, see :mod:`ruledmesh.web.session`)."""
+    defaults: dict[str, dict[str, dict[str, Any]]] = {}
+    choices: dict[str, dict[str, list[str]]] = {}
     for kind, tables in sorted(_found()["surface"].items()):
+        defaults[kind] = {
+            table: {key: value["default"] for key, value in tables[table].values.items()
+                    if "default" in value and isinstance(value["default"], (bool, int, float, str))}
+            for table in ("surface", "mesh") if table in tables}
         values = tables["surface"].values if "surface" in tables else {}
-        out[kind] = {key: list(value["enum"]) for key, value in values.items()
-                     if isinstance(value.get("enum"), list) and all(isinstance(w, str) for w in value["enum"])}
-    return out
+        choices[kind] = {key: list(value["enum"]) for key, value in values.items()
+                         if isinstance(value.get("enum"), list) and all(isinstance(w, str) for w in value["enum"])}
+    return defaults, choices
 
 
 def _reads_profile(kind: str, key: str) -> bool:

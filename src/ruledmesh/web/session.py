@@ -553,6 +553,11 @@ class Session:
             self.path = inside(self.base_dir, self.path.name, "path")
             self._owned.add(self.path)
         self._builder = builder or InProcessBuilder()
+        # The catalogue kinds' default fields (describe) take half a second to read off the
+        # builders, once per process: read while the first design builds, not in the first
+        # answer to the page.
+        from ..design.schema import kind_defaults
+        threading.Thread(target=kind_defaults, name="kind-fields", daemon=True).start()
         design = parse_design(DEFAULT_DESIGN if text is None else text, self.source, self.base_dir)
         data = _plain(design.data)
         check_limits(data, self.base_dir)
