@@ -1304,6 +1304,37 @@ def test_a_catalogue_kind_built_from_its_defaults_has_fields_to_edit(browser, tm
         server.server_close()
 
 
+def test_apply_is_busy_at_once_and_clears_an_old_error(browser, tmp_path):
+    """Apply of a design that takes a while: the page says it is building and drops the
+    error an earlier refused edit left, at once, not when the build answers."""
+    server = serve_text(DESIGN, tmp_path / "d.toml")
+    pg = browser.new_page()
+    try:
+        pg.goto(server.url)
+        pg.wait_for_selector("body[data-version]", timeout=20_000)
+        field = pg.locator('[data-path="mesh.rows"] input.val')
+        field.fill("-1")
+        field.press("Enter")
+        pg.wait_for_selector("#error:not([hidden])")
+        v = pg.evaluate("window.designer.version")
+        pg.click("#toml-pane summary")
+        slow = server.session.toml().replace("count = 15", "count = 101").replace("rows = 12", "rows = 100")
+        pg.fill("#toml", slow)
+        # Read in the same task as the click's handler: before any answer can come back.
+        seen = pg.evaluate("""() => { document.querySelector('#apply-toml').click();
+            return {busy: window.designer.busy(), error: document.querySelector('#error').hidden,
+                    status: document.querySelector('#status').textContent}; }""")
+        assert seen == {"busy": True, "error": True, "status": "building..."}, seen
+        wait_version(pg, v)
+        pg.wait_for_function("!window.designer.busy()", timeout=60_000)
+        assert server.session.design["rulings"]["count"] == 101
+        assert pg.is_hidden("#error")
+    finally:
+        pg.close()
+        server.shutdown()
+        server.server_close()
+
+
 def serve_example(name: str, tmp_path):
     return serve_text((Path(__file__).resolve().parents[1] / "examples" / name).read_text(), tmp_path / name)
 
