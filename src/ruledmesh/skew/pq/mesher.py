@@ -19,6 +19,7 @@ from ...normalise import normalised
 from ...tolerances import DEFAULT, NEARLY_DEVELOPABLE, PARAMETER_SLACK, TINY, Tolerances
 from .assemble import assemble
 from .collapses import _border_vertices, _touching, collapse_splinters
+from .corners import rezip_corners
 from .flips import flip_splinters, flip_triangles
 from .maps import HopMaps, hop_maps
 from .pairing import pair_triangles
@@ -514,8 +515,9 @@ def _cut(a, d, rows, ptol, scale, tol, creases, crease_generators, warnings):
 def _fattened(mesh: Mesh, ptol: float, tol: Tolerances) -> tuple[Mesh, dict[str, int], tuple | None]:
     """Flip the triangles for their angles, collapse what flips cannot fatten, pair the
     triangles in tolerance mode, flip what is left; then the splinters left: corners a
-    sliver from the border snapped onto it, quads walling a splinter opened; last, strip
-    quads much larger than the other panels cut.
+    sliver from the border snapped onto it, quads walling a splinter opened, patch corners
+    with a splinter re-cut (:mod:`.corners`); last, strip quads much larger than the other
+    panels cut.
 
     The third result: the (F,) smallest angles and areas of the faces of the mesh
     returned, where the opening measured them and left the mesh as it was (else None).
@@ -560,10 +562,12 @@ def _fattened(mesh: Mesh, ptol: float, tol: Tolerances) -> tuple[Mesh, dict[str,
     mesh = replace(mesh, vertex_data={k: v for k, v in mesh.vertex_data.items() if k != _FID})
     mesh, more, kept = _pass(flip_splinters, mesh)
     flips += more
+    mesh, corners, kept_corners = _pass(rezip_corners, mesh)
     mesh, cut, kept_too = _pass(split_strip_quads, mesh)
-    same = same and kept and kept_too
+    same = same and kept and kept_corners and kept_too
     return mesh, {"flips": flips, "collapsed": collapsed, "paired": paired, "snapped": snapped,
-                  "trimmed": trimmed, "opened": opened, "cut": cut}, (measured if same else None)
+                  "trimmed": trimmed, "opened": opened, "corners": corners, "cut": cut}, \
+        (measured if same else None)
 
 
 # The persistent vertex id of :class:`_Changes`, dropped before the mesh leaves :func:`_fattened`.
