@@ -67,8 +67,8 @@ def rezip_corners(mesh: Mesh, below: float = 3.0) -> tuple[Mesh, int]:
         return mesh, 0
     # The faces at each corner, from one pass over the corners of all faces.
     at = np.flatnonzero(member(mesh.face_indices, corners))
-    face_of = np.repeat(np.arange(mesh.n_faces), mesh.valences)[at]
     off, val = mesh.face_offsets, mesh.valences
+    face_of = np.searchsorted(off, at, side="right") - 1      # no (N,) array for a few corners
     faces_at = {c: [(int(f), mesh.face_indices[off[f]:off[f] + val[f]])
                     for f in unique(face_of[mesh.face_indices[at] == c]).tolist()] for c in corners.tolist()}
     plans = []
