@@ -512,7 +512,7 @@ def kind_choices() -> dict[str, dict[str, list[str]]]:
 @functools.cache
 def _kind_fields() -> tuple[dict[str, dict[str, dict[str, Any]]], dict[str, dict[str, list[str]]]]:
     """:func:`kind_defaults` and :func:`kind_choices`, from one reading of the builders (about
-    half a second: a server warms it up at start, see :mod:`ruledmesh.web.session`)."""
+    half a second: a designer session reads them when it starts, see :mod:`ruledmesh.web.session`)."""
     defaults: dict[str, dict[str, dict[str, Any]]] = {}
     choices: dict[str, dict[str, list[str]]] = {}
     for kind, tables in sorted(_found()["surface"].items()):

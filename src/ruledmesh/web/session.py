@@ -554,10 +554,11 @@ class Session:
             self._owned.add(self.path)
         self._builder = builder or InProcessBuilder()
         # The catalogue kinds' default fields (describe) take half a second to read off the
-        # builders, once per process: read while the first design builds, not in the first
-        # answer to the page.
+        # builders, once per process: read here, before the page asks, and in this thread.
+        # CPython 3.11's ast.parse in a second thread while another one parses or compiles
+        # can fail ("AST constructor recursion depth mismatch"): it did in a CI run.
         from ..design.schema import kind_defaults
-        threading.Thread(target=kind_defaults, name="kind-fields", daemon=True).start()
+        kind_defaults()
         design = parse_design(DEFAULT_DESIGN if text is None else text, self.source, self.base_dir)
         data = _plain(design.data)
         check_limits(data, self.base_dir)
