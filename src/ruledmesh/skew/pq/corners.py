@@ -25,8 +25,9 @@ from __future__ import annotations
 import numpy as np
 
 from ..._arrays import member, unique
-from ...mesh import FaceKind, Mesh
+from ...mesh import FaceKind, Mesh, offsets_from_valences
 from ...tolerances import PARAMETER_SLACK
+from .panels import _split_members
 
 __all__ = ["rezip_corners"]
 
@@ -114,7 +115,7 @@ def _corner_plan(mesh: Mesh, faces: list[tuple[int, np.ndarray]], c: int, gen: n
         best = _best_cut(V, t, c, e, x, r, w, ref)
         if best is None or best[0] <= old:
             continue
-        return {"faces": (f, q), "c": c, "e": e, "x": x, "r": r, "w": w, "forward": bool(forward),
+        return {"faces": (f, q), "c": c, "e": e, "x": x, "r": r, "w": w, "forward": forward,
                 "on_end": best[1], "on_next": best[2], "triangles": best[3]}
     return None
 
@@ -245,28 +246,26 @@ def _zipper(A: np.ndarray, B: np.ndarray, ref: np.ndarray) -> tuple[float, list]
 
 def _applied(mesh: Mesh, plans: list[dict]) -> Mesh:
     """``mesh`` with each planned corner re-cut."""
+    t = np.asarray(mesh.vertex_data["t"])
     V = [mesh.vertices]
     n = mesh.n_vertices
     data = {name: [np.asarray(v)] for name, v in mesh.vertex_data.items()}
     faces: list[list[int]] = []
-    chains: list[tuple[int, list[int]]] = []      # member end points -> the vertices between
+    chains: list[list[int]] = []        # from one end of a generator segment to the other
     drop = np.zeros(mesh.n_faces, bool)
     for plan in plans:
         drop[list(plan["faces"])] = True
-        ids: dict[object, int] = {}
+        ids: dict[tuple[str, int], int] = {}
         for side, (p, q, ts) in {"a": (plan["c"], plan["e"], plan["on_end"]),
                                  "b": (plan["r"], plan["x"], plan["on_next"])}.items():
-            P = _points(mesh.vertices[p], mesh.vertices[q], 0.0, 1.0,
-                        (ts - mesh.vertex_data["t"][p]) / (mesh.vertex_data["t"][q] - mesh.vertex_data["t"][p]))
-            new = list(range(n, n + len(ts)))
-            n += len(ts)
-            V.append(P[1:-1])
+            V.append(_points(mesh.vertices[p], mesh.vertices[q], t[p], t[q], ts)[1:-1])
             for name, values in mesh.vertex_data.items():
                 values = np.asarray(values)
                 added = ts if name == "t" else np.full(len(ts), values[p])
                 data[name].append(np.asarray(added, dtype=values.dtype))
-            chain = [p, *new, q]
-            chains.append((p, chain))
+            chain = [p, *range(n, n + len(ts)), q]
+            n += len(ts)
+            chains.append(chain)
             ids.update({(side, i): v for i, v in enumerate(chain)})
         new_faces = [[ids[k] for k in tri] for tri in plan["triangles"]]
         b = [ids[("b", j)] for j in range(len(plan["on_next"]) + 2)]
@@ -277,32 +276,10 @@ def _applied(mesh: Mesh, plans: list[dict]) -> Mesh:
         faces += new_faces
     kept = np.repeat(~drop, mesh.valences)
     indices = np.concatenate([mesh.face_indices[kept], np.asarray(faces, np.int64).reshape(-1)])
-    valences = np.concatenate([mesh.valences[~drop], np.full(len(faces), 3)])
-    offsets = np.concatenate([[0], np.cumsum(valences)]).astype(mesh.face_offsets.dtype)
+    offsets = offsets_from_valences(np.concatenate([mesh.valences[~drop], np.full(len(faces), 3)]))
     kind = np.concatenate([mesh.face_kind[~drop], np.full(len(faces), FaceKind.FILL, mesh.face_kind.dtype)])
-    members, member_id = _members_through(mesh, chains)
-    return Mesh(np.concatenate(V), offsets, indices.astype(mesh.face_indices.dtype), kind, members, member_id,
-                {name: np.concatenate(parts) for name, parts in data.items()}, mesh.info)
-
-
-def _members_through(mesh: Mesh, chains: list[tuple[int, list[int]]]) -> tuple[np.ndarray, np.ndarray]:
-    """The members, each lying on a chain's segment cut at the chain's vertices."""
-    members, member_id = mesh.members, mesh.member_id
-    if members.size == 0:
-        return members, member_id
-    n = np.int64(max(mesh.n_vertices, 1) + sum(len(ch) for _, ch in chains))
-    keys = np.minimum(members[:, 0], members[:, 1]) * n + np.maximum(members[:, 0], members[:, 1])
-    out, ids = [members], [member_id]
-    hit = np.zeros(len(members), bool)
-    for _, chain in chains:
-        p, q = chain[0], chain[-1]
-        at = np.flatnonzero(keys == min(p, q) * n + max(p, q))
-        if at.size == 0 or len(chain) == 2:
-            continue
-        hit[at] = True
-        pairs = np.stack([chain[:-1], chain[1:]], axis=1).astype(members.dtype)
-        for i in at.tolist():
-            out.append(pairs)
-            ids.append(np.full(len(pairs), member_id[i], member_id.dtype))
-    out[0], ids[0] = members[~hit], member_id[~hit]
-    return np.concatenate(out), np.concatenate(ids)
+    # The members along the segments the vertices went on, in their pieces (panels' split).
+    start = np.r_[0, np.cumsum([len(chain) for chain in chains])]
+    members, member_id = _split_members(mesh, start, np.concatenate(chains).astype(np.int64))
+    return Mesh(np.concatenate(V), offsets.astype(mesh.face_offsets.dtype), indices.astype(mesh.face_indices.dtype),
+                kind, members, member_id, {name: np.concatenate(parts) for name, parts in data.items()}, mesh.info)
