@@ -1379,19 +1379,12 @@ function buildControls() {
   section('[mesh]', design.mesh, ['mesh']);
   // Every numeric (and boolean) field of the method, also those left at their defaults; for
   // a catalogue kind its [surface] and [mesh] fields with literal defaults (the server's).
-  const grey = (table, defaults) => {
-    for (const [k, v] of Object.entries(defaults || {})) {
+  for (const table of ['surface', 'mesh']) {
+    for (const [k, v] of Object.entries(defaultsOf(design, table))) {
       if (design[table] && k in design[table]) continue;
       control(box, [table, k], k, v);
       box.lastElementChild?.classList.add('default');
     }
-  };
-  if (design.surface) {
-    const kinds = kindDefaults(design);
-    grey('surface', kinds.surface);
-    grey('mesh', kinds.mesh);
-  } else {
-    grey('mesh', METHOD_FIELDS[design.mesh?.method || 'pq']);
   }
   for (const [name, spec] of Object.entries(design.curves || {})) section(`[curves.${name}]`, spec, ['curves', name]);
   // the primary slider's range follows the generator count
@@ -1400,17 +1393,16 @@ function buildControls() {
   if (prim && count) prim.max = count - 1;
 }
 
-// The defaults of the design's catalogue kind, by table ({} for a kind without any).
-function kindDefaults(design) {
-  return current.header.choices.kind_fields?.[design.surface?.kind] || {};
+// The fields of ``table`` ('surface' or 'mesh') that ``design`` shows at their defaults: a
+// catalogue kind's (the server's), else the mesh method's; {} where there are none.
+function defaultsOf(design, table) {
+  if (design.surface) return current.header.choices.kind_fields?.[design.surface.kind]?.[table] || {};
+  return table === 'mesh' ? METHOD_FIELDS[design.mesh?.method || 'pq'] || {} : {};
 }
 
 // The default shown for a field the design leaves out, or undefined.
 function defaultAt(path) {
-  const design = current.header.design;
-  if (path.length !== 2) return undefined;
-  if (design.surface) return kindDefaults(design)[path[0]]?.[path[1]];
-  return path[0] === 'mesh' ? (METHOD_FIELDS[design.mesh?.method || 'pq'] || {})[path[1]] : undefined;
+  return path.length === 2 ? defaultsOf(current.header.design, path[0])[path[1]] : undefined;
 }
 
 // The fields of each mesh method with their defaults (as the builders read them), so every
