@@ -57,6 +57,10 @@ SHORT_OF_SHARE = {
                              "quads between lines 2.5 degrees apart are not planar within 1e-3",
     "skew-bspline-301x300": "14.6% of the area in triangles; 13% of the patch is slender "
                             "(every exact face there a 10:1 panel or worse)",
+    "twisted-bspline-arc-150deg": "27.3% of the area in triangles; the rows through both curves' end "
+                                  "points reach 21.0% after the refinement, but the splinter passes "
+                                  "leave fill triangles at the waist 3.6e-3 of the diagonal off the "
+                                  "surface (docs/mesh-quality.md)",
 }
 
 
