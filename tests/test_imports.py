@@ -28,10 +28,12 @@ LAYERS: list[tuple[str, list[str]]] = [
                     "_files", "roots", "budget", "normalise", "kernels"]),
     # Per-face measures and the distance to the smooth patch are geometry of a mesh that the
     # meshers check their own output with; they depend on the mesh only.  The slender share
-    # (analysis.asymptotic) is geometry of the generators, by the hop: the mesher's warnings use it.
+    # (analysis.asymptotic) is geometry of the generators, by the hop, and how far triangles lie
+    # off the generators they span (analysis.spans) of the mesh and its generators: the mesher's
+    # warnings use both.
     ("core", ["mesh", "notebook", "registry", "curves", "triangulate", "hop", "surfaces", "labels",
               "analysis.faces", "analysis.circularity", "analysis.surface", "analysis.asymptotic",
-              "analysis.__init__"]),
+              "analysis.spans", "analysis.__init__"]),
     ("generators", ["rulings"]),
     ("meshers", ["constructions", "transforms", "pq", "skew", "hybrid", "compound"]),
     ("analysis", ["analysis"]),

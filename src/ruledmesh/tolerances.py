@@ -31,7 +31,7 @@ __all__ = ["BORDER_TRIM_MAX_GAP", "BRENTQ_XTOL", "CLOSENESS_SEARCH", "COLLAPSE_M
            "MIN_HALF_ANGLE", "MIN_RELATIVE_EXTENT", "MITRE_FLOOR", "NEARLY_DEVELOPABLE",
            "OCCT_FACE", "ON_BORDER", "PARAMETER_SLACK", "PLANARITY_FLOOR", "RESTART_ANGLE_DEG",
            "ROOT_RTOL", "ROOT_XTOL", "ROUNDING", "ROUNDING_SQ", "SAME_ROOT", "SETTLED", "SNAP_GAP",
-           "SNAP_MIN_GAIN_DEG", "SPLINTER_AREA_WORTH", "SPLINTER_FLIP_MAX_SAG", "TINY", "ULPS",
+           "SNAP_MIN_GAIN_DEG", "SPAN_MAX_GAP", "SPLINTER_AREA_WORTH", "SPLINTER_FLIP_MAX_SAG", "TINY", "ULPS",
            "Tolerances"]
 
 
@@ -209,6 +209,9 @@ FLIP_ACTIVE_DEG = 20.0
 #: A triangle-only vertex collapsed into a neighbour (ruledmesh.skew.pq.collapses) may lie
 #: at most this share of the patch diagonal off the plane of each face it leaves behind.
 COLLAPSE_MAX_SAG = 2.5e-4
+#: A build warns where a triangle lies farther than this share of the patch diagonal off a
+#: generator it spans without a corner on it (ruledmesh.analysis.spans): the gap goal.
+SPAN_MAX_GAP = 2e-3
 #: An end point whose faces are all needles may be dropped with them
 #: (ruledmesh.skew.pq.splinters.trim_border_needles) when it lies at most this share of
 #: the patch diagonal from their far edges: the patch stays within half the gap goal (2e-3).

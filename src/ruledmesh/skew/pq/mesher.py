@@ -8,7 +8,7 @@ from enum import Enum
 
 import numpy as np
 
-from ..._arrays import member, unique
+from ..._arrays import diagonal, member, unique
 from ..._validation import check_bool, check_choice, check_float, check_int, check_points, describe
 from ...analysis.asymptotic import SLENDER_DEG, SLENDER_ELONGATION, crossing_angles, slender_share
 from ...analysis.faces import SPLINTER_DEG
@@ -16,7 +16,7 @@ from ...errors import GeometryError, ParameterError
 from ...hop import coplanarity, sense_changes
 from ...mesh import Mesh
 from ...normalise import normalised
-from ...tolerances import DEFAULT, NEARLY_DEVELOPABLE, PARAMETER_SLACK, TINY, Tolerances
+from ...tolerances import DEFAULT, NEARLY_DEVELOPABLE, PARAMETER_SLACK, SPAN_MAX_GAP, TINY, Tolerances
 from .assemble import assemble
 from .collapses import _border_vertices, _touching, collapse_splinters
 from .corners import rezip_corners
@@ -476,7 +476,7 @@ def pq_mesh(a, b, rows: int = 20, primary: int | str = "middle", option: int = 0
     mesh, fattening, measured = _fattened(assemble(parts, a, d, args.trim, tol, ptol, warnings, scale, meet,
                                                    rows=rows), ptol, tol)
     _warn_share(mesh, warnings, known, m, rows, (a, d, ptol), measured)
-    _warn_splinters(mesh, warnings, torsal, measured, (a, d))
+    _warn_faces(mesh, warnings, torsal, measured, (a, d))
     if kept.size < m_given:
         mesh = _renumbered(mesh, kept)
     return mesh.with_info(runs=runs, restarts=known.restarts, **_options_info(plan, args, kept), **fattening)
@@ -1008,6 +1008,38 @@ def _warn_splinters(mesh: Mesh, warnings: list[str], torsal: np.ndarray,
 # its corner is where they meet (_at_meetings).
 _MEETING_ANGLE_SHARE = 0.01
 _MEETING_GAP = 0.01
+
+
+def _warn_faces(mesh: Mesh, warnings: list[str], torsal: np.ndarray, measured: tuple | None,
+                lines: tuple[np.ndarray, np.ndarray]) -> None:
+    """What a build says of its faces: splinters (:func:`_warn_splinters`) and triangles off
+    the generators they span (:func:`_warn_off_generators`)."""
+    _warn_splinters(mesh, warnings, torsal, measured, lines)
+    _warn_off_generators(mesh, warnings, lines)
+
+
+def _warn_off_generators(mesh: Mesh, warnings: list[str], lines: tuple[np.ndarray, np.ndarray]) -> None:
+    """Say how many triangles lie farther than :data:`~ruledmesh.tolerances.SPAN_MAX_GAP` of
+    the diagonal off the generators they span (:mod:`ruledmesh.analysis.spans`), how far at
+    most and between which generators; ``lines``: the generators ``(a, d)``."""
+    from ...analysis.spans import off_spanned_generators
+
+    tri = np.flatnonzero(mesh.valences == 3)
+    if tri.size == 0:
+        return
+    corners = mesh.face_indices[mesh.face_offsets[tri][:, None] + np.arange(3)]
+    g = np.asarray(mesh.vertex_data["generator"], np.int64)
+    off = off_spanned_generators(mesh.vertices, corners, g, np.asarray(mesh.vertex_data["t"], np.float64),
+                                 lines) / (diagonal(mesh.vertices) or 1.0)
+    far = off > SPAN_MAX_GAP
+    if not far.any():
+        return
+    span = g[corners[far]]
+    warnings.append(f"{int(far.sum())} triangles lie up to {off.max():.1e} of the diagonal off the "
+                    f"generators they span (between generators {int(span.min())} and {int(span.max())}, "
+                    f"across up to {int((span.max(axis=1) - span.min(axis=1)).max())} strips; the gap goal "
+                    f"is {SPAN_MAX_GAP:g}): the smooth surface is not within the gap goal of the mesh there; "
+                    "more generators (rulings.count) or fewer rows")
 
 
 def _at_meetings(angles: np.ndarray, g0: np.ndarray, lines: tuple | None) -> np.ndarray:
