@@ -64,13 +64,18 @@ def off_spanned_generators(V: np.ndarray, tri: np.ndarray, generator: np.ndarray
     area2 = norm(n)
     n /= np.maximum(area2, TINY)[:, None]
     a, d = lines[0][k], lines[1][k]
-    # The barycentric coordinates of the projection of a + s d are affine in s:
-    # lambda_i = alpha_i + beta_i s; the stretch inside is where all three are >= 0.
+    # The stretch of each generator the mesh covers: from the vertices on the generators
+    # spanned only (a large mesh has few such triangles).
+    on = np.zeros(len(lines[0]), bool)
+    on[k] = True
+    at = np.flatnonzero(on[generator])
     t_lo = np.full(len(lines[0]), np.inf)
     t_hi = np.full(len(lines[0]), -np.inf)
-    np.minimum.at(t_lo, generator, t)
-    np.maximum.at(t_hi, generator, t)
+    np.minimum.at(t_lo, generator[at], t[at])
+    np.maximum.at(t_hi, generator[at], t[at])
     low, high = t_lo[k], t_hi[k]
+    # The barycentric coordinates of the projection of a + s d are affine in s:
+    # lambda_i = alpha_i + beta_i s; the stretch inside is where all three are >= 0.
     for i in range(3):
         p, q = P[:, (i + 1) % 3], P[:, (i + 2) % 3]
         e = cross(q - p, n)                 # normal of the edge opposite corner i ...
