@@ -409,8 +409,27 @@ def test_hybrid_torsal_lines_t_junction_is_reported():
 
     P = build(EXAMPLES / "hybrid-torsal-lines.toml").vertices
     np.testing.assert_allclose(P[v], 0.5 * (P[a] + P[b]), atol=1e-12)   # at the midpoint
-    assert any("T-junctions" in w for w in report["warnings"])
+    said = [w for w in report["warnings"] if "T-junction" in w]
+    assert len(said) == 1 and said[0].startswith("1 T-junction: ") and "conforming by connectivity" in said[0]
     assert _report("hybrid-fig9")["t_junctions"]["count"] == 0
+
+
+def test_a_closed_surfaces_seam_is_named_in_the_t_junction_warning():
+    """A Pluecker conoid from 15 lines over half a turn: the last line is the first, reversed,
+    and the two sides of that seam carry different divisions.  The T-junctions there are
+    named as the seam (the generators that coincide), not as faces failing to meet."""
+    from ruledmesh.analysis.report import analyze
+    from ruledmesh.design import build_design, parse_design
+
+    th = np.linspace(0, np.pi, 15)
+    lines = [[[-3 * np.cos(t), -3 * np.sin(t), 1.5 * np.sin(2 * t)],
+              [3 * np.cos(t), 3 * np.sin(t), 1.5 * np.sin(2 * t)]] for t in th]
+    text = f'name = "seam"\n[rulings]\nlines = {np.round(lines, 12).tolist()}\n[mesh]\nrows = 8\n'
+    report = analyze(build_design(parse_design(text)).mesh)
+    assert report["t_junctions"]["count"] > 0
+    said = [w for w in report["warnings"] if "T-junction" in w]
+    assert len(said) == 1 and "generators 0 and 14 coincide there (the seam of a closed surface)" in said[0]
+    assert "conforming by connectivity" not in said[0]
 
 
 # ------------------------------------------------------------ found by tests/test_fuzz_cli.py

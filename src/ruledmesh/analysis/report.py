@@ -294,6 +294,29 @@ def _low_coverage(report: Mapping[str, Any], explained: bool) -> str | None:
             f"{cov['mesh_area']:.4g}, patch {cov['patch_area']:.4g}): {why}")
 
 
+def _t_junction_warning(mesh: Mesh, tj: dict[str, Any]) -> str:
+    """The warning of the T-junctions ``tj`` (:func:`_t_junctions`), naming the first.
+
+    Where the edge runs along a generator (two of the three points on one generator) and
+    the three points are not all on that one, the generators they lie on coincide there:
+    the seam of a closed surface given by lines (the last line its first), whose two sides
+    carry different divisions, rather than a face that fails to meet its neighbour.
+    """
+    v, a, b = tj["first"][0]
+    said = (f"{tj['count']} T-junction{'s' if tj['count'] != 1 else ''}: vertex {v} lies inside the "
+            f"edge {a}-{b} of another face")
+    gap = "welding or smoothing in another program would open a gap there"
+    data = mesh.vertex_data
+    if "generator" in data and "t" in data:
+        g, t = np.asarray(data["generator"])[[v, a, b]], np.asarray(data["t"])[[v, a, b]]
+        along = any(g[i] == g[j] and t[i] != t[j] for i, j in ((0, 1), (0, 2), (1, 2)))
+        if along and g.min() >= 0 and len(set(g.tolist())) > 1:
+            return (f"{said}: generators {' and '.join(str(k) for k in sorted(set(g.tolist())))} "
+                    "coincide there (the seam of a closed surface) and each side is divided its own "
+                    f"way; {gap}")
+    return f"{said} (conforming by connectivity, not geometrically: {gap})"
+
+
 def _warnings(mesh: Mesh, report: dict[str, Any], tol: Tolerances) -> list[str]:
     """Warnings from the figures; adds ``guarantee_check`` and ``matches_design``."""
     from .guarantees import check_guarantee, format_guarantee
@@ -306,12 +329,8 @@ def _warnings(mesh: Mesh, report: dict[str, Any], tol: Tolerances) -> list[str]:
     if mesh.n_faces and 1.0 - share["quads"] > 0.3 and not said:
         warnings.append(f"{1.0 - share['quads']:.0%} of the area is not in quads "
                         f"(by kind: {_shares(share['by_kind'])})")
-    tj = report["t_junctions"]
-    if tj["count"]:
-        v, a, b = tj["first"][0]
-        warnings.append(f"{tj['count']} T-junctions: vertex {v} lies inside the edge {a}-{b} of a "
-                        "neighbouring face (conforming by connectivity, not geometrically: "
-                        "welding or smoothing in another program would open a gap there)")
+    if report["t_junctions"]["count"]:
+        warnings.append(_t_junction_warning(mesh, report["t_junctions"]))
     if report["quality"]["degenerate_faces"]:
         warnings.append(f"{report['quality']['degenerate_faces']} faces have no area")
     if bent:
