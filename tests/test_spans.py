@@ -15,8 +15,9 @@ QUALITY = Path(__file__).resolve().parents[1] / "benchmarks" / "quality"
 
 
 def _off_brute_force(P, a, d, lo=0.0, hi=1.0):
-    """The largest distance off the plane of triangle ``P`` (3, 3) of the points of the
-    segment ``a + s d``, s in [lo, hi] (100,001 samples), whose projection on it falls inside it."""
+    """The distance off the plane of triangle ``P`` (3, 3) of the segment ``a + s d``, s in
+    [lo, hi], halfway along the stretch whose projection on it falls inside it (found by
+    100,001 samples); 0 where none does."""
     s = np.linspace(lo, hi, 100_001)
     x = a + s[:, None] * d
     n = np.cross(P[1] - P[0], P[2] - P[0])
@@ -27,7 +28,10 @@ def _off_brute_force(P, a, d, lo=0.0, hi=1.0):
     for i in range(3):
         p, q = P[(i + 1) % 3], P[(i + 2) % 3]
         inside &= np.cross(q - p, y - p) @ n >= 0
-    return float(np.abs(dist[inside]).max(initial=0.0))
+    if not inside.any():
+        return 0.0
+    mid = 0.5 * (s[inside].min() + s[inside].max())
+    return float(abs((a + mid * d - P[0]) @ n))
 
 
 def test_off_spanned_generators_on_a_hyperbolic_paraboloid():
@@ -48,7 +52,7 @@ def test_off_spanned_generators_on_a_hyperbolic_paraboloid():
     for row in range(3):
         g = generator[tri[row]]
         want = max(_off_brute_force(V[tri[row]], a[j], d[j]) for j in range(g.min() + 1, g.max()))
-        assert want > 0.1
+        assert want > 0.02
         assert off[row] == pytest.approx(want, rel=1e-3)        # the sampling step
     assert off[3] == 0.0                        # corners on generators 0 and 1: spans none
     flat = off_spanned_generators(V * [1, 1, 0], tri, generator, t, (a, d * [1, 1, 0]))
@@ -60,13 +64,13 @@ def test_off_spanned_generators_on_a_hyperbolic_paraboloid():
     short = off_spanned_generators(V_short, tri[:1], generator, t_short, (a, d))
     want = max(_off_brute_force(V_short[tri[0]], a[j], d[j], t_short[generator == j].min(),
                                 t_short[generator == j].max()) for j in (1, 2, 3))
-    assert short[0] == pytest.approx(want, rel=1e-3) and short[0] < off[0]
+    assert short[0] == pytest.approx(want, rel=1e-3) and short[0] != pytest.approx(off[0], rel=1e-2)
 
 
 def test_a_build_says_where_triangles_leave_the_generators_they_span():
     """A cubic B-spline and an arc turned by 150 degrees against it, rows through both curves'
     end points, graded, not refined: at the waist the passes that fatten splinters leave fill
-    triangles across up to 12 strips, 1.7e-2 of the diagonal off the generators between
+    triangles across up to 12 strips, 8.4e-3 of the diagonal off the generators between
     (the gap goal is 2e-3), and the build says so; the same surface refined does not."""
     text = (QUALITY / "twisted-bspline-arc-150deg.toml").read_text()
     coarse = build_design(parse_design(text.replace(

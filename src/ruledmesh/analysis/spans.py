@@ -27,13 +27,13 @@ def off_spanned_generators(V: np.ndarray, tri: np.ndarray, generator: np.ndarray
     """(T,) how far the generators a triangle spans without a corner on them lie off it.
 
     A triangle whose corners lie on generators ``g0 < g2`` covers the surface of the
-    generators between: of each such generator, the stretch the mesh covers (between the
-    lowest and highest ``t`` of its vertices) whose projection on the triangle's plane
-    falls inside the triangle lies at most this far off it (the distance is affine along
-    the line, so the stretch's ends are its largest).  Stretches that project outside it
-    lie under the faces beside it, and so do generators that cross the triangle's plane at
-    more than 60 degrees (a generator lies in the surface's tangent plane: such a one runs
-    through another part of it, a fold or a pinch where the generators meet).
+    generators between.  Of each such generator, take the stretch the mesh covers (between
+    the lowest and highest ``t`` of its vertices) whose projection on the triangle's plane
+    falls inside the triangle; the distance off the triangle is measured halfway along it.
+    Stretches that project outside the triangle lie under the faces beside it, and so do
+    generators that cross its plane at more than 60 degrees (a generator lies in the
+    surface's tangent plane: such a one runs through another part of it, a fold or a pinch
+    where the generators meet).
 
     Parameters
     ----------
@@ -92,10 +92,10 @@ def off_spanned_generators(V: np.ndarray, tri: np.ndarray, generator: np.ndarray
     # generators meet, as a conoid's at its directrix) that other faces cover.
     steep = np.abs(np.einsum("ij,ij->i", d, n)) > _STEEP * np.maximum(norm(d), TINY)
     inside = (low <= high) & (area2 > TINY) & ~steep
-    far = np.zeros(row.size)
-    for s_end in (low, high):
-        s_at = np.where(inside, s_end, 0.0)
-        far = np.maximum(far, np.where(inside, np.abs(np.einsum("ij,ij->i", a + s_at[:, None] * d - P[:, 0], n)),
-                                       0.0))
+    # Halfway along the stretch, the point deepest inside the triangle's footprint: nearer
+    # its ends the faces beside it may lie nearer the generator than this one's plane (taken
+    # at the ends, a mesh the quality checker finds 1.2e-3 off read 3.0e-3).
+    mid = np.where(inside, 0.5 * (low + high), 0.0)
+    far = np.where(inside, np.abs(np.einsum("ij,ij->i", a + mid[:, None] * d - P[:, 0], n)), 0.0)
     np.maximum.at(out, row, far)
     return out
