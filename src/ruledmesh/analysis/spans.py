@@ -95,7 +95,9 @@ def off_spanned_generators(V: np.ndarray, tri: np.ndarray, generator: np.ndarray
     # Halfway along the stretch, the point deepest inside the triangle's footprint: nearer
     # its ends the faces beside it may lie nearer the generator than this one's plane (taken
     # at the ends, a mesh the quality checker finds 1.2e-3 off read 3.0e-3).
-    mid = np.where(inside, 0.5 * (low + high), 0.0)
+    # Only where the stretch is there: elsewhere low and high may be infinite.
+    mid = np.zeros(row.size)
+    mid[inside] = 0.5 * (low[inside] + high[inside])
     far = np.where(inside, np.abs(np.einsum("ij,ij->i", a + mid[:, None] * d - P[:, 0], n)), 0.0)
     np.maximum.at(out, row, far)
     return out
