@@ -14,14 +14,12 @@ from __future__ import annotations
 import numpy as np
 
 from .._arrays import cross, norm, ranks
-from ..tolerances import TINY
+from ..tolerances import COLLINEAR, TINY
 
 __all__ = ["off_spanned_generators"]
 
 # A generator crossing a triangle's plane at more than 60 degrees is not under it.
 _STEEP = float(np.sin(np.radians(60.0)))
-# A generator within this sine of an edge's direction is parallel to it.
-_PARALLEL = 1e-12
 
 
 def off_spanned_generators(V: np.ndarray, tri: np.ndarray, generator: np.ndarray, t: np.ndarray,
@@ -84,9 +82,9 @@ def off_spanned_generators(V: np.ndarray, tri: np.ndarray, generator: np.ndarray
         e *= np.where(np.einsum("ij,ij->i", P[:, i] - p, e) < 0, -1.0, 1.0)[:, None]   # ... inward
         alpha = np.einsum("ij,ij->i", a - p, e)
         beta = np.einsum("ij,ij->i", d, e)
-        # Parallel to the edge to 1e-12: the edge bounds the whole line or none of it (and
-        # the division below stays finite at any coordinates).
-        flat = np.abs(beta) <= _PARALLEL * np.maximum(norm(d) * norm(e), TINY)
+        # Parallel to the edge (to COLLINEAR): the edge bounds the whole line or none of it
+        # (and the division below stays finite at any coordinates).
+        flat = np.abs(beta) <= COLLINEAR * np.maximum(norm(d) * norm(e), TINY)
         bound = -alpha / np.where(flat, 1.0, beta)
         low = np.where(~flat & (beta > 0), np.maximum(low, bound), low)
         high = np.where(~flat & (beta < 0), np.minimum(high, bound), high)
