@@ -80,7 +80,7 @@ def test_a_build_says_where_triangles_leave_the_generators_they_span():
     built = build_design(parse_design(text))
     mesh, rulings = built.mesh, built.rulings
     a = rulings.a
-    tri = mesh.face_indices[mesh.face_offsets[np.flatnonzero(mesh.valences == 3)][:, None] + np.arange(3)]
+    _, tri = mesh.faces_of_valence(3)
     off = off_spanned_generators(mesh.vertices, tri, np.asarray(mesh.vertex_data["generator"]),
                                  np.asarray(mesh.vertex_data["t"]), (a, rulings.b - a))
     diag = float(np.linalg.norm(mesh.vertices.max(0) - mesh.vertices.min(0)))

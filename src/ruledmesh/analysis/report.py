@@ -310,8 +310,9 @@ def _t_junction_warning(mesh: Mesh, tj: dict[str, Any]) -> str:
     if "generator" in data and "t" in data:
         g, t = np.asarray(data["generator"])[[v, a, b]], np.asarray(data["t"])[[v, a, b]]
         along = any(g[i] == g[j] and t[i] != t[j] for i, j in ((0, 1), (0, 2), (1, 2)))
-        if along and g.min() >= 0 and len(set(g.tolist())) > 1:
-            return (f"{said}: generators {' and '.join(str(k) for k in sorted(set(g.tolist())))} "
+        on = sorted(set(g.tolist()))
+        if along and on[0] >= 0 and len(on) > 1:
+            return (f"{said}: generators {' and '.join(str(k) for k in on)} "
                     "coincide there (the seam of a closed surface) and each side is divided its own "
                     f"way; {gap}")
     return f"{said} (conforming by connectivity, not geometrically: {gap})"

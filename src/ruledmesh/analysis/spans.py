@@ -64,6 +64,7 @@ def off_spanned_generators(V: np.ndarray, tri: np.ndarray, generator: np.ndarray
     area2 = norm(n)
     n /= np.maximum(area2, TINY)[:, None]
     a, d = lines[0][k], lines[1][k]
+    d_len = np.maximum(norm(d), TINY)
     # The stretch of each generator the mesh covers: from the vertices on the generators
     # spanned only (a large mesh has few such triangles).
     on = np.zeros(len(lines[0]), bool)
@@ -84,7 +85,7 @@ def off_spanned_generators(V: np.ndarray, tri: np.ndarray, generator: np.ndarray
         beta = np.einsum("ij,ij->i", d, e)
         # Parallel to the edge (to COLLINEAR): the edge bounds the whole line or none of it
         # (and the division below stays finite at any coordinates).
-        flat = np.abs(beta) <= COLLINEAR * np.maximum(norm(d) * norm(e), TINY)
+        flat = np.abs(beta) <= COLLINEAR * np.maximum(d_len * norm(e), TINY)
         bound = -alpha / np.where(flat, 1.0, beta)
         low = np.where(~flat & (beta > 0), np.maximum(low, bound), low)
         high = np.where(~flat & (beta < 0), np.minimum(high, bound), high)
@@ -92,7 +93,7 @@ def off_spanned_generators(V: np.ndarray, tri: np.ndarray, generator: np.ndarray
     # A generator of the surface lies in its tangent plane: one crossing the triangle's plane
     # steeply runs through another part of the surface (a fold, or a pinch where the
     # generators meet, as a conoid's at its directrix) that other faces cover.
-    steep = np.abs(np.einsum("ij,ij->i", d, n)) > _STEEP * np.maximum(norm(d), TINY)
+    steep = np.abs(np.einsum("ij,ij->i", d, n)) > _STEEP * d_len
     inside = (low <= high) & (area2 > TINY) & ~steep
     # Halfway along the stretch, the point deepest inside the triangle's footprint: nearer
     # its ends the faces beside it may lie nearer the generator than this one's plane (taken

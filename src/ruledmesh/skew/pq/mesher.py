@@ -8,7 +8,7 @@ from enum import Enum
 
 import numpy as np
 
-from ..._arrays import diagonal, member, unique
+from ..._arrays import member, unique
 from ..._validation import check_bool, check_choice, check_float, check_int, check_points, describe
 from ...analysis.asymptotic import SLENDER_DEG, SLENDER_ELONGATION, crossing_angles, slender_share
 from ...analysis.faces import SPLINTER_DEG
@@ -1024,13 +1024,12 @@ def _warn_off_generators(mesh: Mesh, warnings: list[str], lines: tuple[np.ndarra
     most and between which generators; ``lines``: the generators ``(a, d)``."""
     from ...analysis.spans import off_spanned_generators
 
-    tri = np.flatnonzero(mesh.valences == 3)
-    if tri.size == 0:
+    _, corners = mesh.faces_of_valence(3)
+    if corners.size == 0:
         return
-    corners = mesh.face_indices[mesh.face_offsets[tri][:, None] + np.arange(3)]
     g = np.asarray(mesh.vertex_data["generator"], np.int64)
     off = off_spanned_generators(mesh.vertices, corners, g, np.asarray(mesh.vertex_data["t"], np.float64),
-                                 lines) / (diagonal(mesh.vertices) or 1.0)
+                                 lines) / (mesh.diagonal() or 1.0)
     far = off > SPAN_MAX_GAP
     if not far.any():
         return
