@@ -73,6 +73,21 @@ def test_a_mesh_without_such_corners_is_returned_as_it_is(built):
     assert n == 0 and again is mesh
 
 
+def test_an_untrimmed_mesh_has_no_corners_beyond_the_patch():
+    # A hyperbolic paraboloid z = x y extended far beyond its patch and not trimmed: its end
+    # generators carry hundreds of vertices outside the patch (t < 0 or t > 1).  Only the four
+    # points where they meet the director curves are patch corners; taking every vertex
+    # outside for one re-cut 128 "corners" of this mesh, faces far from any corner among them.
+    x = np.linspace(-1.0, 1.0, 9)
+    a = np.stack([x, np.zeros_like(x), np.zeros_like(x)], axis=1)
+    b = np.stack([x, np.ones_like(x), x], axis=1)
+    mesh = pq_mesh(a, b, rows=6, extend=100, max_extend=1000, trim=False)
+    t = mesh.vertex_data["t"]
+    assert (t < -1.0).sum() > 100                   # far beyond the patch: the case in question
+    assert mesh.info["corners"] == 0
+    assert rezip_corners(mesh)[1] == 0
+
+
 def test_a_design_keeps_the_mesh_through_both_arcs_end_points():
     from ruledmesh.design import build_design, parse_design
 

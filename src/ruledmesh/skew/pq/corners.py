@@ -62,7 +62,9 @@ def rezip_corners(mesh: Mesh, below: float = 3.0) -> tuple[Mesh, int]:
     gen = np.asarray(mesh.vertex_data["generator"])
     t = np.asarray(mesh.vertex_data["t"])
     ends = (gen == gen.min()) | (gen == gen.max())
-    rim = (t <= PARAMETER_SLACK) | (t >= 1.0 - PARAMETER_SLACK)
+    # On the rim, not merely outside the patch: an untrimmed mesh (trim = false) has
+    # thousands of vertices beyond the patch on its end generators, none of them a corner.
+    rim = np.minimum(np.abs(t), np.abs(1.0 - t)) <= PARAMETER_SLACK
     corners = np.flatnonzero(ends & rim)
     if corners.size == 0:
         return mesh, 0
@@ -140,7 +142,7 @@ def _beyond(faces: list[tuple[int, np.ndarray]], f: int, c: int, x: int, gen: np
             r, w = around[1], around[2]
         else:
             return None                      # x opposite c: not the quad through the corner
-        rim = min(t[c], 1.0 - t[c]) <= PARAMETER_SLACK
+        rim = min(abs(t[c]), abs(1.0 - t[c])) <= PARAMETER_SLACK
         if gen[r] != gen[x] or not rim or abs(t[r] - t[c]) > PARAMETER_SLACK:
             return None
         return q, r, w, corners
