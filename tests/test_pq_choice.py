@@ -13,6 +13,7 @@ from ruledmesh.design.pq import (
     _GOAL_TRIANGLES_TOLERANCE,
     _TYPICAL_TRIANGLES,
     _fabricable,
+    _goals_met,
     _worth_its_panels,
 )
 from ruledmesh.errors import DesignError
@@ -33,8 +34,10 @@ def _variant(name, count, rows, tolerance=None, mesh=""):
     return build_design(parse_design(text))
 
 
-def _round(triangles, splinters=0, cost=0.0, generators=50):
-    return (1.0 - triangles, splinters, cost, SimpleNamespace(u=range(generators)), None, ())
+def _round(triangles, splinters=0, cost=0.0, generators=50, off=()):
+    # the figures a round carries; its mesh only for the info of triangles off the surface
+    return (1.0 - triangles, splinters, cost, SimpleNamespace(u=range(generators)),
+            SimpleNamespace(info={"off_generators": list(off)}), ())
 
 
 def test_more_generators_are_kept_only_where_they_pay_for_their_panels():
@@ -75,6 +78,19 @@ def test_of_two_meshes_meeting_one_goal_each_the_nearer_wins():
     goal = _GOAL_TRIANGLES_TOLERANCE
     assert _fabricable(_round(0.08, 2, 0.0203), goal) > _fabricable(_round(0.47), goal)
     assert _fabricable(_round(0.30), goal) > _fabricable(_round(0.11, 1, 0.011), goal)
+
+
+def test_a_triangle_off_the_surface_misses_a_goal_as_a_splinter_does():
+    """A mesh with a triangle farther than the gap goal off the generators it spans (its
+    ``off_generators``) does not meet the goal of no face to refuse: one within the gap with
+    more triangles but within the share goal beats it, and of two missing a goal each the
+    smaller miss wins (the far triangle's cost is in the round's, as :func:`_splinters` adds it)."""
+    goal = _GOAL_TRIANGLES
+    off = _round(0.20, cost=0.095, off=[3.9e-3])
+    assert _goals_met(off, goal) == (False, True)
+    assert _fabricable(_round(0.24), goal) > _fabricable(off, goal)
+    assert _fabricable(_round(0.265), goal) > _fabricable(off, goal)        # 1.5 points over
+    assert _fabricable(_round(0.17, cost=0.0235, off=[2.3e-3]), goal) > _fabricable(_round(0.33), goal)
 
 
 def test_tolerance_mode_keeps_the_exact_mesh_where_it_has_more_quads():

@@ -86,3 +86,30 @@ def test_a_build_says_where_triangles_leave_the_generators_they_span():
     diag = float(np.linalg.norm(mesh.vertices.max(0) - mesh.vertices.min(0)))
     assert off.max() <= SPAN_MAX_GAP * diag
     assert not any("off the generators they span" in w for w in mesh.info["warnings"])
+
+
+def test_a_design_build_counts_triangles_off_the_surface_against_a_mesh():
+    """The mesher records how far each triangle beyond the gap goal lies (``info``), and a
+    design build's choice between meshes weighs those triangles as it weighs splinters: a
+    mesh with any fails the goal of no face to refuse, and each costs area share.  Of these
+    two meshes of the same surface (not refined) the one through both curves' end points has
+    15 triangles up to 8.4e-3 off and 5 splinters; the one from the primary has neither."""
+    from ruledmesh.design.pq import _fabricable, _goals_met, _round, _splinters
+
+    text = (QUALITY / "twisted-bspline-arc-150deg.toml").read_text()
+    rounds = []
+    for rows_from in ("both", "primary"):
+        built = build_design(parse_design(text.replace(
+            "[mesh]", f'[mesh]\nrefine = false\nrows_from = "{rows_from}"\ndivision = "graded"')))
+        rounds.append(_round(built.rulings, built.mesh))
+    both, primary = rounds
+    off = np.asarray(both[4].info["off_generators"])
+    assert off.size == 15 and off.min() > SPAN_MAX_GAP and off.max() == pytest.approx(8.4e-3, rel=0.01)
+    assert primary[4].info["off_generators"] == []
+    assert _goals_met(primary, 0.25) == (True, False) and _goals_met(both, 0.25) == (False, False)
+    # each far triangle costs what a splinter costs, more the farther it lies (ten times at
+    # twice the goal and beyond): here 15 of them at 2.0e-3 to 8.4e-3
+    splinters_only = _splinters(both[4].with_info(off_generators=[]))
+    assert both[1] == splinters_only[0] == 5
+    assert 15 * 0.01 < both[2] - splinters_only[1] <= 15 * 0.1
+    assert _fabricable(primary, 0.25) > _fabricable(both, 0.25)

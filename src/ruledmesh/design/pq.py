@@ -16,7 +16,7 @@ from ..budget import MAX_COUNT
 from ..errors import DesignError, GeometryError
 from ..registry import BuildContext, Built, mesh_method
 from ..skew.pq import MAX_GRID_POINTS, PrimaryDivision, RowsFrom, pq_mesh
-from ..tolerances import DEFAULT, TINY
+from ..tolerances import DEFAULT, SPAN_MAX_GAP, TINY
 
 __all__ = ["MESH_KEYS", "build_pq", "keeping_meshes"]
 
@@ -603,7 +603,7 @@ def _short(round_: tuple, goal: float) -> bool:
 def _with_room(round_: tuple, goal: float) -> bool:
     """Whether a round's mesh meets the goals with room: no splinter and at most :data:`_ROOM`
     of the goal's share of its area in triangles."""
-    return round_[1] == 0 and 1.0 - round_[0] <= _ROOM * goal
+    return _no_faces_refused(round_) and 1.0 - round_[0] <= _ROOM * goal
 
 
 # Where the rows may start instead of the primary's division: through the end points on
@@ -777,7 +777,7 @@ def _rounds(rulings, mesh, measured: tuple[float, np.ndarray], options: dict, gr
         # share in triangles (_worth_its_panels then weighs what they cost).
         broad = bars[k] < first
         limit = _ROOM * goal if k < _REFINE_ROUNDS - 1 else _typical(goal)
-        if rounds[-1][1] == 0 and 1.0 - share <= limit:
+        if _no_faces_refused(rounds[-1]) and 1.0 - share <= limit:
             break
         candidate = _with_generators(cur_rulings, cur_mesh, area, bars[k], grid, options["rows"])
         cand = None
@@ -939,9 +939,15 @@ def _fabricable(round_: tuple, goal: float) -> tuple[int, float, float]:
 
 
 def _goals_met(round_: tuple, goal: float) -> tuple[bool, bool]:
-    """A fabricator's two goals for a round's mesh: no splinter, at most ``goal`` of the area
-    in triangles."""
-    return round_[1] == 0, 1.0 - round_[0] <= goal
+    """A fabricator's two goals for a round's mesh: no face to refuse (no splinter, no triangle
+    off the surface: :func:`_splinters`), at most ``goal`` of the area in triangles."""
+    return _no_faces_refused(round_), 1.0 - round_[0] <= goal
+
+
+def _no_faces_refused(round_: tuple) -> bool:
+    """Whether a round's mesh has no splinter and no triangle farther than the gap goal off the
+    generators it spans (the mesher's ``info["off_generators"]``)."""
+    return round_[1] == 0 and not round_[4].info.get("off_generators")
 
 
 def _typical(goal: float) -> float:
@@ -951,18 +957,24 @@ def _typical(goal: float) -> float:
 
 
 def _splinters(mesh) -> tuple[int, float]:
-    """Faces with a corner below the splinter bar, and what they cost in area share.
+    """How many splinters a mesh has, and what they and its triangles off the surface cost in
+    area share.
 
-    Each costs :data:`_SPLINTER_COST` plus up to nine times as much more the
-    further its smallest angle lies below the bar (a point of area share at 2.9
-    degrees, 8.5 points at 0.5): a fabricator can live with a face at 2.9 degrees,
-    not with one at 0.5.
+    A face with a corner below the splinter bar costs :data:`_SPLINTER_COST` plus up
+    to nine times as much more the further its smallest angle lies below the bar (a
+    point of area share at 2.9 degrees, 8.5 points at 0.5): a fabricator can live with
+    a face at 2.9 degrees, not with one at 0.5.  A triangle farther than the gap goal
+    (:data:`~ruledmesh.tolerances.SPAN_MAX_GAP` of the diagonal) off the generators it
+    spans (the mesher's ``info["off_generators"]``) costs the same, up to ten times at
+    twice the goal: the mesh is not the surface there, as wrong as a splinter.
     """
     from ..analysis.faces import SPLINTER_DEG, face_min_angles
 
     angles = face_min_angles(mesh)
     below = angles[angles < SPLINTER_DEG]
-    cost = _SPLINTER_COST * float(np.sum(1.0 + 9.0 * (SPLINTER_DEG - below) / SPLINTER_DEG))
+    off = np.asarray(mesh.info.get("off_generators", ()), np.float64)
+    cost = _SPLINTER_COST * float(np.sum(1.0 + 9.0 * (SPLINTER_DEG - below) / SPLINTER_DEG)
+                                  + np.sum(1.0 + 9.0 * np.minimum(off / SPAN_MAX_GAP - 1.0, 1.0)))
     return int(below.size), cost
 
 

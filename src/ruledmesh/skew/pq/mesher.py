@@ -436,7 +436,9 @@ def pq_mesh(a, b, rows: int = 20, primary: int | str = "middle", option: int = 0
         ``vertex_data`` holds ``t`` and ``generator``; ``info`` the ``warnings``, ``runs``,
         ``restarts``, ``option``, ``primary``, ``division``, ``rows_from`` (``"mixed"`` if
         segments differ; ``row_segments``: ``[lo, hi, rows_from, option]`` each), ``thin``,
-        ``thinnable`` (stretches ``thin`` would give rows), the passes' counts (``flips``, ...).
+        ``thinnable`` (stretches ``thin`` would give rows), ``off_generators`` (how far each
+        triangle farther than the gap goal off the generators it spans lies, relative to the
+        diagonal; :mod:`ruledmesh.analysis.spans`), the passes' counts (``flips``, ...).
 
     Raises
     ------
@@ -476,10 +478,11 @@ def pq_mesh(a, b, rows: int = 20, primary: int | str = "middle", option: int = 0
     mesh, fattening, measured = _fattened(assemble(parts, a, d, args.trim, tol, ptol, warnings, scale, meet,
                                                    rows=rows), ptol, tol)
     _warn_share(mesh, warnings, known, m, rows, (a, d, ptol), measured)
-    _warn_faces(mesh, warnings, torsal, measured, (a, d))
+    off_gap = _warn_faces(mesh, warnings, torsal, measured, (a, d))
     if kept.size < m_given:
         mesh = _renumbered(mesh, kept)
-    return mesh.with_info(runs=runs, restarts=known.restarts, **_options_info(plan, args, kept), **fattening)
+    return mesh.with_info(runs=runs, restarts=known.restarts, **_options_info(plan, args, kept), **fattening,
+                          off_generators=off_gap)
 
 
 def _options_info(plan: _Plan, args: _Args, kept: np.ndarray) -> dict:
@@ -1011,34 +1014,39 @@ _MEETING_GAP = 0.01
 
 
 def _warn_faces(mesh: Mesh, warnings: list[str], torsal: np.ndarray, measured: tuple | None,
-                lines: tuple[np.ndarray, np.ndarray]) -> None:
+                lines: tuple[np.ndarray, np.ndarray]) -> list[float]:
     """What a build says of its faces: splinters (:func:`_warn_splinters`) and triangles off
-    the generators they span (:func:`_warn_off_generators`)."""
+    the generators they span (:func:`_warn_off_generators`, whose result it returns)."""
     _warn_splinters(mesh, warnings, torsal, measured, lines)
-    _warn_off_generators(mesh, warnings, lines)
+    return _warn_off_generators(mesh, warnings, lines)
 
 
-def _warn_off_generators(mesh: Mesh, warnings: list[str], lines: tuple[np.ndarray, np.ndarray]) -> None:
+def _warn_off_generators(mesh: Mesh, warnings: list[str], lines: tuple[np.ndarray, np.ndarray]) -> list[float]:
     """Say how many triangles lie farther than :data:`~ruledmesh.tolerances.SPAN_MAX_GAP` of
     the diagonal off the generators they span (:mod:`ruledmesh.analysis.spans`), how far at
-    most and between which generators; ``lines``: the generators ``(a, d)``."""
+    most and between which generators; ``lines``: the generators ``(a, d)``.
+
+    Returns how far each of those triangles lies, relative to the diagonal (the mesh's
+    ``info["off_generators"]``: a design build weighs them as it weighs splinters).
+    """
     from ...analysis.spans import off_spanned_generators
 
     _, corners = mesh.faces_of_valence(3)
     if corners.size == 0:
-        return
+        return []
     g = np.asarray(mesh.vertex_data["generator"], np.int64)
     off = off_spanned_generators(mesh.vertices, corners, g, np.asarray(mesh.vertex_data["t"], np.float64),
                                  lines) / (mesh.diagonal() or 1.0)
     far = off > SPAN_MAX_GAP
     if not far.any():
-        return
+        return []
     span = g[corners[far]]
     warnings.append(f"{int(far.sum())} triangles lie up to {off.max():.1e} of the diagonal off the "
                     f"generators they span (between generators {int(span.min())} and {int(span.max())}, "
                     f"across up to {int((span.max(axis=1) - span.min(axis=1)).max())} strips; the gap goal "
                     f"is {SPAN_MAX_GAP:g}): the smooth surface is not within the gap goal of the mesh there; "
                     "more generators (rulings.count) or fewer rows")
+    return off[far].tolist()
 
 
 def _at_meetings(angles: np.ndarray, g0: np.ndarray, lines: tuple | None) -> np.ndarray:
