@@ -430,15 +430,13 @@ def pq_mesh(a, b, rows: int = 20, primary: int | str = "middle", option: int = 0
     Returns
     -------
     Mesh
-        Faces of kind QUAD, BORDER (reaching a director curve), STRIP (between coplanar
-        generators), FILL (notch, torsal, border triangles) and SPLIT (halves of quads that
-        were not convex); members are the generator segments between vertices;
-        ``vertex_data`` holds ``t`` and ``generator``; ``info`` the ``warnings``, ``runs``,
-        ``restarts``, ``option``, ``primary``, ``division``, ``rows_from`` (``"mixed"`` if
-        segments differ; ``row_segments``: ``[lo, hi, rows_from, option]`` each), ``thin``,
-        ``thinnable`` (stretches ``thin`` would give rows), ``off_generators`` (how far each
-        triangle farther than the gap goal off the generators it spans lies, relative to the
-        diagonal; :mod:`ruledmesh.analysis.spans`), the passes' counts (``flips``, ...).
+        Faces of kind QUAD, BORDER (reaching a director curve), STRIP (between coplanar generators),
+        FILL (notch, torsal, border triangles) and SPLIT (halves of quads that were not convex);
+        members are the generator segments between vertices; ``vertex_data`` holds ``t`` and
+        ``generator``; ``info`` the ``warnings``, ``runs``, ``restarts``, ``option``, ``primary``,
+        ``division``, ``rows_from`` (``"mixed"`` if segments differ; ``row_segments``: ``[lo, hi,
+        rows_from, option]`` each), ``thin``, ``thinnable`` (stretches ``thin`` would give rows),
+        ``off_generators`` (:func:`_warn_off_generators`), the passes' counts (``flips``, ...).
 
     Raises
     ------
@@ -478,11 +476,10 @@ def pq_mesh(a, b, rows: int = 20, primary: int | str = "middle", option: int = 0
     mesh, fattening, measured = _fattened(assemble(parts, a, d, args.trim, tol, ptol, warnings, scale, meet,
                                                    rows=rows), ptol, tol)
     _warn_share(mesh, warnings, known, m, rows, (a, d, ptol), measured)
-    off_gap = _warn_faces(mesh, warnings, torsal, measured, (a, d))
+    passes = {**fattening, "off_generators": _warn_faces(mesh, warnings, torsal, measured, (a, d))}
     if kept.size < m_given:
         mesh = _renumbered(mesh, kept)
-    return mesh.with_info(runs=runs, restarts=known.restarts, **_options_info(plan, args, kept), **fattening,
-                          off_generators=off_gap)
+    return mesh.with_info(runs=runs, restarts=known.restarts, **_options_info(plan, args, kept), **passes)
 
 
 def _options_info(plan: _Plan, args: _Args, kept: np.ndarray) -> dict:
