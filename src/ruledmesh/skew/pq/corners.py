@@ -123,10 +123,11 @@ def _corner_plan(mesh: Mesh, faces: list[tuple[int, np.ndarray]], c: int, gen: n
 
 
 def _beyond(faces: list[tuple[int, np.ndarray]], f: int, c: int, x: int, gen: np.ndarray, t: np.ndarray):
-    """``(q, r, w, corners)``: the face ``q`` at ``c`` (of ``faces``) across the edge ``c x`` from
-    face ``f``, with its corners.  A triangle ``(c, x, r)``: ``w`` None.  A quad through the
-    corner whose diagonal ``r x`` lies on a generator, ``r`` on the border next to ``c``: ``w``
-    its fourth corner (the quad is cut along that diagonal).  Else None."""
+    """``(q, r, w, corners)``: the face ``q`` at the patch corner ``c`` (of ``faces``; on the rim,
+    as :func:`rezip_corners` picks it) across the edge ``c x`` from face ``f``, with its corners.
+    A triangle ``(c, x, r)``: ``w`` None.  A quad through the corner whose diagonal ``r x`` lies
+    on a generator, ``r`` on the border next to ``c`` (on the same rim): ``w`` its fourth corner
+    (the quad is cut along that diagonal).  Else None."""
     for q, corners in faces:
         if q == f or x not in corners:
             continue
@@ -142,8 +143,7 @@ def _beyond(faces: list[tuple[int, np.ndarray]], f: int, c: int, x: int, gen: np
             r, w = around[1], around[2]
         else:
             return None                      # x opposite c: not the quad through the corner
-        rim = min(abs(t[c]), abs(1.0 - t[c])) <= PARAMETER_SLACK
-        if gen[r] != gen[x] or not rim or abs(t[r] - t[c]) > PARAMETER_SLACK:
+        if gen[r] != gen[x] or abs(t[r] - t[c]) > PARAMETER_SLACK:
             return None
         return q, r, w, corners
     return None
