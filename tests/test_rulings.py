@@ -346,3 +346,77 @@ def test_point_partials_is_point_and_partials(make):
     p, su, st = s.point_partials(u, t)
     qu, qt = s.partials(u, t)
     assert np.array_equal(p, s.point(u, t)) and np.array_equal(su, qu) and np.array_equal(st, qt)
+
+
+# --- three skew lines (closed form) -----------------------------------------
+
+def _regulus_line(a: float, b: float, c: float, phi: float, s: float) -> Line:
+    """The segment of x^2/a^2 + y^2/b^2 - z^2/c^2 = 1's regulus line at angle phi, half-length s."""
+    p = np.array([a * math.cos(phi), b * math.sin(phi), 0.0])
+    d = np.array([-a * math.sin(phi), b * math.cos(phi), c])
+    return Line(p - s * d, p + s * d)
+
+
+def _off_quadric(x: np.ndarray, a: float, b: float, c: float) -> float:
+    return float(np.abs(x[:, 0] ** 2 / a**2 + x[:, 1] ** 2 / b**2 - x[:, 2] ** 2 / c**2 - 1).max())
+
+
+def test_three_lines_meet_the_third_beyond_its_points_and_at_infinity():
+    """c3 only chooses the regulus: the lines may meet it beyond its two points, or run
+    parallel to it, and the surface between c1 and c2 is still there.  (The numeric search
+    refused this design: 'the line runs off the end of c3'.)"""
+    a, b, c = 4.0, 3.0, 2.0
+    c1, c2, c3 = (_regulus_line(a, b, c, phi, s) for phi, s in ((0.0, 1.0), (0.5, 2.0), (2.21, 1.0)))
+    r = three_directrices(c1, c2, c3, 41)
+    assert not r.info["warnings"]
+    assert _on_curve(c1, r.a, r.info["c1_params"]) < 1e-12
+    assert _on_curve(c2, r.b, r.info["c2_params"]) < 1e-12
+    assert r.info["c1_params"][[0, -1]].tolist() == [0.0, 1.0]
+    # Every generator lies on the quadric (the other regulus), and meets c3's line.
+    for t in (0.0, 0.37, 1.0):
+        assert _off_quadric(r.a + t * (r.b - r.a), a, b, c) < 1e-12
+    w, lam = r.info["c3_params"], r.info["c3_t"]
+    seen = np.isfinite(w)
+    assert (~seen).sum() <= 1 and ((w[seen] < 0) | (w[seen] > 1)).any()
+    hit = r.a[seen] + lam[seen, None] * (r.b - r.a)[seen]
+    assert np.abs(hit - c3.evaluate(w[seen])).max() < 1e-9
+    # The closed form agrees with the numeric search (the same lines as polylines) where the
+    # search can follow the family: within the segments of c2 and c3.
+    c3 = _regulus_line(a, b, c, 0.8, 4.0)
+    closed = three_directrices(c1, c2, c3, 9)
+    numeric = three_directrices(c1, *(Polyline(np.array([l.p0, l.p1])) for l in (c2, c3)), 9)
+    assert np.array_equal(closed.a, numeric.a) and np.abs(closed.b - numeric.b).max() < 1e-12
+
+
+def test_three_lines_span_the_part_of_c1_whose_lines_reach_c2():
+    a, b, c = 4.0, 3.0, 2.0
+    c1, c3 = _regulus_line(a, b, c, 0.3, 1.5), _regulus_line(a, b, c, 2.6, 1.5)
+    c2 = _regulus_line(a, b, c, 1.4, 0.5)          # too short for every line through c1
+    r = three_directrices(c1, c2, c3, 21)
+    [said] = r.info["warnings"]
+    assert "reach the segment c2 only from arc-length fraction" in said and "lengthen c2" in said
+    v, u1 = r.info["c2_params"], r.info["c1_params"]
+    assert (v >= 0).all() and (v <= 1).all()
+    # c1 is cut where its lines leave the segment c2: there a generator ends at an end of c2.
+    assert u1[0] > 0.1 and min(v[0], 1 - v[0]) < 1e-9
+    assert u1[-1] < 1.0 or min(v[-1], 1 - v[-1]) > 1e-3
+    assert _off_quadric(0.5 * (r.a + r.b), a, b, c) < 1e-12
+    # No line through c1 reaches a far-away c2 at all.
+    whole = _regulus_line(a, b, c, 1.4, 0.5)
+    far = Line(whole.p0 + 5 * (whole.p1 - whole.p0), whole.p0 + 6 * (whole.p1 - whole.p0))
+    with pytest.raises(GeometryError, match="no line through a point of c1 that meets the line c3 "
+                                            "meets the segment c2"):
+        three_directrices(c1, far, c3, 9)
+
+
+def test_a_design_of_three_lines_says_which_part_its_generators_span():
+    from ruledmesh.design import build_design, parse_design
+
+    a, b, c = 4.0, 3.0, 2.0
+    lines = [_regulus_line(a, b, c, phi, s) for phi, s in ((0.3, 1.5), (1.4, 0.5), (2.6, 1.5))]
+    text = "".join(f"[curves.c{i + 1}]\ntype = \"line\"\npoints = [{l.p0.tolist()}, {l.p1.tolist()}]\n\n"
+                   for i, l in enumerate(lines))
+    text += "[rulings]\nbetween = [\"c1\", \"c2\", \"c3\"]\ncount = 25\n\n[mesh]\nrows = 12\n"
+    built = build_design(parse_design(text, "three.toml"))
+    assert built.mesh.info["warnings"][0].startswith("three directrices: the lines through c1")
+    assert _off_quadric(built.mesh.vertices, a, b, c) < 1e-12

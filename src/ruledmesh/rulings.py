@@ -54,9 +54,20 @@ from ._validation import (
 # scipy is imported where it is used (lines through points, PCHIP at tangencies, root
 # brackets), so building from director curves starts without it.
 from .budget import MAX_GENERATORS, PQ_BYTES_PER_GRID_POINT
-from .curves import BSpline, CubicHermite, Curve, LevelSet, perpendicular
+from .curves import BSpline, CubicHermite, Curve, LevelSet, Line, perpendicular
 from .errors import GeometryError, ParameterError
-from .tolerances import DEFAULT, PARAMETER_SLACK, ROOT_RTOL, ROOT_XTOL, ROUNDING, SAME_ROOT, TINY, ULPS, Tolerances
+from .tolerances import (
+    DEFAULT,
+    PARAMETER_SLACK,
+    ROOT_RTOL,
+    ROOT_XTOL,
+    ROUNDING,
+    SAME_ROOT,
+    SLOPE_STEP,
+    TINY,
+    ULPS,
+    Tolerances,
+)
 
 __all__ = [
     "Distribution",
@@ -727,6 +738,9 @@ def three_directrices(c1: Curve, c2: Curve, c3: Curve, count: int, *,
     continued from the previous solution with step halving, the first from a
     grid search over the central projections of c2 and c3 from ``c1(0)``.
 
+    Where c2 and c3 are lines the lines are found in closed form instead,
+    c3 taken as the whole line (:func:`_three_lines`).
+
     Parameters
     ----------
     c1, c2, c3 : Curve
@@ -735,19 +749,23 @@ def three_directrices(c1: Curve, c2: Curve, c3: Curve, count: int, *,
     count : int >= 2
     start : (2,) array_like, optional
         ``(v, w)`` near the wanted first line, when ``c1(0)`` has several; by
-        default the one with the smallest ``v`` (then ``w``).
+        default the one with the smallest ``v`` (then ``w``).  Not used where
+        c2 and c3 are lines (a point has one line meeting two skew lines).
 
     Raises
     ------
     GeometryError
         No line through ``c1(0)`` meets c2 and c3, or the family ends (the
         line runs off c2 or c3, or the solution turns back) before ``c1(1)``:
-        the message gives the generator and the parameter on c1.
+        the message gives the generator and the parameter on c1.  For lines
+        c2 and c3: no line through a point of c1 meets the segment c2.
     """
     c1 = _check_curve(c1, "c1")
     c2 = _check_curve(c2, "c2")
     c3 = _check_curve(c3, "c3")
     count = check_int(count, "count", lo=2)
+    if isinstance(c2, Line) and isinstance(c3, Line):
+        return _three_lines(c1, c2, c3, count, tol)
     size = max(c1.size, c2.size, c3.size)
     grid, k = dense_grid(count)
     arc1 = _arc_sigma(c1, count)
@@ -808,6 +826,135 @@ def three_directrices(c1: Curve, c2: Curve, c3: Curve, count: int, *,
             "c3_params": sol[::k, 1].copy(), "c3_t": sol[::k, 2].copy()}
     return _curve_rulings(c1, arc1, c2, s2, count, info, tol, sig1[::k].copy(),
                           sol[::k, 0].copy())
+
+
+@dataclass(frozen=True)
+class _Part:
+    """sigma(u) = ``whole``'s at ``lo + u (hi - lo)``: a correspondence over a part of c1."""
+
+    whole: Any
+    lo: float
+    hi: float
+
+    def value(self, u):
+        return self.whole.value(self.lo + np.asarray(u) * (self.hi - self.lo))
+
+    def deriv(self, u):
+        return self.whole.deriv(self.lo + np.asarray(u) * (self.hi - self.lo)) * (self.hi - self.lo)
+
+
+def _transversals(p: np.ndarray, c2: Line, c3: Line) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """The lines through the points ``p`` (n, 3) meeting the lines of ``c2`` and ``c3``: their
+    parameters ``v`` on c2 and ``w`` on c3 and ``lam`` with ``c3(w) - p = lam (c2(v) - p)``
+    (NaN where a line is parallel to c2 or c3: it meets that line at infinity).
+
+    The line lies in both planes through ``p`` and one of the lines, so its direction is the
+    cross product of their normals; each parameter is where it meets that line.
+    """
+    a2, d2 = c2.p0, c2.p1 - c2.p0
+    a3, d3 = c3.p0, c3.p1 - c3.p0
+    e = np.cross(np.cross(d2, a2 - p), np.cross(d3, a3 - p))
+
+    def meet(a: np.ndarray, d: np.ndarray) -> np.ndarray:
+        c = np.cross(d, e)
+        cc = np.einsum("ij,ij->i", c, c)
+        with np.errstate(divide="ignore", invalid="ignore"):
+            x = np.einsum("ij,ij->i", np.cross(p - a, e), c) / cc
+        # Parallel within rounding (relative to both directions): no finite meeting point.
+        flat = cc <= (ROUNDING * np.linalg.norm(d)) ** 2 * np.einsum("ij,ij->i", e, e)
+        return np.where(flat, np.nan, x)
+
+    v, w = meet(a2, d2), meet(a3, d3)
+    q, r = a2 + v[:, None] * d2, a3 + w[:, None] * d3
+    qp = q - p
+    with np.errstate(divide="ignore", invalid="ignore"):
+        lam = np.einsum("ij,ij->i", r - p, qp) / np.einsum("ij,ij->i", qp, qp)
+    return v, w, lam
+
+
+def _three_lines(c1: Curve, c2: Line, c3: Line, count: int, tol: Tolerances) -> Rulings:
+    """:func:`three_directrices` where c2 and c3 are lines: the lines in closed form.
+
+    c3 counts as the whole line through its two points: it only chooses the family
+    (the lines meeting three skew lines are one regulus of a quadric) and bounds no part
+    of the patch, so the lines may meet it beyond its points or, parallel to it, at
+    infinity.  The patch runs from c1 to the segment c2: where only part of c1's lines
+    reach that segment, the generators span that part (the longest), with a warning.
+    """
+    grid, _ = dense_grid(count)
+    arc1 = _arc_sigma(c1, count)
+    v = _transversals(c1.point_at(arc1.value(grid)), c2, c3)[0]
+    inside = np.isfinite(v) & (v >= -PARAMETER_SLACK) & (v <= 1 + PARAMETER_SLACK)
+    if not inside.any():
+        raise GeometryError("three directrices: no line through a point of c1 that meets the line "
+                            "c3 meets the segment c2")
+    warnings = []
+    if not inside.all():
+        lo, hi = _longest_run(inside)
+        g0 = _where_v_leaves(c1, arc1, c2, c3, grid, lo - 1, lo) if lo > 0 else 0.0
+        g1 = _where_v_leaves(c1, arc1, c2, c3, grid, hi + 1, hi) if hi < len(grid) - 1 else 1.0
+        arc1 = _Part(arc1, g0, g1)
+        warnings.append(f"three directrices: the lines through c1 that meet the line c3 reach the "
+                        f"segment c2 only from arc-length fraction {g0:.4g} to {g1:.4g} of c1; the "
+                        f"{count} generators span that part (lengthen c2 for more)")
+    u = np.linspace(0.0, 1.0, count)
+    sig1 = arc1.value(u)
+    v, w, lam = _transversals(c1.point_at(sig1), c2, c3)
+    # c3(w) - a = lam (c2(v) - a): c3 meets the generator at t = lam.
+    info = {"distribution": "three-directrices", "warnings": warnings, "c3_params": w, "c3_t": lam}
+    return _curve_rulings(c1, arc1, c2, _TransversalSigma(c1, arc1, c2, c3), count, info, tol,
+                          sig1, np.clip(v, 0.0, 1.0))
+
+
+@dataclass(frozen=True)
+class _TransversalSigma:
+    """sigma2(u): where the line through ``c1(sigma1(u))`` meeting the lines c2 and c3 meets
+    c2, in closed form at every ``u`` (the generators the refinement adds lie on the quadric
+    to rounding, as the given ones do)."""
+
+    c1: Curve
+    sigma1: Any
+    c2: Line
+    c3: Line
+
+    def value(self, u):
+        u = np.asarray(u, dtype=np.float64)
+        p = self.c1.point_at(self.sigma1.value(u.reshape(-1)))
+        return np.clip(_transversals(p, self.c2, self.c3)[0], 0.0, 1.0).reshape(u.shape)
+
+    def deriv(self, u):
+        # Central differences of the closed form, one-sided at the ends: the slope serves
+        # tangents (closeness, refinement), never a vertex.
+        u = np.asarray(u, dtype=np.float64)
+        lo, hi = np.maximum(u - SLOPE_STEP, 0.0), np.minimum(u + SLOPE_STEP, 1.0)
+        return (self.value(hi) - self.value(lo)) / (hi - lo)
+
+
+
+def _longest_run(mask: np.ndarray) -> tuple[int, int]:
+    """First and last index of the longest run of True in ``mask`` (some True)."""
+    edges = np.diff(np.concatenate([[0], mask.astype(np.int8), [0]]))
+    starts, ends = np.flatnonzero(edges == 1), np.flatnonzero(edges == -1) - 1
+    best = int(np.argmax(ends - starts))
+    return int(starts[best]), int(ends[best])
+
+
+def _where_v_leaves(c1: Curve, arc1: Any, c2: Line, c3: Line, grid: np.ndarray, out: int, into: int) -> float:
+    """The arc-length fraction between ``grid[out]`` (line off the segment c2) and
+    ``grid[into]`` (on it) where the lines leave the segment, by bisection."""
+    def on(g: float) -> bool:
+        v = _transversals(c1.point_at(arc1.value(np.array([g]))), c2, c3)[0][0]
+        # Strictly on the segment: the generator found ends on c2 without being clipped.
+        return bool(np.isfinite(v) and 0.0 <= v <= 1.0)
+
+    a, b = float(grid[out]), float(grid[into])
+    for _ in range(60):
+        mid = 0.5 * (a + b)
+        if on(mid):
+            b = mid
+        else:
+            a = mid
+    return b
 
 
 def _family_end(reason: str, g: float, sig1: np.ndarray, grid: np.ndarray, k: int,

@@ -31,8 +31,8 @@ __all__ = ["BORDER_TRIM_MAX_GAP", "BRENTQ_XTOL", "CLOSENESS_SEARCH", "COLLAPSE_M
            "MIN_HALF_ANGLE", "MIN_RELATIVE_EXTENT", "MITRE_FLOOR", "NEARLY_DEVELOPABLE",
            "OCCT_FACE", "ON_BORDER", "PARAMETER_SLACK", "PLANARITY_FLOOR", "RESTART_ANGLE_DEG",
            "ROOT_RTOL", "ROOT_XTOL", "ROUNDING", "ROUNDING_SQ", "SAME_ROOT", "SETTLED", "SNAP_GAP",
-           "SNAP_MIN_GAIN_DEG", "SPAN_MAX_GAP", "SPLINTER_AREA_WORTH", "SPLINTER_FLIP_MAX_SAG", "TINY", "ULPS",
-           "Tolerances"]
+           "SLOPE_STEP", "SNAP_MIN_GAIN_DEG", "SPAN_MAX_GAP", "SPLINTER_AREA_WORTH", "SPLINTER_FLIP_MAX_SAG",
+           "TINY", "ULPS", "Tolerances"]
 
 
 @dataclass(frozen=True)
@@ -153,6 +153,10 @@ MIN_RELATIVE_EXTENT = 1e-12
 #: interval's ends (a kink split, the first step of a distribution): far above
 #: rounding, so the point is really interior, and far below any spacing a user sees.
 INTERIOR = 1e-6
+#: Step (of a parameter in [0, 1]) of the central differences that give a closed-form
+#: correspondence its slope: its error (the step squared) and rounding (1e-16 over the
+#: step) are both near 1e-10, and the slope serves tangents, never a vertex.
+SLOPE_STEP = 1e-6
 #: Parameters this close to 0 or 1 are on the patch border (rounding of t).
 ON_BORDER = 1e-12
 #: A border made by snapping stays this close (share of the diagonal) to the director curve.

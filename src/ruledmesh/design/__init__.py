@@ -235,6 +235,11 @@ def _build_surface(design: Design, mesh_table: Mapping, task: Task) -> Built:
             raise _unknown("mesh.method", method, MESH_METHODS)
         _check_budget(len(rulings), mesh_table, method)
         built = MESH_METHODS[method](rulings, mesh_table, ctx)
+        said = list(rulings.info.get("warnings", []))
+        if said:
+            # What the generators' construction had to say comes first (a part of c1 left out).
+            mesh = built.mesh
+            built = replace(built, mesh=mesh.with_info(warnings=said + list(mesh.info.get("warnings", []))))
     return built
 
 
