@@ -930,7 +930,6 @@ class _TransversalSigma:
         return (self.value(hi) - self.value(lo)) / (hi - lo)
 
 
-
 def _longest_run(mask: np.ndarray) -> tuple[int, int]:
     """First and last index of the longest run of True in ``mask`` (some True)."""
     edges = np.diff(np.concatenate([[0], mask.astype(np.int8), [0]]))
