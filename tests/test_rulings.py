@@ -420,3 +420,25 @@ def test_a_design_of_three_lines_says_which_part_its_generators_span():
     built = build_design(parse_design(text, "three.toml"))
     assert built.mesh.info["warnings"][0].startswith("three directrices: the lines through c1")
     assert _off_quadric(built.mesh.vertices, a, b, c) < 1e-12
+
+
+def test_a_line_c3_is_the_linear_directrix_taken_as_the_whole_line():
+    """c3 a line, c2 a curve: the family is that of the linear directrix c3 (§5.2 (d)), so a
+    short c3 segment, which the numeric search refused ('no line through c1(0) meets both c2
+    and c3'), gives the same generators as the long one."""
+    c1 = Line(np.array([-4.0, 0.0, 0.0]), np.array([4.0, 0.0, 0.0]))
+    c2 = BSpline([[-2, 4, -1], [0, 4, 3], [2, 4, -1]], 2)
+    long_c3 = Line(np.array([0.0, 8.0, -6.0]), np.array([0.0, 8.0, 6.0]))
+    short_c3 = Line(np.array([0.0, 8.0, -1.0]), np.array([0.0, 8.0, 1.0]))
+    long_r, short_r = (three_directrices(c1, c2, c3, 31) for c3 in (long_c3, short_c3))
+    assert np.abs(long_r.b - short_r.b).max() < 1e-12
+    assert short_r.info["distribution"] == "three-directrices"
+    w, lam = short_r.info["c3_params"], short_r.info["c3_t"]
+    assert ((w < 0) | (w > 1)).any()
+    hit = short_r.a + lam[:, None] * (short_r.b - short_r.a)
+    assert np.abs(hit - short_c3.evaluate(w)).max() < 1e-9
+    # Every generator meets the three: c1 and c2 at its ends, the line c3 where reported.
+    assert _on_curve(c2, short_r.b, short_r.info["c2_params"]) < 1e-12
+    away = Line(np.array([0.0, 8.0, 50.0]), np.array([1.0, 8.0, 50.0]))
+    with pytest.raises(GeometryError, match=r"^three directrices, the line c3 as linear directrix d: "):
+        three_directrices(c1, c2, away, 9)

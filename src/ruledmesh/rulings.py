@@ -36,7 +36,7 @@ given lines is then followed rather than smoothed over.
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from enum import Enum
 from typing import Any
 
@@ -738,8 +738,9 @@ def three_directrices(c1: Curve, c2: Curve, c3: Curve, count: int, *,
     continued from the previous solution with step halving, the first from a
     grid search over the central projections of c2 and c3 from ``c1(0)``.
 
-    Where c2 and c3 are lines the lines are found in closed form instead,
-    c3 taken as the whole line (:func:`_three_lines`).
+    Where c3 is a line it is taken as the whole line: the lines are those of
+    the pencil of planes through it (:func:`_c3_a_line`; in closed form where
+    c2 is a line too, :func:`_three_lines`).
 
     Parameters
     ----------
@@ -749,8 +750,7 @@ def three_directrices(c1: Curve, c2: Curve, c3: Curve, count: int, *,
     count : int >= 2
     start : (2,) array_like, optional
         ``(v, w)`` near the wanted first line, when ``c1(0)`` has several; by
-        default the one with the smallest ``v`` (then ``w``).  Not used where
-        c2 and c3 are lines (a point has one line meeting two skew lines).
+        default the one with the smallest ``v`` (then ``w``); unused for lines c2, c3.
 
     Raises
     ------
@@ -766,6 +766,8 @@ def three_directrices(c1: Curve, c2: Curve, c3: Curve, count: int, *,
     count = check_int(count, "count", lo=2)
     if isinstance(c2, Line) and isinstance(c3, Line):
         return _three_lines(c1, c2, c3, count, tol)
+    if isinstance(c3, Line) and start is None:
+        return _c3_a_line(c1, c2, c3, count, tol)
     size = max(c1.size, c2.size, c3.size)
     grid, k = dense_grid(count)
     arc1 = _arc_sigma(c1, count)
@@ -828,6 +830,28 @@ def three_directrices(c1: Curve, c2: Curve, c3: Curve, count: int, *,
                           sol[::k, 0].copy())
 
 
+def _c3_a_line(c1: Curve, c2: Curve, c3: Line, count: int, tol: Tolerances) -> Rulings:
+    """:func:`three_directrices` where c3 is a line (and c2 is not): the lines through a
+    point of c1 that meet c3 are those of the plane through both, so the family is that of
+    the linear directrix c3 (paper §5.2 (d), :func:`_linear_directrix`): c3 counts as the
+    whole line through its points, which the lines may meet beyond them or, parallel to
+    it, at infinity.  Its branch is the one from the root nearest ``c2(0)``, as the search
+    takes the smallest ``v``."""
+    try:
+        r = _linear_directrix(c1, c2, count, np.stack([c3.p0, c3.p1]),
+                              {"distribution": "three-directrices", "warnings": []}, tol)
+    except GeometryError as exc:
+        raise GeometryError("three directrices, the line c3 as linear directrix d: "
+                            + str(exc).removeprefix("linear-directrix: ")) from None
+    # Where each generator meets c3 (NaN where parallel to it), as the search reports it.
+    e = r.b - r.a
+    d3 = c3.p1 - c3.p0
+    w = _meeting(r.a, e, c3.p0, d3)
+    lam = np.einsum("ij,ij->i", c3.p0 + w[:, None] * d3 - r.a, e) / np.einsum("ij,ij->i", e, e)
+    info = {k: v for k, v in r.info.items() if k != "directrix"}
+    return replace(r, info={**info, "c3_params": w, "c3_t": lam})
+
+
 @dataclass(frozen=True)
 class _Part:
     """sigma(u) = ``whole``'s at ``lo + u (hi - lo)``: a correspondence over a part of c1."""
@@ -854,22 +878,24 @@ def _transversals(p: np.ndarray, c2: Line, c3: Line) -> tuple[np.ndarray, np.nda
     a2, d2 = c2.p0, c2.p1 - c2.p0
     a3, d3 = c3.p0, c3.p1 - c3.p0
     e = np.cross(np.cross(d2, a2 - p), np.cross(d3, a3 - p))
-
-    def meet(a: np.ndarray, d: np.ndarray) -> np.ndarray:
-        c = np.cross(d, e)
-        cc = np.einsum("ij,ij->i", c, c)
-        with np.errstate(divide="ignore", invalid="ignore"):
-            x = np.einsum("ij,ij->i", np.cross(p - a, e), c) / cc
-        # Parallel within rounding (relative to both directions): no finite meeting point.
-        flat = cc <= (ROUNDING * np.linalg.norm(d)) ** 2 * np.einsum("ij,ij->i", e, e)
-        return np.where(flat, np.nan, x)
-
-    v, w = meet(a2, d2), meet(a3, d3)
+    v, w = _meeting(p, e, a2, d2), _meeting(p, e, a3, d3)
     q, r = a2 + v[:, None] * d2, a3 + w[:, None] * d3
     qp = q - p
     with np.errstate(divide="ignore", invalid="ignore"):
         lam = np.einsum("ij,ij->i", r - p, qp) / np.einsum("ij,ij->i", qp, qp)
     return v, w, lam
+
+
+def _meeting(p: np.ndarray, e: np.ndarray, a: np.ndarray, d: np.ndarray) -> np.ndarray:
+    """(n,) the parameter ``x`` where each line ``p + s e`` (n, 3) meets the line ``a + x d``
+    (the nearest point, where they are skew), NaN where they are parallel within rounding
+    (relative to both directions): no finite meeting point."""
+    c = np.cross(d, e)
+    cc = np.einsum("ij,ij->i", c, c)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        x = np.einsum("ij,ij->i", np.cross(p - a, e), c) / cc
+    flat = cc <= (ROUNDING * np.linalg.norm(d)) ** 2 * np.einsum("ij,ij->i", e, e)
+    return np.where(flat, np.nan, x)
 
 
 def _three_lines(c1: Curve, c2: Line, c3: Line, count: int, tol: Tolerances) -> Rulings:
