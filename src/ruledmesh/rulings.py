@@ -844,10 +844,7 @@ def _c3_a_line(c1: Curve, c2: Curve, c3: Line, count: int, tol: Tolerances) -> R
         raise GeometryError("three directrices, the line c3 as linear directrix d: "
                             + str(exc).removeprefix("linear-directrix: ")) from None
     # Where each generator meets c3 (NaN where parallel to it), as the search reports it.
-    e = r.b - r.a
-    d3 = c3.p1 - c3.p0
-    w = _meeting(r.a, e, c3.p0, d3)
-    lam = np.einsum("ij,ij->i", c3.p0 + w[:, None] * d3 - r.a, e) / np.einsum("ij,ij->i", e, e)
+    w, lam = _crossing(r.a, r.b - r.a, c3)
     info = {k: v for k, v in r.info.items() if k != "directrix"}
     return replace(r, info={**info, "c3_params": w, "c3_t": lam})
 
@@ -870,20 +867,27 @@ class _Part:
 def _transversals(p: np.ndarray, c2: Line, c3: Line) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """The lines through the points ``p`` (n, 3) meeting the lines of ``c2`` and ``c3``: their
     parameters ``v`` on c2 and ``w`` on c3 and ``lam`` with ``c3(w) - p = lam (c2(v) - p)``
-    (NaN where a line is parallel to c2 or c3: it meets that line at infinity).
+    (NaN where a line is parallel to c2 or c3: it meets that line at infinity; ``w`` and
+    ``lam`` are NaN too where it is parallel to c2).
 
     The line lies in both planes through ``p`` and one of the lines, so its direction is the
     cross product of their normals; each parameter is where it meets that line.
     """
     a2, d2 = c2.p0, c2.p1 - c2.p0
-    a3, d3 = c3.p0, c3.p1 - c3.p0
-    e = np.cross(np.cross(d2, a2 - p), np.cross(d3, a3 - p))
-    v, w = _meeting(p, e, a2, d2), _meeting(p, e, a3, d3)
-    q, r = a2 + v[:, None] * d2, a3 + w[:, None] * d3
-    qp = q - p
-    with np.errstate(divide="ignore", invalid="ignore"):
-        lam = np.einsum("ij,ij->i", r - p, qp) / np.einsum("ij,ij->i", qp, qp)
+    e = np.cross(np.cross(d2, a2 - p), np.cross(c3.p1 - c3.p0, c3.p0 - p))
+    v = _meeting(p, e, a2, d2)
+    w, lam = _crossing(p, a2 + v[:, None] * d2 - p, c3)
     return v, w, lam
+
+
+def _crossing(a: np.ndarray, e: np.ndarray, c3: Line) -> tuple[np.ndarray, np.ndarray]:
+    """Where each line ``a + t e`` (n, 3) meets the line of ``c3``: its parameter ``w`` on c3
+    and ``t`` (NaN where they are parallel, or the line is undefined)."""
+    d3 = c3.p1 - c3.p0
+    w = _meeting(a, e, c3.p0, d3)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        t = np.einsum("ij,ij->i", c3.p0 + w[:, None] * d3 - a, e) / np.einsum("ij,ij->i", e, e)
+    return w, t
 
 
 def _meeting(p: np.ndarray, e: np.ndarray, a: np.ndarray, d: np.ndarray) -> np.ndarray:
