@@ -419,9 +419,9 @@ def pq_mesh(a, b, rows: int = 20, primary: int | str = "middle", option: int = 0
     rows_from : {"primary", "c1", "c2", "both", "none"} or (m,) sequence of them
         Where the rows start (:class:`RowsFrom`; ``"none"``: no rows); per generator, a segment
         with a division of its own (between torsal generators) takes the value where its rows start.
-    division : {"even", "graded"}
-        The primary's steps: even, or graded for faces of even shape wherever the rows land
-        (:class:`PrimaryDivision`).
+    division : {"even", "graded", "bounded"}
+        The primary's steps: even, or graded for faces of even shape wherever the rows land,
+        or graded with the steps at the rims bounded (:class:`PrimaryDivision`).
     thin : bool
         Restart runs failing towards a torsal generator with every other row left out, not
         leaving the rest without rows (:func:`_past_hopeless`; its seams may hold splinters).
@@ -469,7 +469,7 @@ def pq_mesh(a, b, rows: int = 20, primary: int | str = "middle", option: int = 0
                  hop_maps(a, d), args.respace, args.thin)
     primary = int(np.searchsorted(kept, args.primary, side="right") - 1)
     parts = _build_all(plan, segs, primary, args.middle, Division(
-        rows, 0, args.extend, args.max_extend, graded=args.division == "graded"), m)
+        rows, 0, args.extend, args.max_extend, graded=args.division != "even", bounded=args.division == "bounded"), m)
     even = _even_ranges(parts, segs, warnings, exact=ptol <= tol.planarity, own=plan.own)
     known = _Causes.of(parts, segs, torsal.size, even)    # before assemble() empties parts
     meet, runs = np.r_[flat, False] | np.r_[False, flat], len(parts)    # meet: of a coplanar pair
@@ -666,11 +666,15 @@ class PrimaryDivision(str, Enum):
     where they would bunch, :mod:`.extension`).  ``GRADED``: steps graded so that the faces
     are of about even shape on every generator the rows reach, the median generator
     carrying ``rows`` steps (:mod:`.grading`); on a hyperboloid close to its asymptotic
-    cone the even division's far rows crowd into slivers.
+    cone the even division's far rows crowd into slivers.  ``BOUNDED``: graded, but no
+    generator's step for square faces taken as more than :data:`.grading.BOUND` times their
+    median, so that the rows stay close enough together at the rims for small teeth of
+    triangles along the border.
     """
 
     EVEN = "even"
     GRADED = "graded"
+    BOUNDED = "bounded"
 
 
 @dataclass(frozen=True)
@@ -687,7 +691,7 @@ class _Args:
     ptol: float
     respace: bool
     ends: np.ndarray        # (m,) RowsFrom.ends, or -1 for the primary's division
-    division: str = "even"  # the primary's division: "even" or "graded"
+    division: str = "even"  # the primary's division: "even", "graded" or "bounded"
     thin: bool = False      # thin the rows where they fail towards a torsal generator
 
 

@@ -68,7 +68,8 @@ class Division:
     point ``t = ends`` of every generator the rows cross there (:func:`_through_ends`);
     :data:`BOTH_ENDS` through the end points at both ends.
     ``graded`` (not matched) spaces the rows for faces of about even shape on
-    every generator they reach instead of evenly on the primary (:func:`_graded_rows`).
+    every generator they reach instead of evenly on the primary (:func:`_graded_rows`);
+    ``bounded`` with no square step above :data:`.grading.BOUND` medians.
     """
 
     rows: int
@@ -78,6 +79,7 @@ class Division:
     matched: np.ndarray | None = None
     ends: int | None = None
     graded: bool = False
+    bounded: bool = False
 
 
 @dataclass
@@ -368,7 +370,7 @@ def mesh_run(a: np.ndarray, d: np.ndarray, first: int, primary: int, div: Divisi
     elif div.graded and m >= 3:
         lo, hi = _covering(preimage, div, warnings) if isinstance(div.extend, str) else \
             (-float(div.extend), 1.0 + float(div.extend))
-        tau = graded_rows(a, d, M, lo, hi, div.rows, bool((first + primary - div.option) % 2))
+        tau = graded_rows(a, d, M, lo, hi, div.rows, bool((first + primary - div.option) % 2), div.bounded)
     else:
         tau = _uniform_rows(M, div, first + primary, preimage, warnings)
     parity = (np.arange(m) - primary) % 2                     # 0: chain a, 1: chain b

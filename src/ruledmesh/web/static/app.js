@@ -1300,7 +1300,7 @@ function choiceList(path, name) {
   if (name === 'method' && path[0] === 'mesh') return ch.methods;
   if (name === 'type' && path[0] === 'curves') return ch.curve_types;
   if (name === 'rows_from' && path[0] === 'mesh') return ['auto', 'primary', 'c1', 'c2', 'both', 'none'];
-  if (name === 'division' && path[0] === 'mesh') return ['auto', 'even', 'graded'];
+  if (name === 'division' && path[0] === 'mesh') return ['auto', 'even', 'graded', 'bounded'];
   if (path[0] === 'surface' && path.length === 2) {
     return ch.kind_choices?.[current.header.design.surface?.kind]?.[name] || null;
   }
