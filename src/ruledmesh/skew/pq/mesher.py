@@ -8,7 +8,7 @@ from enum import Enum
 
 import numpy as np
 
-from ..._arrays import member, unique
+from ..._arrays import member, ranks, unique
 from ..._validation import check_bool, check_choice, check_float, check_int, check_points, describe
 from ...analysis.asymptotic import SLENDER_DEG, SLENDER_ELONGATION, crossing_angles, slender_share
 from ...analysis.faces import SPLINTER_DEG
@@ -1036,8 +1036,13 @@ def _warn_off_generators(mesh: Mesh, warnings: list[str], lines: tuple[np.ndarra
     if corners.size == 0:
         return []
     g = np.asarray(mesh.vertex_data["generator"], np.int64)
-    off = off_spanned_generators(mesh.vertices, corners, g, np.asarray(mesh.vertex_data["t"], np.float64),
-                                 lines) / (mesh.diagonal() or 1.0)
+    spanning = np.ptp(g[corners], axis=1) > 1
+    off = np.zeros(len(corners))
+    diagonal = mesh.diagonal() or 1.0
+    if spanning.any():
+        off[spanning] = off_spanned_generators(
+            mesh.vertices, corners[spanning], g, np.asarray(mesh.vertex_data["t"], np.float64), lines,
+            faces=_fanned(mesh), within=SPAN_MAX_GAP * diagonal) / diagonal
     far = off > SPAN_MAX_GAP
     if not far.any():
         return []
@@ -1048,6 +1053,15 @@ def _warn_off_generators(mesh: Mesh, warnings: list[str], lines: tuple[np.ndarra
                     f"is {SPAN_MAX_GAP:g}): the smooth surface is not within the gap goal of the mesh there; "
                     "more generators (rulings.count) or fewer rows")
     return off[far].tolist()
+
+
+def _fanned(mesh: Mesh) -> np.ndarray:
+    """(F3, 3) int64: every face of ``mesh`` fanned into triangles from its first corner."""
+    fans = mesh.valences - 2
+    first = np.repeat(mesh.face_offsets[:-1], fans)
+    i = ranks(fans) + 1
+    idx = mesh.face_indices
+    return np.stack([idx[first], idx[first + i], idx[first + i + 1]], axis=1)
 
 
 def _at_meetings(angles: np.ndarray, g0: np.ndarray, lines: tuple | None) -> np.ndarray:
