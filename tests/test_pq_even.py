@@ -127,6 +127,17 @@ def test_a_design_whose_rows_leave_splinters_is_meshed_without_them(tolerance):
         assert face_planarity(mesh).max() <= tolerance
 
 
+def test_the_rows_through_the_end_points_start_from_the_graded_rows_kept():
+    """The 172-degree arcs at 25 x 12 in exact mode, the division left free: the graded
+    (bounded) rows are kept over the even ones, and the rows through the curves' end points
+    are tried with them too, not only with the even division: 36.5 % of the area in quads
+    instead of 13.5 %, none below 3 degrees."""
+    mesh = build_design(parse_design(_design(172, None, count=25, rows=12))).mesh
+    assert mesh.info["division"] in ("graded", "bounded") and mesh.info["rows_from"] != "primary"
+    assert area_shares(mesh)["quads"] >= 0.3
+    assert face_min_angles(mesh).min() >= 3.0 and face_planarity(mesh).max() <= 1e-12
+
+
 def _plucker_lines(count: int, lo_deg: float, hi_deg: float, height: float = 1.3, half: float = 2.0):
     """Lines of the Plücker conoid z = height sin(2 theta), |r| <= half, theta from lo to hi."""
     th = np.radians(np.linspace(lo_deg, hi_deg, count))

@@ -135,8 +135,6 @@ def _to_the_mesh(stretch: np.ndarray, corner: np.ndarray, normal: np.ndarray, T:
     against every face that can be nearer (a large face may be near a point its centre is
     far from).
     """
-    from scipy.spatial import cKDTree
-
     bound = np.abs(np.einsum("pkj,pj->pk", stretch - corner[:, None, :], normal)).max(axis=1)
     out = np.minimum(bound, within)
     far = np.flatnonzero(bound > within)
@@ -146,26 +144,34 @@ def _to_the_mesh(stretch: np.ndarray, corner: np.ndarray, normal: np.ndarray, T:
     dist = np.abs(np.einsum("ij,ij->i", X - np.repeat(corner[far], _ALONG.size, axis=0),
                             np.repeat(normal[far], _ALONG.size, axis=0)))
     centre = T.mean(axis=1)
-    k = min(_NEAREST, len(T))
+    radius = norm(T - centre[:, None, :]).max(axis=1)
     hot = np.flatnonzero(dist > within)
-    near = cKDTree(centre).query(X[hot], k=k)[1].reshape(hot.size, k)
-    dist[hot] = np.minimum(dist[hot], _to_triangles(np.repeat(X[hot], k, axis=0),
-                                                    T[near.ravel()]).reshape(-1, k).min(axis=1))
-    hot = hot[dist[hot] > within]
-    if hot.size:
-        _nearer(dist, hot, X, T, centre)
+    if hot.size * len(T) <= _CHUNK:
+        # Few pairs (a small mesh): every face, without a search tree (nor scipy's import).
+        _against(dist, hot, X, T, centre, radius, np.arange(len(T)))
+    else:
+        from scipy.spatial import cKDTree
+
+        k = min(_NEAREST, len(T))
+        near = cKDTree(centre).query(X[hot], k=k)[1].reshape(hot.size, k)
+        dist[hot] = np.minimum(dist[hot], _to_triangles(np.repeat(X[hot], k, axis=0),
+                                                        T[near.ravel()]).reshape(-1, k).min(axis=1))
+        hot = hot[dist[hot] > within]
+        if hot.size:
+            _nearer(dist, hot, X, T, centre, radius)
     out[far] = dist.reshape(-1, _ALONG.size).max(axis=1)
     return out
 
 
-def _nearer(dist: np.ndarray, hot: np.ndarray, X: np.ndarray, T: np.ndarray, centre: np.ndarray) -> None:
+def _nearer(dist: np.ndarray, hot: np.ndarray, X: np.ndarray, T: np.ndarray, centre: np.ndarray,
+            radius: np.ndarray) -> None:
     """Lower ``dist`` (n,) of the points ``X[hot]`` to their distance to every face ``T``
     (F, 3, 3) that can be nearer: the faces of ordinary size whose centres (``centre``) lie
-    within reach, and every large one (fill triangles across many strips; were they in the
-    search radius, it would take in the whole mesh)."""
+    within reach (``radius``: centre to farthest corner), and every large one (fill
+    triangles across many strips; were they in the search radius, it would take in the
+    whole mesh)."""
     from scipy.spatial import cKDTree
 
-    radius = norm(T - centre[:, None, :]).max(axis=1)
     large = radius > _LARGE * median(radius)
     small = np.flatnonzero(~large)
     if small.size:
@@ -175,18 +181,24 @@ def _nearer(dist: np.ndarray, hot: np.ndarray, X: np.ndarray, T: np.ndarray, cen
             point = np.repeat(hot, count)
             face = small[np.concatenate([np.asarray(f, np.int64) for f in found])]
             np.minimum.at(dist, point, _to_triangles(X[point], T[face]))
-    big = np.flatnonzero(large)
-    step = max(1, _CHUNK // max(big.size, 1))
-    for k in range(0, big.size and hot.size, step):
-        point = np.repeat(hot[k:k + step], big.size)
-        face = np.tile(big, point.size // big.size)
-        # Only the faces whose bounding spheres come nearer than the distance so far.
+    _against(dist, hot, X, T, centre, radius, np.flatnonzero(large))
+
+
+def _against(dist: np.ndarray, hot: np.ndarray, X: np.ndarray, T: np.ndarray, centre: np.ndarray,
+             radius: np.ndarray, faces: np.ndarray) -> None:
+    """Lower ``dist`` of the points ``X[hot]`` to their distance to the faces ``T[faces]``
+    whose bounding spheres (``centre``, ``radius``) come nearer, a chunk of pairs at a time."""
+    step = max(1, _CHUNK // max(faces.size, 1))
+    for k in range(0, faces.size and hot.size, step):
+        point = np.repeat(hot[k:k + step], faces.size)
+        face = np.tile(faces, point.size // faces.size)
         near = norm(X[point] - centre[face]) - radius[face] < dist[point]
         np.minimum.at(dist, point[near], _to_triangles(X[point[near]], T[face[near]]))
 
 
 # Faces more than this many times the median size (centre to farthest corner) are measured
-# against every point, not found by their centres; pairs of point and face at a time.
+# against every point, not found by their centres; pairs of point and face at a time (and
+# below this many pairs in all, every face against every point).
 _LARGE = 4.0
 _CHUNK = 1 << 18
 # Where along a spanned generator's stretch its distance is taken, given the faces ...
