@@ -119,19 +119,19 @@ def off_spanned_generators(V: np.ndarray, tri: np.ndarray, generator: np.ndarray
         return out
     pair = np.flatnonzero(inside)
     stretch = a[pair, None, :] + np.stack([low[pair], high[pair]], axis=1)[..., None] * d[pair, None, :]
-    np.maximum.at(out, row[pair], _to_the_mesh(stretch, P[pair, 0], n[pair], V[faces], within))
+    np.maximum.at(out, row[pair], _to_the_mesh(stretch, P[pair, 0], n[pair], V, faces, within))
     return out
 
 
-def _to_the_mesh(stretch: np.ndarray, corner: np.ndarray, normal: np.ndarray, T: np.ndarray,
-                 within: float) -> np.ndarray:
+def _to_the_mesh(stretch: np.ndarray, corner: np.ndarray, normal: np.ndarray, V: np.ndarray,
+                 faces: np.ndarray, within: float) -> np.ndarray:
     """(p,) how far the stretches of generators under triangles lie off the mesh.
 
     Off the triangle's own plane (through ``corner`` (p, 3), unit ``normal`` (p, 3)) is a
     bound from above of the distance to the mesh, largest at an end of the stretch
     (``stretch`` (p, 2, 3), its ends; the distance is affine along the line): the stretches
     within ``within`` of it are done.  The others are taken at five points, each measured
-    against the faces ``T`` (F, 3, 3) nearest by their centres, then, where still farther,
+    against the faces (``V[faces]``, (F, 3, 3)) nearest by their centres, then, where still farther,
     against every face that can be nearer (a large face may be near a point its centre is
     far from).
     """
@@ -143,6 +143,7 @@ def _to_the_mesh(stretch: np.ndarray, corner: np.ndarray, normal: np.ndarray, T:
     X = (stretch[far, :1] + _ALONG[:, None] * (stretch[far, 1:] - stretch[far, :1])).reshape(-1, 3)
     dist = np.abs(np.einsum("ij,ij->i", X - np.repeat(corner[far], _ALONG.size, axis=0),
                             np.repeat(normal[far], _ALONG.size, axis=0)))
+    T = V[faces]                    # only here: most meshes have no stretch this far off
     centre = T.mean(axis=1)
     radius = norm(T - centre[:, None, :]).max(axis=1)
     hot = np.flatnonzero(dist > within)
