@@ -17,7 +17,7 @@ import pytest
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
-from ruledmesh.analysis.faces import face_min_angles
+from ruledmesh.analysis.faces import face_min_angles, triangle_distances
 from ruledmesh.design import build_file
 from ruledmesh.pq import pq_mesh
 from ruledmesh.skew.pq import collapses, mesher
@@ -54,7 +54,7 @@ def _point_keys(P):
 
 
 def _triangle_distance(p, P):
-    return collapses._triangle_distance(np.repeat(p[None], len(P), 0), P).min()
+    return triangle_distances(np.repeat(p[None], len(P), 0), P).min()
 
 
 def _defects(mesh) -> tuple[int, int]:

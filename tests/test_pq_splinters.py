@@ -101,7 +101,7 @@ def _trimmed_soundly(before, after, n):
     """Only needle fans at the border went: quads as they were, the border a manifold,
     and the patch within BORDER_TRIM_MAX_GAP of what is left."""
     from ruledmesh._arrays import diagonal
-    from ruledmesh.skew.pq.collapses import _segment_distance
+    from ruledmesh.analysis.faces import segment_distances as _segment_distance
     from ruledmesh.tolerances import BORDER_TRIM_MAX_GAP
 
     assert after.n_vertices == before.n_vertices - n

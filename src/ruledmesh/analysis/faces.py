@@ -35,6 +35,8 @@ __all__ = [
     "face_min_angles",
     "min_corner_angles",
     "area_shares",
+    "segment_distances",
+    "triangle_distances",
 ]
 
 
@@ -222,6 +224,34 @@ def face_centroids(mesh: Mesh) -> np.ndarray:
     """(F, 3) float64: mean of each face's vertices."""
     sums = np.add.reduceat(mesh.vertices[mesh.face_indices], mesh.face_offsets[:-1], axis=0)
     return sums / mesh.valences[:, None]
+
+
+def segment_distances(p: np.ndarray, a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    """(k,) distance of points ``p`` from segments ``a b`` (all (k, 3)), each from its own."""
+    ab = b - a
+    s = np.clip(np.einsum("ij,ij->i", p - a, ab) / np.maximum(np.einsum("ij,ij->i", ab, ab), _TINY), 0, 1)
+    return norm(p - a - s[:, None] * ab)
+
+
+def triangle_distances(p: np.ndarray, P: np.ndarray) -> np.ndarray:
+    """(k,) distance of points ``p`` (k, 3) from triangles ``P`` (k, 3, 3), each from its own."""
+    A, B, C = P[:, 0], P[:, 1], P[:, 2]
+    n = cross(B - A, C - A)
+    n = n / np.maximum(norm(n), _TINY)[:, None]          # zero for degenerate triangles
+    h = np.einsum("ij,ij->i", p - A, n)
+    q = p - h[:, None] * n
+    # Inside when q is on the inner side of all three edges.
+    inside = np.ones(len(p), bool)
+    for x, y in ((A, B), (B, C), (C, A)):
+        inside &= np.einsum("ij,ij->i", cross(y - x, q - x), n) >= 0
+    out = np.abs(h)
+    # Outside: the nearest edge (only there, where most points are inside).
+    o = np.flatnonzero(~inside)
+    if o.size:
+        p, A, B, C = p[o], A[o], B[o], C[o]
+        out[o] = np.minimum(np.minimum(segment_distances(p, A, B), segment_distances(p, B, C)),
+                            segment_distances(p, C, A))
+    return out
 
 
 def polygon_angles(corners: np.ndarray) -> np.ndarray:

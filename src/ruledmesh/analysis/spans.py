@@ -15,6 +15,7 @@ import numpy as np
 
 from .._arrays import cross, median, norm, ranks
 from ..tolerances import COLLINEAR, TINY
+from .faces import triangle_distances
 
 __all__ = ["off_spanned_generators"]
 
@@ -155,7 +156,7 @@ def _to_the_mesh(stretch: np.ndarray, corner: np.ndarray, normal: np.ndarray, V:
 
         k = min(_NEAREST, len(T))
         near = cKDTree(centre).query(X[hot], k=k)[1].reshape(hot.size, k)
-        dist[hot] = np.minimum(dist[hot], _to_triangles(np.repeat(X[hot], k, axis=0),
+        dist[hot] = np.minimum(dist[hot], triangle_distances(np.repeat(X[hot], k, axis=0),
                                                         T[near.ravel()]).reshape(-1, k).min(axis=1))
         hot = hot[dist[hot] > within]
         if hot.size:
@@ -181,7 +182,7 @@ def _nearer(dist: np.ndarray, hot: np.ndarray, X: np.ndarray, T: np.ndarray, cen
         if count.sum():
             point = np.repeat(hot, count)
             face = small[np.concatenate([np.asarray(f, np.int64) for f in found])]
-            np.minimum.at(dist, point, _to_triangles(X[point], T[face]))
+            np.minimum.at(dist, point, triangle_distances(X[point], T[face]))
     _against(dist, hot, X, T, centre, radius, np.flatnonzero(large))
 
 
@@ -194,7 +195,7 @@ def _against(dist: np.ndarray, hot: np.ndarray, X: np.ndarray, T: np.ndarray, ce
         point = np.repeat(hot[k:k + step], faces.size)
         face = np.tile(faces, point.size // faces.size)
         near = norm(X[point] - centre[face]) - radius[face] < dist[point]
-        np.minimum.at(dist, point[near], _to_triangles(X[point[near]], T[face[near]]))
+        np.minimum.at(dist, point[near], triangle_distances(X[point[near]], T[face[near]]))
 
 
 # Faces more than this many times the median size (centre to farthest corner) are measured
@@ -206,25 +207,3 @@ _CHUNK = 1 << 18
 _ALONG = np.linspace(0.0, 1.0, 5)
 # ... and against how many faces, those whose centres are nearest.
 _NEAREST = 16
-
-
-def _to_triangles(X: np.ndarray, T: np.ndarray) -> np.ndarray:
-    """(q,) distances of points ``X`` (q, 3) to the triangles ``T`` (q, 3, 3), each to its own."""
-    A, B, C = T[:, 0], T[:, 1], T[:, 2]
-    n = cross(B - A, C - A)
-    area2 = norm(n)
-    n = n / np.maximum(area2, TINY)[:, None]
-    # Inside the triangle's footprint (on the inner side of all three edges): off its plane.
-    inside = area2 > TINY
-    for p, q in ((A, B), (B, C), (C, A)):
-        inside &= np.einsum("ij,ij->i", cross(q - p, X - p), n) >= 0
-    plane = np.abs(np.einsum("ij,ij->i", X - A, n))
-    edge = np.minimum(np.minimum(_to_segments(X, A, B), _to_segments(X, B, C)), _to_segments(X, C, A))
-    return np.where(inside, plane, edge)
-
-
-def _to_segments(X: np.ndarray, P: np.ndarray, Q: np.ndarray) -> np.ndarray:
-    """(q,) distances of points ``X`` (q, 3) to the segments ``P Q`` (q, 3), each to its own."""
-    e = Q - P
-    f = np.clip(np.einsum("ij,ij->i", X - P, e) / np.maximum(np.einsum("ij,ij->i", e, e), TINY), 0.0, 1.0)
-    return norm(X - P - f[:, None] * e)

@@ -28,7 +28,7 @@ from dataclasses import replace
 import numpy as np
 
 from ..._arrays import cross, diagonal, lookup, member, norm, unique
-from ...analysis.faces import min_corner_angles
+from ...analysis.faces import min_corner_angles, triangle_distances
 from ...kernels import wanted
 from ...mesh import FaceKind, Mesh
 from ...tolerances import COLLAPSE_MAX_SAG, FLIP_MAX_BEND_DEG, FLIP_MIN_GAIN_DEG, RESTART_ANGLE_DEG, TINY
@@ -48,33 +48,6 @@ def _angles(P: np.ndarray) -> np.ndarray:
 def _normals(P: np.ndarray) -> np.ndarray:
     """(T, 3) unit normals of triangles ``P`` (T, 3, 3) (zero for degenerate ones)."""
     return _unit_normals(P[:, 0], P[:, 1], P[:, 2])
-
-
-def _segment_distance(p: np.ndarray, a: np.ndarray, b: np.ndarray) -> np.ndarray:
-    """(k,) distance of points ``p`` from segments ``a b`` (all (k, 3))."""
-    ab = b - a
-    s = np.clip(np.einsum("ij,ij->i", p - a, ab) / np.maximum(np.einsum("ij,ij->i", ab, ab), TINY), 0, 1)
-    return norm(p - a - s[:, None] * ab)
-
-
-def _triangle_distance(p: np.ndarray, P: np.ndarray) -> np.ndarray:
-    """(k,) distance of points ``p`` (k, 3) from triangles ``P`` (k, 3, 3)."""
-    A, B, C = P[:, 0], P[:, 1], P[:, 2]
-    n = _normals(P)
-    h = np.einsum("ij,ij->i", p - A, n)
-    q = p - h[:, None] * n
-    # Inside when q is on the inner side of all three edges.
-    inside = np.ones(len(p), bool)
-    for x, y in ((A, B), (B, C), (C, A)):
-        inside &= np.einsum("ij,ij->i", cross(y - x, q - x), n) >= 0
-    out = np.abs(h)
-    # Outside: the nearest edge (only there, where most points are inside).
-    o = np.flatnonzero(~inside)
-    if o.size:
-        p, A, B, C = p[o], A[o], B[o], C[o]
-        out[o] = np.minimum(np.minimum(_segment_distance(p, A, B), _segment_distance(p, B, C)),
-                            _segment_distance(p, C, A))
-    return out
 
 
 def _expand(counts: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -216,7 +189,7 @@ def _evaluate(V, tri, stars: _Stars, keys, faces_at, v, u, scale) -> tuple[np.nd
     # it, measured last, for the collapses every other test allows.
     at = keep & ok[rep]
     sag = np.full(C, np.inf)
-    np.minimum.at(sag, rep[at], _triangle_distance(V[v[rep[at]]], V[new[at]]))
+    np.minimum.at(sag, rep[at], triangle_distances(V[v[rep[at]]], V[new[at]]))
     return gain, ok & (sag <= COLLAPSE_MAX_SAG * scale)
 
 
@@ -257,11 +230,11 @@ def _keeps_ghosts(V, tri, stars: _Stars, v, u, ghosts, anchors, scale) -> np.nda
     c_rep, _, new, gone = _collapsed_star(tri, stars, v[cand], u[cand])
     live = ~gone
     near = np.full(cand.size, np.inf)
-    np.minimum.at(near, c_rep[live], _triangle_distance(ghosts[g[c_rep[live]]], V[new[live]]))
+    np.minimum.at(near, c_rep[live], triangle_distances(ghosts[g[c_rep[live]]], V[new[live]]))
     # ... or to the triangles at the anchor that do not have v for a corner.
     a_rep, a_face, _ = stars.triangles(anchors[g])
     kept = ~(tri[a_face] == v[cand][a_rep][:, None]).any(axis=1)
-    np.minimum.at(near, a_rep[kept], _triangle_distance(ghosts[g[a_rep[kept]]], V[tri[a_face[kept]]]))
+    np.minimum.at(near, a_rep[kept], triangle_distances(ghosts[g[a_rep[kept]]], V[tri[a_face[kept]]]))
     return np.bincount(cand[near > bound], minlength=C) == 0
 
 

@@ -27,7 +27,7 @@ from dataclasses import replace
 import numpy as np
 
 from ..._arrays import diagonal, ranks, unique
-from ...analysis.faces import face_min_angles, face_normals
+from ...analysis.faces import face_min_angles, face_normals, segment_distances
 from ...mesh import FaceKind, Mesh, offsets_from_valences
 from ...tolerances import (
     BORDER_TRIM_MAX_GAP,
@@ -36,7 +36,7 @@ from ...tolerances import (
     SNAP_MIN_GAIN_DEG,
     SPLINTER_AREA_WORTH,
 )
-from .collapses import _apply, _border_vertices, _near, _rejoined, _rings, _segment_distance, _touching
+from .collapses import _apply, _border_vertices, _near, _rejoined, _rings, _touching
 from .pairing import _rebuilt
 
 __all__ = ["open_walled_splinters", "snap_to_border", "trim_border_needles"]
@@ -181,7 +181,7 @@ def trim_border_needles(mesh: Mesh, scale: float | None = None, *,
     corner = np.argmax(at[rows], axis=1)
     p, q = T[rows, (corner + 1) % 3], T[rows, (corner + 2) % 3]
     V = mesh.vertices
-    dist = _segment_distance(V[owner], V[p], V[q])
+    dist = segment_distances(V[owner], V[p], V[q])
     far = np.zeros(n)
     np.maximum.at(far, owner, dist)
     fan_size = np.bincount(owner, minlength=n)
