@@ -138,6 +138,19 @@ def test_page_loads_and_draws(page, designer):
     assert '"faces"' in page.inner_text("#report")
 
 
+def undo(page, designer) -> None:
+    """Click Undo and wait until the server took the step back and the page shows it.
+
+    The page's version alone can also move on for the full mesh of the edit before
+    (shown after its quick mesh when builds are slow), so the server's history is watched.
+    """
+    steps = len(designer.session.history()["undo"])
+    v = page.evaluate("window.designer.version")
+    page.click("#undo")
+    assert server_reaches(lambda: len(designer.session.history()["undo"]) == steps - 1)
+    wait_version(page, v)
+
+
 def server_reaches(predicate, timeout=10.0) -> bool:
     """Poll the server-side state until ``predicate`` holds (edits are applied asynchronously)."""
     import time
@@ -778,9 +791,7 @@ def test_insert_delete_points_and_type_coordinates_each_one_undo_step(page, desi
                             "curves.c1.points: 4 points", "curves.c1.degree = 2"]
     # four edits, four undo steps, back to the start
     for _ in range(4):
-        v = page.evaluate("window.designer.version")
-        page.click("#undo")
-        wait_version(page, v)
+        undo(page, designer)
     assert designer.session.design["curves"]["c1"]["points"] == pts
     assert designer.session.design["curves"]["c1"]["degree"] == 3
     # the history shows the undone steps still to redo
@@ -815,9 +826,7 @@ def test_multi_select_moves_together_and_snaps_to_the_grid(page, designer):
     np.testing.assert_allclose(np.round(np.array(after[2]) / step) * step, after[2], atol=1e-6)
     shot(page, "multi-select-top")
     # one drag, one undo step
-    v = page.evaluate("window.designer.version")
-    page.click("#undo")
-    wait_version(page, v)
+    undo(page, designer)
     assert designer.session.design["curves"]["c2"]["points"] == before
 
 
