@@ -57,10 +57,6 @@ SHORT_OF_SHARE = {
                              "quads between lines 2.5 degrees apart are not planar within 1e-3",
     "skew-bspline-301x300": "14.6% of the area in triangles; 13% of the patch is slender "
                             "(every exact face there a 10:1 panel or worse)",
-    "twisted-bspline-arc-150deg": "25.4% of the area in triangles; the bounded division's rows "
-                                  "through both curves' end points reach 17.2%, but fill triangles "
-                                  "across up to 15 strips at the waist lie 2.4e-3 of the diagonal "
-                                  "off the surface (docs/mesh-quality.md)",
 }
 SHORT_OF_GAP: dict[str, str] = {}
 

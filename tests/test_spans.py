@@ -130,8 +130,9 @@ def test_a_design_build_counts_triangles_off_the_surface_against_a_mesh():
     design build's choice between meshes weighs those triangles as it weighs splinters: a
     mesh with any fails the goal of no face to refuse, and each costs area share.  Of these
     two meshes of the same surface (not refined) the one through both curves' end points has
-    19 triangles up to 6.7e-3 off (the quality checker: 6.9e-3) and 5 splinters; the one from
-    the primary has neither."""
+    22 triangles up to 6.7e-3 off (the quality checker: 6.9e-3; those the halving of
+    ruledmesh.skew.pq.halving leaves, whose halves would fold or be splinters) and 5
+    splinters; the one from the primary has neither."""
     from ruledmesh.design.pq import _fabricable, _goals_met, _round, _splinters
 
     text = (QUALITY / "twisted-bspline-arc-150deg.toml").read_text()
@@ -142,12 +143,12 @@ def test_a_design_build_counts_triangles_off_the_surface_against_a_mesh():
         rounds.append(_round(built.rulings, built.mesh))
     both, primary = rounds
     off = np.asarray(both[4].info["off_generators"])
-    assert off.size == 19 and off.min() > SPAN_MAX_GAP and off.max() == pytest.approx(6.7e-3, rel=0.01)
+    assert off.size == 22 and off.min() > SPAN_MAX_GAP and off.max() == pytest.approx(6.7e-3, rel=0.01)
     assert primary[4].info["off_generators"] == []
     assert _goals_met(primary, 0.25) == (True, False) and _goals_met(both, 0.25) == (False, False)
     # each far triangle costs what a splinter costs, more the farther it lies (ten times at
-    # twice the goal and beyond): here 19 of them at 2.0e-3 to 6.7e-3
+    # twice the goal and beyond): here 22 of them at 2.0e-3 to 6.7e-3
     splinters_only = _splinters(both[4].with_info(off_generators=[]))
     assert both[1] == splinters_only[0] == 5
-    assert 19 * 0.01 < both[2] - splinters_only[1] <= 19 * 0.1
+    assert 22 * 0.01 < both[2] - splinters_only[1] <= 22 * 0.1
     assert _fabricable(primary, 0.25) > _fabricable(both, 0.25)

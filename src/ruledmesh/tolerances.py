@@ -31,7 +31,8 @@ __all__ = ["BORDER_TRIM_MAX_GAP", "BRENTQ_XTOL", "CLOSENESS_SEARCH", "COLLAPSE_M
            "MIN_HALF_ANGLE", "MIN_RELATIVE_EXTENT", "MITRE_FLOOR", "NEARLY_DEVELOPABLE",
            "OCCT_FACE", "ON_BORDER", "PARAMETER_SLACK", "PLANARITY_FLOOR", "RESTART_ANGLE_DEG",
            "ROOT_RTOL", "ROOT_XTOL", "ROUNDING", "ROUNDING_SQ", "SAME_ROOT", "SETTLED", "SNAP_GAP",
-           "SLOPE_STEP", "SNAP_MIN_GAIN_DEG", "SPAN_MAX_GAP", "SPLINTER_AREA_WORTH", "SPLINTER_FLIP_MAX_SAG",
+           "SLOPE_STEP", "SNAP_MIN_GAIN_DEG", "SPAN_HALVED_ABOVE", "SPAN_MAX_GAP", "SPLINTER_AREA_WORTH",
+           "SPLINTER_FLIP_MAX_SAG",
            "TINY", "ULPS", "Tolerances"]
 
 
@@ -216,6 +217,10 @@ COLLAPSE_MAX_SAG = 2.5e-4
 #: A build warns where a triangle lies farther than this share of the patch diagonal off a
 #: generator it spans without a corner on it (ruledmesh.analysis.spans): the gap goal.
 SPAN_MAX_GAP = 2e-3
+#: Triangles farther off the generators they span than this share of the gap goal are
+#: halved (ruledmesh.skew.pq.halving): the measure takes five points along each stretch,
+#: and the quality checker's dense sampling found up to 3 % more between them.
+SPAN_HALVED_ABOVE = 0.8
 #: An end point whose faces are all needles may be dropped with them
 #: (ruledmesh.skew.pq.splinters.trim_border_needles) when it lies at most this share of
 #: the patch diagonal from their far edges: the patch stays within half the gap goal (2e-3).

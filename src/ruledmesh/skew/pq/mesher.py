@@ -8,7 +8,7 @@ from enum import Enum
 
 import numpy as np
 
-from ..._arrays import member, ranks, unique
+from ..._arrays import member, unique
 from ..._validation import check_bool, check_choice, check_float, check_int, check_points, describe
 from ...analysis.asymptotic import SLENDER_DEG, SLENDER_ELONGATION, crossing_angles, slender_share
 from ...analysis.faces import SPLINTER_DEG
@@ -16,11 +16,20 @@ from ...errors import GeometryError, ParameterError
 from ...hop import coplanarity, sense_changes
 from ...mesh import Mesh
 from ...normalise import normalised
-from ...tolerances import DEFAULT, NEARLY_DEVELOPABLE, PARAMETER_SLACK, SPAN_MAX_GAP, TINY, Tolerances
+from ...tolerances import (
+    DEFAULT,
+    NEARLY_DEVELOPABLE,
+    PARAMETER_SLACK,
+    SPAN_HALVED_ABOVE,
+    SPAN_MAX_GAP,
+    TINY,
+    Tolerances,
+)
 from .assemble import assemble
 from .collapses import _border_vertices, _touching, collapse_splinters
 from .corners import rezip_corners
 from .flips import flip_splinters, flip_triangles
+from .halving import halve_spanning_triangles
 from .maps import HopMaps, hop_maps
 from .pairing import pair_triangles
 from .panels import split_strip_quads
@@ -473,10 +482,10 @@ def pq_mesh(a, b, rows: int = 20, primary: int | str = "middle", option: int = 0
     even = _even_ranges(parts, segs, warnings, exact=ptol <= tol.planarity, own=plan.own)
     known = _Causes.of(parts, segs, torsal.size, even)    # before assemble() empties parts
     meet, runs = np.r_[flat, False] | np.r_[False, flat], len(parts)    # meet: of a coplanar pair
-    mesh, fattening, measured = _fattened(assemble(parts, a, d, args.trim, tol, ptol, warnings, scale, meet,
-                                                   rows=rows), ptol, tol)
+    mesh, fattening, measured, spans = _fattened(assemble(parts, a, d, args.trim, tol, ptol, warnings, scale,
+                                                          meet, rows=rows), ptol, tol, (a, d))
     _warn_share(mesh, warnings, known, m, rows, (a, d, ptol), measured)
-    passes = {**fattening, "off_generators": _warn_faces(mesh, warnings, torsal, measured, (a, d))}
+    passes = {**fattening, "off_generators": _warn_faces(mesh, warnings, torsal, measured, (a, d), spans)}
     if kept.size < m_given:
         mesh = _renumbered(mesh, kept)
     return mesh.with_info(runs=runs, restarts=known.restarts, **_options_info(plan, args, kept), **passes)
@@ -512,15 +521,19 @@ def _cut(a, d, rows, ptol, scale, tol, creases, crease_generators, warnings):
     return flat, torsal, cg, segs
 
 
-def _fattened(mesh: Mesh, ptol: float, tol: Tolerances) -> tuple[Mesh, dict[str, int], tuple | None]:
+def _fattened(mesh: Mesh, ptol: float, tol: Tolerances, lines: tuple[np.ndarray, np.ndarray]
+              ) -> tuple[Mesh, dict[str, int], tuple | None, tuple[np.ndarray, np.ndarray]]:
     """Flip the triangles for their angles, collapse what flips cannot fatten, pair the
     triangles in tolerance mode, flip what is left; then the splinters left: corners a
     sliver from the border snapped onto it, quads walling a splinter opened, patch corners
-    with a splinter re-cut (:mod:`.corners`); last, strip quads much larger than the other
-    panels cut.
+    with a splinter re-cut (:mod:`.corners`); strip quads much larger than the other
+    panels cut; last, triangles lying off the generators they span halved
+    (:mod:`.halving`; ``lines``: the generators ``(a, d)``).
 
     The third result: the (F,) smallest angles and areas of the faces of the mesh
     returned, where the opening measured them and left the mesh as it was (else None).
+    The fourth: the triangles across strips and how far each lies off the generators
+    it spans (:func:`.halving.halve_spanning_triangles`).
     The caller does not keep ``mesh``, so each pass frees the mesh it replaces (a
     1000 x 1000 build's is 50 MB).
 
@@ -564,10 +577,12 @@ def _fattened(mesh: Mesh, ptol: float, tol: Tolerances) -> tuple[Mesh, dict[str,
     flips += more
     mesh, corners, kept_corners = _pass(rezip_corners, mesh)
     mesh, cut, kept_too = _pass(split_strip_quads, mesh)
-    same = same and kept and kept_corners and kept_too
+    mesh, halved, *spans = halve_spanning_triangles(mesh, lines, SPAN_HALVED_ABOVE * SPAN_MAX_GAP
+                                                    * (mesh.diagonal() or 1.0))
+    same = same and kept and kept_corners and kept_too and not halved
     return mesh, {"flips": flips, "collapsed": collapsed, "paired": paired, "snapped": snapped,
-                  "trimmed": trimmed, "opened": opened, "corners": corners, "cut": cut}, \
-        (measured if same else None)
+                  "trimmed": trimmed, "opened": opened, "corners": corners, "cut": cut, "halved": halved}, \
+        (measured if same else None), (spans[0], spans[1])
 
 
 # The persistent vertex id of :class:`_Changes`, dropped before the mesh leaves :func:`_fattened`.
@@ -1015,53 +1030,34 @@ _MEETING_GAP = 0.01
 
 
 def _warn_faces(mesh: Mesh, warnings: list[str], torsal: np.ndarray, measured: tuple | None,
-                lines: tuple[np.ndarray, np.ndarray]) -> list[float]:
+                lines: tuple[np.ndarray, np.ndarray], spans: tuple[np.ndarray, np.ndarray]) -> list[float]:
     """What a build says of its faces: splinters (:func:`_warn_splinters`) and triangles off
     the generators they span (:func:`_warn_off_generators`, whose result it returns)."""
     _warn_splinters(mesh, warnings, torsal, measured, lines)
-    return _warn_off_generators(mesh, warnings, lines)
+    return _warn_off_generators(mesh, warnings, *spans)
 
 
-def _warn_off_generators(mesh: Mesh, warnings: list[str], lines: tuple[np.ndarray, np.ndarray]) -> list[float]:
+def _warn_off_generators(mesh: Mesh, warnings: list[str], tri: np.ndarray, off: np.ndarray) -> list[float]:
     """Say how many triangles lie farther than :data:`~ruledmesh.tolerances.SPAN_MAX_GAP` of
-    the diagonal off the generators they span (:mod:`ruledmesh.analysis.spans`), how far at
-    most and between which generators; ``lines``: the generators ``(a, d)``.
+    the diagonal off the generators they span, how far at most and between which
+    generators; ``tri``, ``off``: the triangles across strips and how far each lies off
+    (:func:`.halving.halve_spanning_triangles`, which halved those it could).
 
     Returns how far each of those triangles lies, relative to the diagonal (the mesh's
     ``info["off_generators"]``: a design build weighs them as it weighs splinters).
     """
-    from ...analysis.spans import off_spanned_generators
-
-    _, corners = mesh.faces_of_valence(3)
-    if corners.size == 0:
-        return []
-    g = np.asarray(mesh.vertex_data["generator"], np.int64)
-    spanning = np.ptp(g[corners], axis=1) > 1
-    off = np.zeros(len(corners))
-    diagonal = mesh.diagonal() or 1.0
-    if spanning.any():
-        off[spanning] = off_spanned_generators(
-            mesh.vertices, corners[spanning], g, np.asarray(mesh.vertex_data["t"], np.float64), lines,
-            faces=_fanned(mesh), within=SPAN_MAX_GAP * diagonal) / diagonal
+    off = off / (mesh.diagonal() or 1.0)
     far = off > SPAN_MAX_GAP
     if not far.any():
         return []
-    span = g[corners[far]]
+    g = np.asarray(mesh.vertex_data["generator"], np.int64)
+    span = g[tri[far]]
     warnings.append(f"{int(far.sum())} triangles lie up to {off.max():.1e} of the diagonal off the "
                     f"generators they span (between generators {int(span.min())} and {int(span.max())}, "
                     f"across up to {int((span.max(axis=1) - span.min(axis=1)).max())} strips; the gap goal "
                     f"is {SPAN_MAX_GAP:g}): the smooth surface is not within the gap goal of the mesh there; "
                     "more generators (rulings.count) or fewer rows")
     return off[far].tolist()
-
-
-def _fanned(mesh: Mesh) -> np.ndarray:
-    """(F3, 3) int64: every face of ``mesh`` fanned into triangles from its first corner."""
-    fans = mesh.valences - 2
-    first = np.repeat(mesh.face_offsets[:-1], fans)
-    i = ranks(fans) + 1
-    idx = mesh.face_indices
-    return np.stack([idx[first], idx[first + i], idx[first + i + 1]], axis=1)
 
 
 def _at_meetings(angles: np.ndarray, g0: np.ndarray, lines: tuple | None) -> np.ndarray:

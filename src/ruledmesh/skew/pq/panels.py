@@ -20,7 +20,7 @@ from ..._arrays import lookup, median, ranks
 from ...mesh import FaceKind, Mesh, offsets_from_valences
 from ...tolerances import RESTART_ANGLE_DEG
 
-__all__ = ["split_strip_quads"]
+__all__ = ["faces_across", "split_strip_quads"]
 
 # A strip quad is cut where its area is above this many times the median quad area, into
 # pieces near that median (at most _MAX_PIECES).
@@ -60,7 +60,7 @@ def split_strip_quads(mesh: Mesh) -> tuple[Mesh, int]:
     pieces = np.clip(np.rint(area[big] / middle), 2, _MAX_PIECES).astype(np.int64)
     corners = _strip_corners(mesh, big)
     # The faces across the two generator edges a0 -> a1 and b1 -> b0.
-    across = [_neighbours(mesh, corners[:, 0], corners[:, 1]), _neighbours(mesh, corners[:, 2], corners[:, 3])]
+    across = [faces_across(mesh, corners[:, 0], corners[:, 1]), faces_across(mesh, corners[:, 2], corners[:, 3])]
     # The fans never lower the mesh's smallest angle (nor go below the splinter bar).
     floor = max(RESTART_ANGLE_DEG, float(face_min_angles(mesh).min()))
     pieces = _fitting(mesh, corners, pieces, across, floor)
@@ -80,7 +80,7 @@ def _strip_corners(mesh: Mesh, faces: np.ndarray) -> np.ndarray:
     return idx
 
 
-def _neighbours(mesh: Mesh, a: np.ndarray, b: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+def faces_across(mesh: Mesh, a: np.ndarray, b: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """For each edge ``a -> b`` of a face: the face using ``b -> a`` (-1: none) and its corner
     opposite the edge if it is a triangle (-1 otherwise)."""
     n = np.int64(mesh.n_vertices)
@@ -102,7 +102,7 @@ def _neighbours(mesh: Mesh, a: np.ndarray, b: np.ndarray) -> tuple[np.ndarray, n
 
 def _fitting(mesh: Mesh, corners: np.ndarray, pieces: np.ndarray, across: list, floor: float) -> np.ndarray:
     """Pieces each quad can be cut into: its neighbours across the generator edges
-    (``across``: :func:`_neighbours` of each) are triangles (or the border) whose fans keep
+    (``across``: :func:`faces_across` of each) are triangles (or the border) whose fans keep
     every angle at or above ``floor`` (degrees)."""
     from ...analysis.faces import min_corner_angles
 
