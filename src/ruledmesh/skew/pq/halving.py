@@ -117,7 +117,8 @@ def _halvable(mesh: Mesh, faces: np.ndarray, tri: np.ndarray) -> tuple[np.ndarra
     face = np.repeat(faces, 3)
     other, far = faces_across(mesh, u, v)
     span = np.abs(g[u] - g[v])
-    score = np.where((span > 1) & ((other < 0) | (far >= 0)), span, 0).reshape(k, 3)
+    ok = (span > 1) & ((other < 0) | (far >= 0)) & (g[u] >= 0) & (g[v] >= 0)
+    score = np.where(ok, span, 0).reshape(k, 3)
     best = np.argmax(score, axis=1)
     pick = (np.arange(k) * 3 + best)[score[np.arange(k), best] > 0]
     if pick.size == 0:
