@@ -90,8 +90,8 @@ def with_worker(steps: range) -> list[float]:
     session, worker = Session(_text(100)), BuildWorker()
     worker.start()
     session.set_builder(worker)
+    session.page_opened()    # the worker loads the kernels (as when a page connects)
     try:
-        time.sleep(3)  # the worker loads its kernels at its first idle second
         session.edit([(["mesh", "rows"], 99)])
         times = []
         for rows in steps:
@@ -108,15 +108,16 @@ def over_http(steps: range) -> tuple[list[float], list[float]]:
     from ruledmesh.web.server import make_server
     from ruledmesh.web.session import Session
 
-    server = make_server(Session(_text(100)), port=0)
+    session = Session(_text(100))
+    server = make_server(session, port=0)
     threading.Thread(target=server.serve_forever, daemon=True).start()
+    session.page_opened()    # the server's worker loads the kernels (as when a page connects)
     conn = http.client.HTTPConnection(*server.server_address[:2], timeout=60)
     headers = {"Content-Type": "application/json", "Authorization": f"Bearer {server.token}",
                "X-Ruledmesh-Answer": "version"}
     walls, timings = [], []
     try:
-        time.sleep(3)
-        for rows in [99, *steps]:
+        for rows in [99, *steps]:       # the first waits for the kernels; not timed
             t = time.perf_counter()
             conn.request("POST", "/api/edit",
                          json.dumps({"changes": [[["mesh", "rows"], rows]]}), headers)

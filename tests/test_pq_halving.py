@@ -33,7 +33,7 @@ def _mesh(a, d, generator, t, faces, kinds, members=None):
 
 
 def _off(mesh, lines):
-    ids, tri = mesh.faces_of_valence(3)
+    _, tri = mesh.faces_of_valence(3)
     return off_spanned_generators(mesh.vertices, tri, np.asarray(mesh.vertex_data["generator"]),
                                   np.asarray(mesh.vertex_data["t"]), lines, faces=fanned(mesh))
 
@@ -68,6 +68,8 @@ def test_two_triangles_across_eight_strips_are_halved_until_near_the_surface():
     assert before.max() > 5 * goal
     out, halved, tri, off = halve_spanning_triangles(mesh, lines, goal)
     assert halved > 2
+    # the triangles still across strips, each with its distance
+    assert len(tri) == len(off) > 0 and (np.ptp(np.asarray(out.vertex_data["generator"])[tri], axis=1) > 1).all()
     assert off.max() <= goal
     assert _off(out, lines).max() <= goal          # measured again, exactly (no bounds)
     g = np.asarray(out.vertex_data["generator"])
