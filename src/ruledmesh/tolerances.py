@@ -218,8 +218,9 @@ COLLAPSE_MAX_SAG = 2.5e-4
 #: generator it spans without a corner on it (ruledmesh.analysis.spans): the gap goal.
 SPAN_MAX_GAP = 2e-3
 #: Triangles farther off the generators they span than this share of the gap goal are
-#: halved (ruledmesh.skew.pq.halving): the measure takes five points along each stretch,
-#: and the quality checker's dense sampling found up to 3 % more between them.
+#: halved (ruledmesh.skew.pq.halving): the measure takes five points along each stretch of
+#: the discrete generators, and the quality checker, sampling the smooth surface between
+#: them too, read up to a fifth more (docs/mesh-quality.md).
 SPAN_HALVED_ABOVE = 0.8
 #: An end point whose faces are all needles may be dropped with them
 #: (ruledmesh.skew.pq.splinters.trim_border_needles) when it lies at most this share of
