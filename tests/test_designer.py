@@ -23,7 +23,7 @@ from ruledmesh import io
 from ruledmesh.design import build_design, parse_design
 from ruledmesh.errors import DesignError, ExportError, ParameterError
 from ruledmesh.web.server import make_server
-from ruledmesh.web.session import Session, fan_triangles, topology_key
+from ruledmesh.web.session import Session, topology_key
 from ruledmesh.web.toml_writer import dumps
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -91,7 +91,7 @@ def test_toml_writer_special_floats_and_refusals():
 def test_display_triangles_cover_every_face():
     s = Session(QUICK)
     mesh = s.built.mesh
-    tris, face = fan_triangles(mesh)
+    tris, face = mesh.fan_triangles()
     # a k-gon gives k - 2 triangles, all from its own corners
     assert np.array_equal(np.bincount(face, minlength=mesh.n_faces), mesh.valences - 2)
     for t, f in zip(tris, face):

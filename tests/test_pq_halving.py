@@ -8,7 +8,7 @@ import pytest
 from ruledmesh.analysis.faces import face_min_angles
 from ruledmesh.analysis.spans import off_spanned_generators
 from ruledmesh.mesh import FaceKind, Mesh, offsets_from_valences
-from ruledmesh.skew.pq.halving import fanned, halve_spanning_triangles
+from ruledmesh.skew.pq.halving import halve_spanning_triangles
 
 
 def _hp(m: int = 9):
@@ -35,7 +35,7 @@ def _mesh(a, d, generator, t, faces, kinds, members=None):
 def _off(mesh, lines):
     _, tri = mesh.faces_of_valence(3)
     return off_spanned_generators(mesh.vertices, tri, np.asarray(mesh.vertex_data["generator"]),
-                                  np.asarray(mesh.vertex_data["t"]), lines, faces=fanned(mesh))
+                                  np.asarray(mesh.vertex_data["t"]), lines, faces=mesh.fan_triangles()[0])
 
 
 def _parameter_areas(mesh) -> np.ndarray:

@@ -19,7 +19,7 @@ from typing import Any
 
 import numpy as np
 
-from ._arrays import diagonal, extent, unique
+from ._arrays import diagonal, extent, ranks, unique
 from ._validation import check_points
 from .errors import ParameterError
 from .tolerances import ROUNDING, TINY
@@ -306,6 +306,25 @@ class Mesh:
             return ids, np.zeros((0, k), dtype=np.int64)
         cols = self.face_offsets[ids][:, None] + np.arange(k)
         return ids, self.face_indices[cols]
+
+    def fan_triangles(self) -> tuple[np.ndarray, np.ndarray]:
+        """Every face as a fan of triangles from its first corner.
+
+        Returns
+        -------
+        triangles : (T, 3) int64
+            Vertex indices.
+        face : (T,) int64
+            The face each triangle belongs to.
+        """
+        off = self.face_offsets
+        idx = self.face_indices
+        ntri = np.maximum(self.valences - 2, 0)
+        face = np.repeat(np.arange(self.n_faces), ntri)
+        # j = 1 .. k-2 within each face.
+        j = ranks(ntri) + 1
+        base = off[:-1][face]
+        return np.stack([idx[base], idx[base + j], idx[base + j + 1]], axis=1), face
 
     def padded_faces(self, fill: int = -1) -> np.ndarray:
         """(F, K) int64: faces padded to the largest valence K with ``fill``."""

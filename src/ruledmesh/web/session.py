@@ -30,7 +30,6 @@ from typing import Any
 
 import numpy as np
 
-from .._arrays import ranks
 from ..design import Design, build_design, parse_design
 from ..errors import DesignError, ExportError, ParameterError, RuledMeshError
 from ..mesh import FaceKind, Mesh
@@ -46,7 +45,6 @@ __all__ = [
     "check_limits",
     "edit_label",
     "encode_message",
-    "fan_triangles",
     "fast_figures",
     "set_path",
     "topology_key",
@@ -250,28 +248,6 @@ def topology_key(mesh: Mesh) -> str:
     for arr in (mesh.face_offsets, mesh.face_indices, mesh.face_kind):
         h.update(np.ascontiguousarray(arr).tobytes())
     return h.hexdigest()
-
-
-def fan_triangles(mesh: Mesh) -> tuple[np.ndarray, np.ndarray]:
-    """Triangles of every face for display (a fan from each face's first corner).
-
-    Returns
-    -------
-    triangles : (T, 3) int64
-        Vertex indices.
-    face : (T,) int64
-        The face each triangle belongs to.
-    """
-    off = mesh.face_offsets
-    idx = mesh.face_indices
-    val = np.diff(off)
-    ntri = np.maximum(val - 2, 0)
-    face = np.repeat(np.arange(len(val)), ntri)
-    # j = 1 .. k-2 within each face.
-    j = ranks(ntri) + 1
-    base = off[:-1][face]
-    tris = np.stack([idx[base], idx[base + j], idx[base + j + 1]], axis=1)
-    return tris, face
 
 
 def fast_figures(mesh: Mesh) -> tuple[dict[str, Any], np.ndarray, np.ndarray]:
@@ -480,7 +456,7 @@ def frame_data(design: Mapping[str, Any], built: Built) -> dict[str, Any]:
             _CURVES.update(spec=spec, value=_curve_polylines(design))
         names, counts, points = _CURVES["value"]
     bbox = mesh.bounding_box() if mesh.n_vertices else np.zeros((2, 3))
-    tris, tri_face = fan_triangles(mesh)
+    tris, tri_face = mesh.fan_triangles()
     return {
         "key": topology_key(mesh),
         "header": {"figures": figures, "construction": _construction(design, len(gens)),

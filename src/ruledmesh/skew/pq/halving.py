@@ -19,11 +19,11 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..._arrays import ranks
+from ..._arrays import cross
 from ...analysis.faces import SPLINTER_DEG, min_corner_angles
 from ...analysis.spans import off_spanned_generators
 from ...mesh import Mesh, offsets_from_valences
-from .panels import faces_across
+from .panels import _chains, _split_members, faces_across
 
 __all__ = ["halve_spanning_triangles"]
 
@@ -88,16 +88,7 @@ def _off(mesh: Mesh, tri: np.ndarray, lines: tuple[np.ndarray, np.ndarray], goal
         return np.zeros(0)
     return off_spanned_generators(mesh.vertices, tri, np.asarray(mesh.vertex_data["generator"], np.int64),
                                   np.asarray(mesh.vertex_data["t"], np.float64), lines,
-                                  faces=fanned(mesh), within=goal)
-
-
-def fanned(mesh: Mesh) -> np.ndarray:
-    """(F3, 3) int64: every face of ``mesh`` fanned into triangles from its first corner."""
-    fans = mesh.valences - 2
-    first = np.repeat(mesh.face_offsets[:-1], fans)
-    i = ranks(fans) + 1
-    idx = mesh.face_indices
-    return np.stack([idx[first], idx[first + i], idx[first + i + 1]], axis=1)
+                                  faces=mesh.fan_triangles()[0], within=goal)
 
 
 def _halvable(mesh: Mesh, faces: np.ndarray, tri: np.ndarray) -> tuple[np.ndarray, ...] | None:
@@ -167,7 +158,7 @@ def _halve(mesh: Mesh, lines: tuple[np.ndarray, np.ndarray], u: np.ndarray, v: n
     kept = mesh.select_faces(~drop)
     sizes = np.concatenate([kept.valences, np.full(sum(len(p) for p in polys), 3)])
     indices = np.concatenate([kept.face_indices] + [p.reshape(-1) for p in polys])
-    members, member_id = _split_members(mesh, k, tk, m)
+    members, member_id = _members_cut(mesh, k, tk, m)
     halved = Mesh.from_arrays(np.concatenate([mesh.vertices, P]), offsets_from_valences(sizes), indices,
                               np.concatenate([kept.face_kind, *kinds]), members=members, member_id=member_id,
                               vertex_data={"t": np.r_[t, tk], "generator": np.r_[g, k.astype(g.dtype)]},
@@ -194,11 +185,11 @@ def _kept_shape(V: np.ndarray, P: np.ndarray, u, v, apex, far, has) -> np.ndarra
 
 
 def _normals(W: np.ndarray, f: np.ndarray) -> np.ndarray:
-    return np.cross(W[f[:, 1]] - W[f[:, 0]], W[f[:, 2]] - W[f[:, 0]])
+    return cross(W[f[:, 1]] - W[f[:, 0]], W[f[:, 2]] - W[f[:, 0]])
 
 
-def _split_members(mesh: Mesh, k: np.ndarray, tk: np.ndarray, new: np.ndarray
-                   ) -> tuple[np.ndarray, np.ndarray]:
+def _members_cut(mesh: Mesh, k: np.ndarray, tk: np.ndarray, new: np.ndarray
+                 ) -> tuple[np.ndarray, np.ndarray]:
     """Members along generator ``k[j]`` whose stretch holds ``tk[j]`` cut at the new vertex
     ``new[j]`` (several new vertices on one member in their order along it)."""
     members, ids = mesh.members, mesh.member_id
@@ -221,14 +212,10 @@ def _split_members(mesh: Mesh, k: np.ndarray, tk: np.ndarray, new: np.ndarray
     if not hit.any():
         return members, ids
     row, at, along = row[hit], new[hit], tk[hit]
+    # Each member's chain from its first end to its second through the new vertices on it.
     rising = t[q[row]] >= t[p[row]]
     seq = np.lexsort((np.where(rising, along, -along), row))
     row, at = row[seq], at[seq]
-    start = np.r_[True, row[1:] != row[:-1]]
-    last = np.r_[row[1:] != row[:-1], True]
-    prev = np.where(start, p[row], np.r_[-1, at[:-1]])
-    pieces = [np.stack([prev, at], 1), np.stack([at[last], q[row[last]]], 1)]
-    gone = np.zeros(len(members), bool)
-    gone[row] = True
-    return (np.concatenate([members[~gone], *pieces]),
-            np.concatenate([ids[~gone], ids[row], ids[row[last]]]))
+    cut, counts = np.unique(row, return_counts=True)
+    start, flat = _chains(p[cut], at, q[cut], counts)
+    return _split_members(mesh, start, flat)
