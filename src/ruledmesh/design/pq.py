@@ -16,6 +16,7 @@ from ..budget import MAX_COUNT
 from ..errors import DesignError, GeometryError
 from ..registry import BuildContext, Built, mesh_method
 from ..skew.pq import MAX_GRID_POINTS, PrimaryDivision, RowsFrom, pq_mesh
+from ..skew.pq.reuse import reusing_assemblies
 from ..tolerances import DEFAULT, SPAN_MAX_GAP, TINY
 
 __all__ = ["MESH_KEYS", "build_pq", "keeping_meshes"]
@@ -71,33 +72,34 @@ def build_pq(rulings, table: Mapping[str, Any], ctx: BuildContext) -> Built:
     token = _PROGRESS.set([ctx.task, 0]) if ctx.task is not None else None
     kept = _KEPT.get()
     made = _MADE.set(kept if kept is not None else {})
-    try:
-        mesh = _mesh(rulings, options)
-        if refine:
-            given = rulings
-            rulings, kept, notes = _refined(rulings, mesh, options, respace == "auto",
-                                            rows_from == "auto", division == "auto")
-            # The graded division: here for explicit lines (for director curves the
-            # refinement weighed it, with its own rounds).
-            chosen_round, chosen = _other_rows(kept, options, free=(
-                "option" not in table, "primary" not in table, rows_from == "auto",
-                division == "auto" and _fixed_generators(given)))
-            notes += chosen
-            if rows_from == "auto":
-                rulings, chosen_round, notes = _rows_or_none(given, chosen_round, notes, options)
-            if thin == "auto":
-                chosen_round = _with_thinned_rows(chosen_round, options)
-            mesh = chosen_round[4]
-            if mesh.info["rows_from"] != options["rows_from"] or mesh.info["option"] == "mixed":
-                notes.append(_rows_from_note(mesh.info))
-            if mesh.info.get("thin") and not options["thin"]:
-                notes.append(_THINNED_NOTE)
-            if notes:
-                mesh = mesh.with_info(warnings=list(mesh.info.get("warnings", [])) + notes)
-    finally:
-        _MADE.reset(made)
-        if token is not None:
-            _PROGRESS.reset(token)
+    with reusing_assemblies():
+        try:
+            mesh = _mesh(rulings, options)
+            if refine:
+                given = rulings
+                rulings, kept, notes = _refined(rulings, mesh, options, respace == "auto",
+                                                rows_from == "auto", division == "auto")
+                # The graded division: here for explicit lines (for director curves the
+                # refinement weighed it, with its own rounds).
+                chosen_round, chosen = _other_rows(kept, options, free=(
+                    "option" not in table, "primary" not in table, rows_from == "auto",
+                    division == "auto" and _fixed_generators(given)))
+                notes += chosen
+                if rows_from == "auto":
+                    rulings, chosen_round, notes = _rows_or_none(given, chosen_round, notes, options)
+                if thin == "auto":
+                    chosen_round = _with_thinned_rows(chosen_round, options)
+                mesh = chosen_round[4]
+                if mesh.info["rows_from"] != options["rows_from"] or mesh.info["option"] == "mixed":
+                    notes.append(_rows_from_note(mesh.info))
+                if mesh.info.get("thin") and not options["thin"]:
+                    notes.append(_THINNED_NOTE)
+                if notes:
+                    mesh = mesh.with_info(warnings=list(mesh.info.get("warnings", [])) + notes)
+        finally:
+            _MADE.reset(made)
+            if token is not None:
+                _PROGRESS.reset(token)
     reference = None
     if getattr(rulings, "surface", None) is not None:
         from ..surfaces import RuledReference

@@ -34,6 +34,7 @@ from .maps import HopMaps, hop_maps
 from .pairing import pair_triangles
 from .panels import split_strip_quads
 from .respacing import evened, spread_generators
+from .reuse import assembled, remember, runs_digest
 from .runs import (
     BOTH_ENDS,
     BYTES_PER_GRID_POINT,
@@ -482,13 +483,28 @@ def pq_mesh(a, b, rows: int = 20, primary: int | str = "middle", option: int = 0
     even = _even_ranges(parts, segs, warnings, exact=ptol <= tol.planarity, own=plan.own)
     known = _Causes.of(parts, segs, torsal.size, even)    # before assemble() empties parts
     meet, runs = np.r_[flat, False] | np.r_[False, flat], len(parts)    # meet: of a coplanar pair
-    mesh, fattening, measured, spans = _fattened(assemble(parts, a, d, args.trim, tol, ptol, warnings, scale,
-                                                          meet, rows=rows), ptol, tol, (a, d))
+    mesh, fattening, measured, spans = _assembled(parts, a, d, args.trim, tol, ptol, warnings, scale, meet, rows)
     _warn_share(mesh, warnings, known, m, rows, (a, d, ptol), measured)
     passes = {**fattening, "off_generators": _warn_faces(mesh, warnings, torsal, measured, (a, d), spans)}
     if kept.size < m_given:
         mesh = _renumbered(mesh, kept)
     return mesh.with_info(runs=runs, restarts=known.restarts, **_options_info(plan, args, kept), **passes)
+
+
+def _assembled(parts: list[Run], a, d, trim: bool, tol: Tolerances, ptol: float, warnings: list[str],
+               scale: float, meet: np.ndarray, rows: int) -> tuple[Mesh, dict[str, int], tuple | None, tuple]:
+    """The runs assembled and the passes after (:func:`~.assemble.assemble`, :func:`_fattened`),
+    once per distinct set of runs where a caller is reusing assemblies (:mod:`.reuse`)."""
+    key = runs_digest(parts, (a, d, meet), (trim, tol, ptol, scale, rows))
+    if (hit := assembled(key)) is not None:
+        mesh, *rest, said = hit
+        warnings.extend(said)
+        return (mesh.with_info(warnings=warnings), *rest)
+    n = len(warnings)
+    mesh, fattening, measured, spans = _fattened(assemble(parts, a, d, trim, tol, ptol, warnings, scale, meet,
+                                                          rows=rows), ptol, tol, (a, d))
+    remember(key, (mesh, fattening, measured, spans, tuple(warnings[n:])))
+    return mesh, fattening, measured, spans
 
 
 def _options_info(plan: _Plan, args: _Args, kept: np.ndarray) -> dict:
