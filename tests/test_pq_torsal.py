@@ -184,3 +184,34 @@ def test_large_strip_quads_are_cut_to_the_size_of_the_other_panels():
     g = np.asarray(mesh.vertex_data["generator"])
     assert np.all(g[mesh.members[:, 0]] == g[mesh.members[:, 1]])
     assert np.all(g[mesh.members[:, 0]] == mesh.member_id)
+
+
+# Two zigzag polylines in one plane, c2 doubling back along one line: generator 2 ends where
+# generator 0 starts, and a pass merges the two corners into generator 0's vertex.
+DOUBLED_BACK = """
+[curves.c1]
+type = "bspline"
+points = [[0, 0, 0], [0, 1, 0], [0, 0, 1], [0, 1, 0]]
+degree = 1
+[curves.c2]
+type = "bspline"
+points = [[0, 0, 1], [0, 0, 0], [0, 0, 1], [0, 0, 0]]
+degree = 1
+[rulings]
+between = ["c1", "c2"]
+count = 3
+[mesh]
+rows = 1
+refine = false
+"""
+
+
+def test_a_quad_with_merged_corners_is_not_cut_as_a_strip_quad():
+    """Found by the fuzzing (test_fuzz_ruled_designs): a large strip quad whose corners a pass
+    had merged across generators was cut as if two of its edges lay on generators; its new
+    points, labelled with a generator and t, lay up to 0.4 (of a 1.4 patch) off it."""
+    built = build_design(parse_design(DOUBLED_BACK, "doubled-back.toml"))
+    mesh, r = built.mesh, built.rulings
+    a, b = np.asarray(r.a), np.asarray(r.b)
+    g, t = np.asarray(mesh.vertex_data["generator"]), np.asarray(mesh.vertex_data["t"])
+    assert np.abs(a[g] + t[:, None] * (b[g] - a[g]) - mesh.vertices).max() <= 1e-12

@@ -57,8 +57,16 @@ def split_strip_quads(mesh: Mesh) -> tuple[Mesh, int]:
     big = strip[area[strip] > _LARGE * middle]
     if big.size == 0 or middle <= 0.0:
         return mesh, 0
-    pieces = np.clip(np.rint(area[big] / middle), 2, _MAX_PIECES).astype(np.int64)
     corners = _strip_corners(mesh, big)
+    # Only a quad with two edges along two generators is a strip quad to cut: a pass
+    # before may have merged corners of different generators (coincident end points of a
+    # degenerate design), and points on its other edges would not lie on their generators.
+    gen = np.asarray(mesh.vertex_data["generator"])[corners]
+    two = (gen[:, 0] == gen[:, 1]) & (gen[:, 2] == gen[:, 3]) & (gen[:, 0] != gen[:, 2])
+    big, corners = big[two], corners[two]
+    if big.size == 0:
+        return mesh, 0
+    pieces = np.clip(np.rint(area[big] / middle), 2, _MAX_PIECES).astype(np.int64)
     # The faces across the two generator edges a0 -> a1 and b1 -> b0.
     across = [faces_across(mesh, corners[:, 0], corners[:, 1]), faces_across(mesh, corners[:, 2], corners[:, 3])]
     # The fans never lower the mesh's smallest angle (nor go below the splinter bar).
