@@ -300,7 +300,7 @@ def ruled_designs(draw):
         rulings["directrix"] = draw(DIRECTRIX)
     if draw(st.booleans()):
         mesh = {"method": "pq", "rows": draw(st.integers(1, 6)),
-                "option": draw(st.integers(0, 1)), "trim": True}
+                "option": draw(st.integers(0, 1)), "trim": True, "refine": draw(st.booleans())}
     else:
         mesh = {"method": "hybrid", "midpoints": draw(st.integers(0, 2)),
                 "divisions": draw(st.integers(1, 4))}
@@ -336,11 +336,11 @@ def test_fuzz_ruled_designs(data):
 
 @min_built(0.5)
 @fuzz(800)
-@given(gens=generator_sets(), rows=st.integers(1, 6), hybrid=st.booleans())
-def test_fuzz_line_designs(gens, rows, hybrid):
+@given(gens=generator_sets(), rows=st.integers(1, 6), hybrid=st.booleans(), refine=st.booleans())
+def test_fuzz_line_designs(gens, rows, hybrid, refine):
     a, b = gens
     lines = np.stack([a, b], axis=1).tolist()
-    mesh = {"method": "hybrid"} if hybrid else {"rows": rows}
+    mesh = {"method": "hybrid"} if hybrid else {"rows": rows, "refine": refine}
     built = _build({"rulings": {"lines": lines}, "mesh": mesh})
     if built is not None:
         check_mesh(built.mesh)
