@@ -57,12 +57,13 @@ import argparse
 import hashlib
 import json
 import os
+import queue
 import subprocess
 import sys
 import tempfile
 import time
 import tomllib
-from concurrent.futures import ThreadPoolExecutor
+from concurrent.futures import Future, ThreadPoolExecutor
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
@@ -167,16 +168,94 @@ class BuildResult:
     obj: Path
 
 
-def build(design: Path, obj: Path, timeout: float = 900.0) -> BuildResult:
-    """Run ``python -m ruledmesh.cli build design -o obj`` and time it."""
+def _cli_env() -> dict[str, str]:
     env = dict(os.environ)
     src = str(ROOT / "src")
     env["PYTHONPATH"] = src + (os.pathsep + env["PYTHONPATH"] if env.get("PYTHONPATH") else "")
+    return env
+
+
+def build(design: Path, obj: Path, timeout: float = 900.0) -> BuildResult:
+    """Run ``python -m ruledmesh.cli build design -o obj`` and time it."""
     t0 = time.perf_counter()
     proc = subprocess.run([sys.executable, "-m", "ruledmesh.cli", "build", str(design), "-o",
-                           str(obj)], capture_output=True, text=True, timeout=timeout, env=env,
+                           str(obj)], capture_output=True, text=True, timeout=timeout, env=_cli_env(),
                           check=False)
     return BuildResult(proc.returncode, time.perf_counter() - t0, proc.stdout, proc.stderr, obj)
+
+
+# A worker of BuildPool: one design path and OBJ path per line in, one JSON result per line
+# out; each build runs the command line's own entry point with its output captured.
+_WORKER = """
+import contextlib, io, json, sys, time
+from ruledmesh.cli import main
+for line in sys.stdin:
+    design, obj = json.loads(line)
+    out, err = io.StringIO(), io.StringIO()
+    t0 = time.perf_counter()
+    with contextlib.redirect_stdout(out), contextlib.redirect_stderr(err):
+        try:
+            rc = main(["build", design, "-o", obj])
+        except SystemExit as exc:
+            rc = exc.code if isinstance(exc.code, int) else 1
+        except BaseException as exc:
+            print(f"{type(exc).__name__}: {exc}", file=sys.stderr)
+            rc = 3
+    seconds = time.perf_counter() - t0
+    sys.stdout.write(json.dumps([rc, seconds, out.getvalue(), err.getvalue()]) + "\\n")
+    sys.stdout.flush()
+"""
+
+
+class BuildPool:
+    """``ruledmesh build`` of many designs in ``jobs`` long-lived worker processes.
+
+    Each worker runs the command line's entry point (``ruledmesh.cli.main``) in-process for
+    one design after another, so the interpreter's start and the imports (about 2 s a
+    build, most of a small design's time) are paid once per worker; the build times then
+    leave them out.  A worker that dies is replaced for the next design.
+    """
+
+    def __init__(self, jobs: int) -> None:
+        self._idle: queue.Queue[subprocess.Popen] = queue.Queue()
+        for _ in range(jobs):
+            self._idle.put(self._start())
+        self._threads = ThreadPoolExecutor(jobs)
+
+    @staticmethod
+    def _start() -> subprocess.Popen:
+        return subprocess.Popen([sys.executable, "-c", _WORKER], stdin=subprocess.PIPE,
+                                stdout=subprocess.PIPE, text=True, env=_cli_env())
+
+    def submit(self, design: Path, obj: Path) -> Future:
+        """Start building ``design`` into ``obj``; the future gives its :class:`BuildResult`."""
+        return self._threads.submit(self._build, design, obj)
+
+    def _build(self, design: Path, obj: Path) -> BuildResult:
+        proc = self._idle.get()
+        assert proc.stdin is not None and proc.stdout is not None
+        try:
+            proc.stdin.write(json.dumps([str(design), str(obj)]) + "\n")
+            proc.stdin.flush()
+            line = proc.stdout.readline()
+        except OSError:
+            line = ""
+        if not line:
+            code = proc.wait()
+            self._idle.put(self._start())
+            return BuildResult(code or 1, 0.0, "", f"the build worker ended (exit {code})", obj)
+        self._idle.put(proc)
+        rc, seconds, out, err = json.loads(line)
+        return BuildResult(rc, seconds, out, err, obj)
+
+    def close(self) -> None:
+        """Stop the workers (builds not started are dropped)."""
+        self._threads.shutdown(cancel_futures=True)
+        while not self._idle.empty():
+            proc = self._idle.get()
+            if proc.stdin is not None:
+                proc.stdin.close()
+            proc.wait()
 
 
 @dataclass
@@ -1157,9 +1236,9 @@ def _relative(path: Path, suffix: bool = False) -> str:
 
 
 def _run_all(surfaces: list[Surface], work: Path, jobs: int) -> list[dict]:
-    """Build and measure every surface; with ``jobs > 1`` builds run ahead in threads."""
-    pool = ThreadPoolExecutor(jobs) if jobs > 1 else None
-    futures = [pool.submit(build, s.path, obj_path(s, work)) for s in surfaces] if pool else []
+    """Build and measure every surface; with ``jobs > 1`` builds run ahead in a :class:`BuildPool`."""
+    pool = BuildPool(jobs) if jobs > 1 else None
+    futures = [pool.submit(s.path, obj_path(s, work)) for s in surfaces] if pool else []
     rows = []
     for i, s in enumerate(surfaces):
         row = run_surface(s, work, futures[i].result() if pool else None)
@@ -1167,7 +1246,7 @@ def _run_all(surfaces: list[Surface], work: Path, jobs: int) -> list[dict]:
         print(f"{s.name}: {row['status']} ({row['build_seconds']:.1f} s build, "
               f"{row.get('measure_seconds', 0):.1f} s measure)", file=sys.stderr)
     if pool:
-        pool.shutdown()
+        pool.close()
     return rows
 
 

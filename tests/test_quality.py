@@ -1,6 +1,7 @@
 """Mesh quality on the regression surfaces of benchmarks/quality/, built with the CLI.
 
-Each surface is built once per module (``python -m ruledmesh.cli build``), read
+Each surface is built once per module with the command line (``ruledmesh build``,
+its entry point run in two long-lived worker processes: ``quality.BuildPool``), read
 back from OBJ and measured by ``benchmarks/quality.py``, independently of
 ``ruledmesh.analysis``.  The figures asserted are the fabrication bar for PQ
 meshes of skew surfaces:
@@ -22,7 +23,7 @@ tolerance mode (``[mesh] planarity_tolerance``)
 from __future__ import annotations
 
 import math
-from concurrent.futures import Future, ThreadPoolExecutor
+from concurrent.futures import Future
 
 import pytest
 from _shared import bench_module
@@ -74,18 +75,19 @@ def _ids(surfaces):
 def measured(tmp_path_factory):
     """Build and measure each surface once per module; failed builds fail every test of it.
 
-    Two builds run at once: asking for a surface also starts the build of the
-    next one in :data:`ALL` (the order the parametrised tests ask in).
+    Two builds run at once, in the two workers of a :class:`quality.BuildPool` (one
+    interpreter start and one set of imports each, not one per surface): asking for a
+    surface also starts the build of the next one in :data:`ALL` (the order the
+    parametrised tests ask in).
     """
     cache: dict[str, dict] = {}
     builds: dict[str, Future] = {}
     work = tmp_path_factory.mktemp("quality")
-    pool = ThreadPoolExecutor(2)
+    pool = quality.BuildPool(2)
 
     def start(surface) -> Future:
         if surface.name not in builds:
-            builds[surface.name] = pool.submit(quality.build, surface.path,
-                                               quality.obj_path(surface, work))
+            builds[surface.name] = pool.submit(surface.path, quality.obj_path(surface, work))
         return builds[surface.name]
 
     def get(surface) -> dict:
@@ -103,7 +105,7 @@ def measured(tmp_path_factory):
         return row
 
     yield get
-    pool.shutdown(cancel_futures=True)
+    pool.close()
 
 
 def _rounding(row: dict) -> float:
