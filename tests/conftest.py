@@ -75,24 +75,24 @@ import _shared  # noqa: E402 - importable only once the finder is in place
 SMALL_DESIGN = _shared.SMALL_DESIGN
 
 # The longest test files, longest first (seconds of one worker, measured with --durations=0 on
-# 2026-12-06, 1,257 s in all).  The two workers take a file at a time in collection order
-# (--dist loadfile --no-loadscope-reorder): the longest files first, so the short ones even out
-# the end.  (pytest-xdist orders the files by their number of tests unless told not to, which
-# it can be since 3.8: until then this order had no effect, the long files with few tests each
-# came last, and one worker ran on alone for about 70 s.)
-LONGEST_FIRST = ("test_fuzz.py",               # 167 s
-                 "test_quality.py",            # 161 s
-                 "test_designer_browser.py",   # 110 s
-                 "test_designer.py",           # 87 s
-                 "test_pq_quality.py",         # 68 s
-                 "test_pq_splinters.py",       # 59 s
-                 "test_pq_choice.py",          # 57 s
-                 "test_fuzz_cli.py",           # 47 s
-                 "test_help_examples.py",      # 43 s
-                 "test_designer_security.py",  # 34 s
-                 "test_cli.py",                # 33 s
-                 "test_analysis_claims.py",    # 29 s
-                 "test_robustness_geometry.py")  # 29 s
+# 2026-12-08, 1,190 s in all, 614 s of wall time).  The two workers take a file at a time in
+# collection order (--dist loadfile --no-loadscope-reorder): the longest files first, so the
+# short ones even out the end.  (pytest-xdist orders the files by their number of tests unless
+# told not to, which it can be since 3.8: until then this order had no effect, the long files
+# with few tests each came last, and one worker ran on alone for about 70 s.)
+LONGEST_FIRST = ("test_fuzz.py",               # 174 s
+                 "test_designer_browser.py",   # 130 s
+                 "test_quality.py",            # 118 s (and two build processes of its own)
+                 "test_designer.py",           # 82 s
+                 "test_pq_choice.py",          # 53 s
+                 "test_pq_splinters.py",       # 49 s
+                 "test_pq_quality.py",         # 43 s
+                 "test_help_examples.py",      # 34 s
+                 "test_pq_thinned.py",         # 34 s
+                 "test_robustness_geometry.py",  # 30 s
+                 "test_designer_security.py",  # 29 s
+                 "test_cli.py",                # 26 s
+                 "test_bundled_examples.py")   # 24 s
 
 
 def pytest_collection_modifyitems(config, items):
