@@ -187,7 +187,11 @@ def build(design: Path, obj: Path, timeout: float = 900.0) -> BuildResult:
 # A worker of BuildPool: one design path and OBJ path per line in, one JSON result per line
 # out; each build runs the command line's own entry point with its output captured.
 _WORKER = """
-import contextlib, io, json, sys, time
+import contextlib, io, json, os, sys, time
+# The results go out on a copy of stdout; anything written to file descriptor 1 itself
+# (below Python's sys.stdout) goes to stderr, not into the results.
+results = os.fdopen(os.dup(1), "w")
+os.dup2(2, 1)
 from ruledmesh.cli import main
 for line in sys.stdin:
     design, obj = json.loads(line)
@@ -202,8 +206,8 @@ for line in sys.stdin:
             print(f"{type(exc).__name__}: {exc}", file=sys.stderr)
             rc = 3
     seconds = time.perf_counter() - t0
-    sys.stdout.write(json.dumps([rc, seconds, out.getvalue(), err.getvalue()]) + "\\n")
-    sys.stdout.flush()
+    results.write(json.dumps([rc, seconds, out.getvalue(), err.getvalue()]) + "\\n")
+    results.flush()
 """
 
 
