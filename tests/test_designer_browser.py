@@ -54,6 +54,26 @@ PIXELS_JS = """([w, h]) => {
 }"""
 
 
+# What a designer's build worker runs when a page opens (web.builder._warm_up on the
+# default design), in a process of its own so that this one keeps numpy for small builds.
+_WARM_UP = """
+from ruledmesh.design import parse_design, build_design
+from ruledmesh.web.builder import _warm_up
+from ruledmesh.web.session import DEFAULT_DESIGN, frame_data
+default = parse_design(DEFAULT_DESIGN)
+_warm_up(lambda: frame_data(default.data, build_design(default)))
+"""
+
+
+@pytest.fixture(scope="module", autouse=True)
+def compiled_kernels():
+    """numba's on-disk cache filled before any page opens.  A page's first edit waits for its
+    server's worker to load the kernels; on a fresh checkout (CI) that is compiling them,
+    30-35 s, and the first tests' 20-s waits ran out when this file ran before any other
+    had compiled them."""
+    subprocess.run([sys.executable, "-c", _WARM_UP], check=True, timeout=600)
+
+
 @pytest.fixture(scope="module")
 def browser(tmp_path_factory):
     with sync_api.sync_playwright() as p:
