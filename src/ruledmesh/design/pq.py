@@ -72,7 +72,9 @@ def build_pq(rulings, table: Mapping[str, Any], ctx: BuildContext) -> Built:
     token = _PROGRESS.set([ctx.task, 0]) if ctx.task is not None else None
     kept = _KEPT.get()
     made = _MADE.set(kept if kept is not None else {})
-    with reusing_assemblies():
+    # Only a refined build weighs more than one mesh: an unrefined one (the designer's quick
+    # mesh on every edit) would hash its runs for nothing: 1.1 of 21 ms at 100 x 100.
+    with reusing_assemblies() if refine else contextlib.nullcontext():
         try:
             mesh = _mesh(rulings, options)
             if refine:
