@@ -57,12 +57,7 @@ def split_strip_quads(mesh: Mesh) -> tuple[Mesh, int]:
     big = strip[area[strip] > _LARGE * middle]
     if big.size == 0 or middle <= 0.0:
         return mesh, 0
-    corners = _strip_corners(mesh, big)
-    # Only a quad with two edges along two generators is a strip quad to cut: a pass
-    # before may have merged corners of different generators (coincident end points of a
-    # degenerate design), and points on its other edges would not lie on their generators.
-    gen = np.asarray(mesh.vertex_data["generator"])[corners]
-    two = (gen[:, 0] == gen[:, 1]) & (gen[:, 2] == gen[:, 3]) & (gen[:, 0] != gen[:, 2])
+    corners, two = _strip_corners(mesh, big)
     big, corners = big[two], corners[two]
     if big.size == 0:
         return mesh, 0
@@ -79,13 +74,19 @@ def split_strip_quads(mesh: Mesh) -> tuple[Mesh, int]:
     return _cut(mesh, big[keep], corners[keep], pieces[keep], across), int(keep.sum())
 
 
-def _strip_corners(mesh: Mesh, faces: np.ndarray) -> np.ndarray:
-    """(k, 4) corners ``a0, a1, b1, b0`` of strip quads: ``a0 a1`` and ``b1 b0`` on generators."""
+def _strip_corners(mesh: Mesh, faces: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """(k, 4) corners ``a0, a1, b1, b0`` of strip quads: ``a0 a1`` and ``b1 b0`` on generators;
+    (k,) bool: whether the quad has those two edges on two different generators.
+
+    Only those are strip quads to cut: a pass before may have merged corners of different
+    generators (coincident end points of a degenerate design), and points put on the other
+    edges would not lie on their generators."""
     idx = mesh.face_indices[mesh.face_offsets[faces][:, None] + np.arange(4)]
     gen = np.asarray(mesh.vertex_data["generator"])[idx]
     turn = gen[:, 0] != gen[:, 1]
     idx[turn] = np.roll(idx[turn], -1, axis=1)
-    return idx
+    gen[turn] = np.roll(gen[turn], -1, axis=1)
+    return idx, (gen[:, 0] == gen[:, 1]) & (gen[:, 2] == gen[:, 3]) & (gen[:, 0] != gen[:, 2])
 
 
 def faces_across(mesh: Mesh, a: np.ndarray, b: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
