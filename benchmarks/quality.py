@@ -201,7 +201,7 @@ for line in sys.stdin:
         try:
             rc = main(["build", design, "-o", obj])
         except SystemExit as exc:
-            rc = exc.code if isinstance(exc.code, int) else 1
+            rc = 0 if exc.code is None else exc.code if isinstance(exc.code, int) else 1
         except BaseException as exc:
             print(f"{type(exc).__name__}: {exc}", file=sys.stderr)
             rc = 3
